@@ -1,0 +1,202 @@
+//! Strict RON reading and atomic writing shared by score and kit files: parse errors name
+//! the file, line and column; saving goes to a temporary file in the same folder that is
+//! synced and then renamed over the target, so a crash never leaves a half-written file.
+
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Anything that can go wrong reading or writing one of our files.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum FileError {
+    /// The file could not be read or written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The text is not valid RON for the expected structure.
+    #[error("{}:{line}:{col}: {message}", path.display())]
+    Parse {
+        path: PathBuf,
+        line: usize,
+        col: usize,
+        message: String,
+    },
+    /// The file parsed but its content is not acceptable (`place` says where, e.g. "beat 3").
+    #[error("{}: {place}: {message}", path.display())]
+    Invalid {
+        path: PathBuf,
+        place: String,
+        message: String,
+    },
+    /// The file was written by a newer timpanist.
+    #[error(
+        "{}: format version {found} is newer than this timpanist reads (1 to {supported}); please update timpanist",
+        path.display()
+    )]
+    TooNew {
+        path: PathBuf,
+        found: u32,
+        supported: u32,
+    },
+}
+
+impl FileError {
+    /// Wrap an I/O error with the file it concerns.
+    pub fn io(path: &Path, source: std::io::Error) -> Self {
+        FileError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+
+    /// A content problem at `place` in the file at `path`.
+    pub fn invalid(path: &Path, place: impl Into<String>, message: impl Into<String>) -> Self {
+        FileError::Invalid {
+            path: path.to_path_buf(),
+            place: place.into(),
+            message: message.into(),
+        }
+    }
+}
+
+/// Read a whole text file.
+pub fn read_text(path: &Path) -> Result<String, FileError> {
+    std::fs::read_to_string(path).map_err(|e| FileError::io(path, e))
+}
+
+/// Parse RON text strictly into `T`, naming `path` and the line and column on error.
+pub fn parse<T: DeserializeOwned>(path: &Path, text: &str) -> Result<T, FileError> {
+    ron::from_str(text).map_err(|e| FileError::Parse {
+        path: path.to_path_buf(),
+        line: e.span.start.line,
+        col: e.span.start.col,
+        message: e.code.to_string(),
+    })
+}
+
+/// Serialise `value` as pretty RON with struct names, ending in a newline.
+pub fn to_pretty<T: Serialize>(value: &T) -> String {
+    let config = ron::ser::PrettyConfig::new()
+        .struct_names(true)
+        .indentor("    ")
+        .separate_tuple_members(false)
+        .enumerate_arrays(false);
+    let mut text = ron::ser::to_string_pretty(value, config)
+        .expect("our score and kit types always serialise to RON");
+    text.push('\n');
+    text
+}
+
+/// Write `bytes` to `path` atomically: a temporary file beside it, synced, then renamed.
+/// On any error the target is untouched and no temporary file is left behind.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".timpanist-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(|e| FileError::io(path, e))?;
+    tmp.write_all(bytes).map_err(|e| FileError::io(path, e))?;
+    tmp.as_file()
+        .sync_all()
+        .map_err(|e| FileError::io(path, e))?;
+    tmp.persist(path)
+        .map_err(|e| FileError::io(path, e.error))?;
+    Ok(())
+}
+
+/// Save `value` as pretty RON to `path`, atomically.
+pub fn save<T: Serialize>(path: &Path, value: &T) -> Result<(), FileError> {
+    write_atomic(path, to_pretty(value).as_bytes())
+}
+
+/// The first identifier of a RON document (e.g. `Score` or `Kit`), skipping whitespace,
+/// comments and `#![enable(...)]` attributes; `None` for an unnamed top-level value.
+pub fn top_level_name(text: &str) -> Option<&str> {
+    let mut rest = text;
+    loop {
+        rest = rest.trim_start();
+        if let Some(r) = rest.strip_prefix("//") {
+            rest = r.split_once('\n').map_or("", |(_, after)| after);
+        } else if let Some(r) = rest.strip_prefix("/*") {
+            rest = r.split_once("*/").map_or("", |(_, after)| after);
+        } else if rest.starts_with("#!") {
+            rest = rest.split_once(']').map_or("", |(_, after)| after);
+        } else {
+            break;
+        }
+    }
+    let end = rest
+        .find(|c: char| !(c.is_alphanumeric() || c == '_'))
+        .unwrap_or(rest.len());
+    (end > 0).then(|| &rest[..end])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde::Deserialize;
+
+    #[derive(Debug, Deserialize, Serialize, PartialEq)]
+    #[serde(deny_unknown_fields)]
+    struct Thing {
+        a: u32,
+        b: String,
+    }
+
+    /// A typo in a field name reports 1-based line and column and the expected fields.
+    #[test]
+    fn parse_error_names_place() {
+        let text = "Thing(\n    a: 1,\n    bb: \"x\",\n)";
+        let err = parse::<Thing>(Path::new("t.ron"), text).unwrap_err();
+        let msg = err.to_string();
+        assert!(msg.starts_with("t.ron:3:"), "{msg}");
+        assert!(msg.contains("bb") && msg.contains('b'), "{msg}");
+    }
+
+    /// A missing field is an error too.
+    #[test]
+    fn missing_field_is_error() {
+        let err = parse::<Thing>(Path::new("t.ron"), "(a: 1)").unwrap_err();
+        assert!(err.to_string().contains("`b`"), "{err}");
+    }
+
+    /// Atomic save writes the file and leaves no temporary behind; a failed save leaves
+    /// the previous content intact.
+    #[test]
+    fn atomic_save() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("x.ron");
+        let thing = Thing {
+            a: 7,
+            b: "seven".into(),
+        };
+        save(&path, &thing).unwrap();
+        assert_eq!(
+            parse::<Thing>(&path, &read_text(&path).unwrap()).unwrap(),
+            thing
+        );
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        let missing_dir = dir.path().join("no/such/dir/x.ron");
+        assert!(save(&missing_dir, &thing).is_err());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    /// The top-level name is found past comments and extension attributes.
+    #[test]
+    fn finds_top_level_name() {
+        assert_eq!(
+            top_level_name("// hi\n/* x */ #![enable(implicit_some)]\nKit(a: 1)"),
+            Some("Kit")
+        );
+        assert_eq!(top_level_name("(a: 1)"), None);
+    }
+}

@@ -1,0 +1,15 @@
+//! timpanist: compose timpani gesture scores and hear and see them performed by a
+//! physically simulated timpanist. The library holds every capability; the binary's CLI
+//! and the eframe editor (`app`) are two thin faces over it.
+//!
+//! Data flows one way: score + kit → sticking and planning (`motion`) → trajectories →
+//! simulation → sound and motion; `io` reads and writes files.
+
+pub mod app;
+pub mod cli;
+pub mod io;
+pub mod kit;
+pub mod motion;
+pub mod pitch;
+pub mod problem;
+pub mod score;

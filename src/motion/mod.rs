@@ -1,0 +1,4 @@
+//! From score to motion: hand assignment (sticking) now; motion-unit planning, splicing and
+//! co-articulation build on it.
+
+pub mod sticking;

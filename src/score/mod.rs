@@ -1,0 +1,446 @@
+//! The gesture score: beats in exact musical time (integer ticks) under a tempo map and
+//! time signatures, each with hand, playing mode, dynamic, drum, pitch, impact location and
+//! an optional roll; read from and written to strict, versioned RON files (`scores/*.ron`).
+
+pub mod meter;
+pub mod tempo;
+pub mod validate;
+
+use crate::io::ron_file::{self, FileError};
+use crate::kit::{Kit, Side};
+use crate::pitch::Pitch;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+pub use meter::{BarBeat, MeterChange, MeterMap};
+pub use tempo::{TempoChange, TempoMap, TempoPoint};
+
+/// The score file format this timpanist writes and the newest it reads.
+pub const SCORE_FORMAT_VERSION: u32 = 1;
+
+/// Ticks per quarter note of new scores.
+pub const DEFAULT_TICKS_PER_QUARTER: u32 = 960;
+
+/// The hand that plays a beat.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Hand {
+    Left,
+    Right,
+    /// Let a sticking method choose (see `motion::sticking`).
+    Auto,
+}
+
+impl Hand {
+    /// The side, if the hand is fixed.
+    pub fn side(self) -> Option<Side> {
+        match self {
+            Hand::Left => Some(Side::Left),
+            Hand::Right => Some(Side::Right),
+            Hand::Auto => None,
+        }
+    }
+}
+
+impl From<Side> for Hand {
+    fn from(side: Side) -> Hand {
+        match side {
+            Side::Left => Hand::Left,
+            Side::Right => Hand::Right,
+        }
+    }
+}
+
+/// The five timpani playing modes (seed 000 §2.4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub enum PlayingMode {
+    Legato,
+    Tenuto,
+    Accent,
+    VerticalAccent,
+    Staccato,
+}
+
+impl PlayingMode {
+    /// All modes in the order of the number keys 1–5.
+    pub const ALL: [PlayingMode; 5] = [
+        PlayingMode::Legato,
+        PlayingMode::Tenuto,
+        PlayingMode::Accent,
+        PlayingMode::VerticalAccent,
+        PlayingMode::Staccato,
+    ];
+
+    /// Lower-case name as used on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            PlayingMode::Legato => "legato",
+            PlayingMode::Tenuto => "tenuto",
+            PlayingMode::Accent => "accent",
+            PlayingMode::VerticalAccent => "vertical accent",
+            PlayingMode::Staccato => "staccato",
+        }
+    }
+}
+
+/// Grip of the sticks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Grip {
+    /// Thumbs up, palms facing each other: large vertical motion.
+    French,
+    /// Palms down: smaller vertical motion, more wrist.
+    German,
+}
+
+/// How loud a beat is: a dynamic marking or an exact velocity in 0–1.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Dynamic {
+    Pp,
+    P,
+    Mp,
+    Mf,
+    F,
+    Ff,
+    /// A velocity in 0–1 (1 is MIDI velocity 127).
+    Velocity(f64),
+}
+
+impl Dynamic {
+    /// The markings from soft to loud with their MIDI velocities.
+    pub const MARKS: [(Dynamic, u8, &'static str); 6] = [
+        (Dynamic::Pp, 33, "pp"),
+        (Dynamic::P, 49, "p"),
+        (Dynamic::Mp, 64, "mp"),
+        (Dynamic::Mf, 80, "mf"),
+        (Dynamic::F, 96, "f"),
+        (Dynamic::Ff, 112, "ff"),
+    ];
+
+    /// Velocity in 0–1.
+    pub fn velocity(self) -> f64 {
+        match self {
+            Dynamic::Velocity(v) => v,
+            mark => {
+                let (_, midi, _) = Self::MARKS
+                    .iter()
+                    .find(|(m, _, _)| *m == mark)
+                    .expect("every marking is in MARKS");
+                f64::from(*midi) / 127.0
+            }
+        }
+    }
+
+    /// MIDI velocity 1–127.
+    pub fn midi_velocity(self) -> u8 {
+        (self.velocity() * 127.0).round().clamp(1.0, 127.0) as u8
+    }
+
+    /// The marking for a MIDI velocity if it is exactly a marking's, else a velocity.
+    pub fn from_midi_velocity(velocity: u8) -> Dynamic {
+        Self::MARKS
+            .iter()
+            .find(|(_, v, _)| *v == velocity)
+            .map(|(m, _, _)| *m)
+            .unwrap_or(Dynamic::Velocity(f64::from(velocity) / 127.0))
+    }
+
+    /// The nearest marking's name, e.g. "mf".
+    pub fn nearest_mark(self) -> &'static str {
+        let v = self.velocity() * 127.0;
+        Self::MARKS
+            .iter()
+            .min_by(|a, b| {
+                (f64::from(a.1) - v)
+                    .abs()
+                    .total_cmp(&(f64::from(b.1) - v).abs())
+            })
+            .map(|m| m.2)
+            .expect("MARKS is not empty")
+    }
+}
+
+/// Where the mallet strikes the head.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum ImpactLocation {
+    /// The centre of the head (dull, short sound).
+    Centre,
+    /// The usual playing spot, a third of the radius in from the rim, toward the player.
+    PlayingSpot,
+    /// Just inside the rim, toward the player.
+    Rim,
+    /// Any point: radius as a fraction of the head radius (0 centre, 1 rim) and angle in
+    /// degrees from the direction toward the player, counter-clockwise seen from above.
+    Point { radius: f64, angle_deg: f64 },
+}
+
+impl ImpactLocation {
+    /// Radius fraction of the playing spot.
+    pub const PLAYING_SPOT_RADIUS: f64 = 2.0 / 3.0;
+    /// Radius fraction of a rim stroke.
+    pub const RIM_RADIUS: f64 = 0.92;
+
+    /// (radius fraction, angle in degrees) on the head.
+    pub fn polar(self) -> (f64, f64) {
+        match self {
+            ImpactLocation::Centre => (0.0, 0.0),
+            ImpactLocation::PlayingSpot => (Self::PLAYING_SPOT_RADIUS, 0.0),
+            ImpactLocation::Rim => (Self::RIM_RADIUS, 0.0),
+            ImpactLocation::Point { radius, angle_deg } => (radius, angle_deg),
+        }
+    }
+
+    /// Short name for display.
+    pub fn name(self) -> String {
+        match self {
+            ImpactLocation::Centre => "centre".into(),
+            ImpactLocation::PlayingSpot => "playing spot".into(),
+            ImpactLocation::Rim => "rim".into(),
+            ImpactLocation::Point { radius, angle_deg } => {
+                format!("r {radius:.2} at {angle_deg:.0}°")
+            }
+        }
+    }
+}
+
+/// A roll (tremolo) starting at a beat: single strokes alternating hands, starting with
+/// the beat's hand.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Roll {
+    /// How long the roll lasts, ticks.
+    pub length_ticks: u64,
+    /// Strokes per quarter note (e.g. 8 for thirty-second notes).
+    pub strokes_per_quarter: u32,
+}
+
+/// One stroke (or roll) of the score.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Beat {
+    /// Position in ticks from the start of the score.
+    pub tick: u64,
+    pub hand: Hand,
+    pub mode: PlayingMode,
+    pub dynamic: Dynamic,
+    /// Index of the drum in the kit (0 is the first drum of the kit file).
+    pub drum: usize,
+    /// The pitch the drum is tuned to for this beat; `None` keeps the kit tuning.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pitch: Option<Pitch>,
+    pub location: ImpactLocation,
+    /// A roll starting at this beat; `None` for a single stroke.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub roll: Option<Roll>,
+}
+
+impl Beat {
+    /// The pitch sounded: the beat's own or the drum's kit tuning.
+    pub fn sounding_pitch(&self, kit: &Kit) -> Pitch {
+        self.pitch.unwrap_or(kit.drums[self.drum].tuning)
+    }
+
+    /// Tick of the last stroke (the beat itself, or the end of its roll).
+    pub fn end_tick(&self) -> u64 {
+        self.tick + self.roll.map_or(0, |r| r.length_ticks)
+    }
+}
+
+/// A whole score, as saved in a `.ron` file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename = "Score", deny_unknown_fields)]
+pub struct Score {
+    /// File format version (currently 1).
+    pub version: u32,
+    pub title: String,
+    /// The kit: a path ending in `.ron`, relative to the score file, or the name of a
+    /// bundled kit ("standard", "pair").
+    pub kit: String,
+    pub grip: Grip,
+    /// Resolution of musical time (960 in new scores).
+    pub ticks_per_quarter: u32,
+    /// Tempo points, the first at tick 0.
+    pub tempo: Vec<TempoPoint>,
+    /// Time signatures, the first at bar 1.
+    pub meter: Vec<MeterChange>,
+    /// The beats, in time order.
+    pub beats: Vec<Beat>,
+}
+
+/// A score together with its kit, as loaded from disk.
+#[derive(Clone, Debug)]
+pub struct LoadedScore {
+    pub score: Score,
+    pub kit: Kit,
+    /// Where the kit came from, for display.
+    pub kit_source: String,
+    /// Things the user should know that did not stop loading (e.g. a kit fallback).
+    pub notices: Vec<String>,
+}
+
+impl Score {
+    /// An empty score in 4/4 at 100 bpm on the standard kit.
+    pub fn new(title: &str) -> Score {
+        Score {
+            version: SCORE_FORMAT_VERSION,
+            title: title.to_string(),
+            kit: "standard".into(),
+            grip: Grip::French,
+            ticks_per_quarter: DEFAULT_TICKS_PER_QUARTER,
+            tempo: vec![TempoPoint {
+                tick: 0,
+                bpm: 100.0,
+                change: TempoChange::Step,
+            }],
+            meter: vec![MeterChange {
+                bar: 1,
+                numerator: 4,
+                denominator: 4,
+            }],
+            beats: Vec::new(),
+        }
+    }
+
+    /// Parse score text strictly (unknown or missing fields are errors), migrating older
+    /// format versions; beats are put in time order. Does not check against a kit.
+    pub fn parse(path: &Path, text: &str) -> Result<Score, FileError> {
+        #[derive(Deserialize)]
+        #[serde(rename = "Score")]
+        struct Probe {
+            version: u32,
+        }
+        let probe: Probe = ron_file::parse(path, text)?;
+        let mut score: Score = match probe.version {
+            1 => ron_file::parse(path, text)?,
+            0 => {
+                return Err(FileError::invalid(
+                    path,
+                    "version",
+                    "format version 0 does not exist",
+                ));
+            }
+            found => {
+                return Err(FileError::TooNew {
+                    path: path.to_path_buf(),
+                    found,
+                    supported: SCORE_FORMAT_VERSION,
+                });
+            }
+        };
+        score.sort_beats();
+        Ok(score)
+    }
+
+    /// Put beats in time order (stable, so simultaneous beats keep their file order).
+    pub fn sort_beats(&mut self) {
+        self.beats.sort_by_key(|b| b.tick);
+    }
+
+    /// Save atomically as pretty RON.
+    pub fn save(&self, path: &Path) -> Result<(), FileError> {
+        ron_file::save(path, self)
+    }
+
+    /// The score as RON text, exactly as [`Score::save`] writes it.
+    pub fn to_ron(&self) -> String {
+        ron_file::to_pretty(self)
+    }
+
+    /// The tempo map of this score.
+    pub fn tempo_map(&self) -> TempoMap {
+        TempoMap::new(&self.tempo, self.ticks_per_quarter)
+    }
+
+    /// The bar map of this score.
+    pub fn meter_map(&self) -> MeterMap {
+        MeterMap::new(&self.meter, self.ticks_per_quarter)
+    }
+
+    /// Seconds from the start to each beat.
+    pub fn beat_times(&self) -> Vec<f64> {
+        let map = self.tempo_map();
+        self.beats
+            .iter()
+            .map(|b| map.seconds_at(b.tick as f64))
+            .collect()
+    }
+
+    /// Length of the score in seconds (to its last stroke).
+    pub fn duration_s(&self) -> f64 {
+        let end = self.beats.iter().map(Beat::end_tick).max().unwrap_or(0);
+        self.tempo_map().seconds_at(end as f64)
+    }
+
+    /// Find the kit this score refers to, relative to `score_path`'s folder.
+    pub fn resolve_kit(&self, score_path: &Path) -> Result<(Kit, String, Vec<String>), FileError> {
+        if !self.kit.ends_with(".ron") {
+            return Kit::bundled(&self.kit)
+                .map(|k| (k, format!("bundled kit \"{}\"", self.kit), Vec::new()))
+                .ok_or_else(|| {
+                    let names: Vec<&str> =
+                        crate::kit::BUNDLED_KITS.iter().map(|(n, _)| *n).collect();
+                    FileError::invalid(
+                        score_path,
+                        "kit",
+                        format!(
+                            "\"{}\" is neither a .ron path nor a bundled kit (bundled: {})",
+                            self.kit,
+                            names.join(", ")
+                        ),
+                    )
+                });
+        }
+        let dir = score_path.parent().unwrap_or(Path::new("."));
+        let kit_path: PathBuf = dir.join(&self.kit);
+        if kit_path.exists() {
+            let kit = Kit::load(&kit_path)?;
+            return Ok((kit, kit_path.display().to_string(), Vec::new()));
+        }
+        // A score moved away from its kit folder still opens if the kit is a bundled one.
+        let stem = Path::new(&self.kit)
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("");
+        match Kit::bundled(stem) {
+            Some(kit) => Ok((
+                kit,
+                format!("bundled kit \"{stem}\""),
+                vec![format!(
+                    "kit file {} not found; using the bundled kit \"{stem}\"",
+                    kit_path.display()
+                )],
+            )),
+            None => Err(FileError::invalid(
+                score_path,
+                "kit",
+                format!("kit file {} not found", kit_path.display()),
+            )),
+        }
+    }
+
+    /// Problems of this score against `kit`, in file order.
+    pub fn problems(&self, kit: &Kit) -> Vec<crate::problem::Problem> {
+        validate::problems(self, kit)
+    }
+}
+
+impl LoadedScore {
+    /// Parse score text (with `path` for errors and kit lookup), find its kit and check the
+    /// score against it.
+    pub fn parse(path: &Path, text: &str) -> Result<LoadedScore, FileError> {
+        let score = Score::parse(path, text)?;
+        let (kit, kit_source, notices) = score.resolve_kit(path)?;
+        if let Some(p) = score.problems(&kit).into_iter().next() {
+            return Err(FileError::invalid(path, p.place, p.message));
+        }
+        Ok(LoadedScore {
+            score,
+            kit,
+            kit_source,
+            notices,
+        })
+    }
+
+    /// Load a score file with its kit, strictly.
+    pub fn load(path: &Path) -> Result<LoadedScore, FileError> {
+        LoadedScore::parse(path, &ron_file::read_text(path)?)
+    }
+}

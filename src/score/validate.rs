@@ -1,0 +1,179 @@
+//! Checks a score against its kit: format version, tempo and meter maps, and every beat
+//! (drum exists, pitch in the drum's range, velocity 0–1, location on the head, rolls,
+//! no more simultaneous strokes than hands).
+
+use super::{Dynamic, Hand, ImpactLocation, SCORE_FORMAT_VERSION, Score, meter, tempo};
+use crate::kit::Kit;
+use crate::problem::Problem;
+
+/// Every problem in `score` played on `kit`, in file order.
+pub fn problems(score: &Score, kit: &Kit) -> Vec<Problem> {
+    let mut out = Vec::new();
+    if score.version != SCORE_FORMAT_VERSION {
+        out.push(Problem::new(
+            "version",
+            format!("expected {SCORE_FORMAT_VERSION}"),
+        ));
+    }
+    if !(24..=32767).contains(&score.ticks_per_quarter) {
+        out.push(Problem::new(
+            "ticks_per_quarter",
+            format!("{} is not between 24 and 32767", score.ticks_per_quarter),
+        ));
+        return out; // Every position below depends on it.
+    }
+    for (i, m) in tempo::validate_points(&score.tempo) {
+        out.push(Problem::new(format!("tempo point {i}"), m));
+    }
+    let meter_problems = meter::validate_changes(&score.meter, score.ticks_per_quarter);
+    let meter_ok = meter_problems.is_empty();
+    for (i, m) in meter_problems {
+        out.push(Problem::new(format!("time signature {i}"), m));
+    }
+    let bars = meter_ok.then(|| score.meter_map());
+    let place = |i: usize| match &bars {
+        Some(map) => format!("beat {i} ({})", map.position(score.beats[i].tick)),
+        None => format!("beat {i} (tick {})", score.beats[i].tick),
+    };
+    for (i, beat) in score.beats.iter().enumerate() {
+        let mut bad = |message: String| out.push(Problem::new(place(i), message));
+        match kit.drums.get(beat.drum) {
+            None => bad(format!(
+                "drum {} does not exist: kit \"{}\" has drums 0 to {}",
+                beat.drum,
+                kit.name,
+                kit.drums.len().saturating_sub(1)
+            )),
+            Some(drum) => {
+                if let Some(p) = beat.pitch.filter(|&p| !drum.in_range(p)) {
+                    bad(format!(
+                        "pitch {p} is outside the {} drum's range {}–{}",
+                        drum.name, drum.lowest, drum.highest
+                    ));
+                }
+            }
+        }
+        if let Dynamic::Velocity(v) = beat.dynamic
+            && !(0.0..=1.0).contains(&v)
+        {
+            bad(format!("velocity {v} is not between 0 and 1"));
+        }
+        if let ImpactLocation::Point { radius, angle_deg } = beat.location
+            && !((0.0..=1.0).contains(&radius) && angle_deg.is_finite())
+        {
+            bad(format!(
+                "impact point radius {radius} must be a fraction 0–1 of the head radius, with a finite angle"
+            ));
+        }
+        if let Some(roll) = beat.roll {
+            let per_quarter_ok = (1..=32).contains(&roll.strokes_per_quarter)
+                && score.ticks_per_quarter % roll.strokes_per_quarter == 0;
+            if roll.length_ticks == 0 || !per_quarter_ok {
+                bad(format!(
+                    "a roll needs a positive length and 1–32 strokes per quarter dividing {} ticks",
+                    score.ticks_per_quarter
+                ));
+            }
+            if let Some(j) = (i + 1..score.beats.len())
+                .find(|&j| score.beats[j].tick > beat.tick && score.beats[j].tick < beat.end_tick())
+            {
+                bad(format!(
+                    "beat {j} falls inside this roll, which takes both hands"
+                ));
+            }
+        }
+    }
+    let mut i = 0;
+    while i < score.beats.len() {
+        let tick = score.beats[i].tick;
+        let together: Vec<usize> = (i..score.beats.len())
+            .take_while(|&j| score.beats[j].tick == tick)
+            .collect();
+        let hands: Vec<Hand> = together.iter().map(|&j| score.beats[j].hand).collect();
+        if together.len() > 2 {
+            out.push(Problem::new(
+                place(i),
+                format!(
+                    "{} strokes at once, but a timpanist has two hands",
+                    together.len()
+                ),
+            ));
+        } else if together.len() == 2 && hands[0] == hands[1] && hands[0] != Hand::Auto {
+            out.push(Problem::new(
+                place(together[1]),
+                format!("two strokes at once with the same hand ({:?})", hands[0]),
+            ));
+        }
+        i += together.len();
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::score::{Beat, PlayingMode, Roll};
+
+    fn beat(tick: u64, drum: usize) -> Beat {
+        Beat {
+            tick,
+            hand: Hand::Auto,
+            mode: PlayingMode::Legato,
+            dynamic: Dynamic::Mf,
+            drum,
+            pitch: None,
+            location: ImpactLocation::PlayingSpot,
+            roll: None,
+        }
+    }
+
+    fn first_problem(score: &Score) -> String {
+        problems(score, &Kit::standard())
+            .first()
+            .map(ToString::to_string)
+            .unwrap_or_default()
+    }
+
+    /// A sensible score has no problems.
+    #[test]
+    fn valid_score() {
+        let mut s = Score::new("t");
+        s.beats = vec![beat(0, 0), beat(960, 3)];
+        assert!(problems(&s, &Kit::standard()).is_empty());
+    }
+
+    /// Each kind of mistake is found and named with its bar and beat.
+    #[test]
+    fn finds_mistakes() {
+        let mut s = Score::new("t");
+        s.beats = vec![beat(0, 0), beat(960, 9)];
+        assert!(first_problem(&s).contains("beat 1 (bar 1 beat 2): drum 9 does not exist"));
+
+        s.beats = vec![beat(0, 0)];
+        s.beats[0].pitch = Some("C4".parse().unwrap());
+        assert!(first_problem(&s).contains("outside the 32-inch drum's range D2–A2"));
+
+        s.beats = vec![beat(0, 0)];
+        s.beats[0].dynamic = Dynamic::Velocity(1.5);
+        assert!(first_problem(&s).contains("velocity"));
+
+        s.beats = vec![beat(0, 0), beat(0, 1), beat(0, 2)];
+        assert!(first_problem(&s).contains("3 strokes at once"));
+
+        s.beats = vec![beat(0, 0), beat(0, 1)];
+        s.beats[0].hand = Hand::Left;
+        s.beats[1].hand = Hand::Left;
+        assert!(first_problem(&s).contains("same hand"));
+
+        s.beats = vec![beat(0, 0), beat(480, 1), beat(1920, 1)];
+        s.beats[0].roll = Some(Roll {
+            length_ticks: 1920,
+            strokes_per_quarter: 8,
+        });
+        assert!(first_problem(&s).contains("beat 1 falls inside this roll"));
+
+        s.beats = vec![beat(0, 0)];
+        s.tempo[0].bpm = 2000.0;
+        assert!(first_problem(&s).contains("tempo point 0: tempo 2000 bpm is impossible"));
+    }
+}
