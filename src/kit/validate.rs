@@ -44,11 +44,12 @@ pub fn problems(kit: &Kit) -> Vec<Problem> {
             bad("the mode table is empty".into());
         }
         for (k, mode) in d.modes.iter().enumerate() {
-            if mode.n == 0
-                || !positive(mode.ratio)
-                || !positive(mode.decay_s)
-                || !(mode.gain >= 0.0 && mode.gain.is_finite())
-            {
+            let usable = mode.n >= 1
+                && positive(mode.ratio)
+                && positive(mode.decay_s)
+                && mode.gain.is_finite()
+                && mode.gain >= 0.0;
+            if !usable {
                 bad(format!(
                     "mode {k} ({},{}): n must be ≥ 1, ratio and decay_s positive, gain ≥ 0",
                     mode.m, mode.n

@@ -135,7 +135,7 @@ pub fn validate_changes(changes: &[MeterChange], ticks_per_quarter: u32) -> Vec<
             problems.push((i, format!("numerator {} is not 1 to 64", c.numerator)));
         }
         let den_ok = matches!(c.denominator, 1 | 2 | 4 | 8 | 16 | 32)
-            && (u64::from(ticks_per_quarter) * 4) % u64::from(c.denominator) == 0;
+            && (u64::from(ticks_per_quarter) * 4).is_multiple_of(u64::from(c.denominator));
         if !den_ok {
             problems.push((
                 i,

@@ -67,7 +67,9 @@ pub fn problems(score: &Score, kit: &Kit) -> Vec<Problem> {
         }
         if let Some(roll) = beat.roll {
             let per_quarter_ok = (1..=32).contains(&roll.strokes_per_quarter)
-                && score.ticks_per_quarter % roll.strokes_per_quarter == 0;
+                && score
+                    .ticks_per_quarter
+                    .is_multiple_of(roll.strokes_per_quarter);
             if roll.length_ticks == 0 || !per_quarter_ok {
                 bad(format!(
                     "a roll needs a positive length and 1–32 strokes per quarter dividing {} ticks",
