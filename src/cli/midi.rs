@@ -1,0 +1,108 @@
+//! `timpanist import-midi` and `timpanist export-midi`: Standard MIDI Files in and out.
+
+use crate::io::midi_import::{self, ImportOptions, TrackChoice};
+use crate::io::{midi_export, ron_file};
+use crate::kit::Kit;
+use crate::score::LoadedScore;
+use anyhow::Context;
+use std::path::{Component, Path, PathBuf};
+
+/// Import `input` with `kit` (default: the bundled standard kit) and save the score.
+pub fn import(
+    input: &Path,
+    output: &Path,
+    track: Option<String>,
+    kit_path: Option<&Path>,
+    title: Option<String>,
+    detect_rolls: bool,
+) -> anyhow::Result<()> {
+    let (kit, kit_ref) = match kit_path {
+        Some(p) => (Kit::load(p)?, kit_reference(p, output)?),
+        None => (Kit::standard(), "standard".to_string()),
+    };
+    let options = ImportOptions {
+        track: track.map(|t| match t.parse::<usize>() {
+            Ok(i) => TrackChoice::Index(i),
+            Err(_) => TrackChoice::Name(t),
+        }),
+        kit_ref,
+        title,
+        detect_rolls,
+    };
+    let (score, report) = midi_import::import_file(input, &kit, &options)?;
+    if let Some(p) = score.problems(&kit).first() {
+        anyhow::bail!("{}: the imported score is not playable: {p}", input.display());
+    }
+    score.save(output)?;
+    println!(
+        "{} -> {}: {} notes from {}; {} duplicates dropped; {} notes moved by octaves",
+        input.display(),
+        output.display(),
+        report.notes,
+        report.source,
+        report.duplicates_dropped,
+        report.octave_moves
+    );
+    for w in &report.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(())
+}
+
+/// Export the score at `input` to a type 1 Standard MIDI File at `output`.
+pub fn export(input: &Path, output: &Path) -> anyhow::Result<()> {
+    let loaded = LoadedScore::load(input)?;
+    for n in &loaded.notices {
+        eprintln!("note: {n}");
+    }
+    let bytes = midi_export::export(&loaded.score, &loaded.kit);
+    ron_file::write_atomic(output, &bytes)?;
+    println!(
+        "{} -> {}: {} beats, {:.1} s",
+        input.display(),
+        output.display(),
+        loaded.score.beats.len(),
+        loaded.score.duration_s()
+    );
+    Ok(())
+}
+
+/// How a score saved at `score` should name the kit file `kit`: relative to the score's
+/// folder when both are on the same tree.
+fn kit_reference(kit: &Path, score: &Path) -> anyhow::Result<String> {
+    let kit = kit
+        .canonicalize()
+        .with_context(|| format!("{}: cannot resolve the kit path", kit.display()))?;
+    let dir = score.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = dir
+        .canonicalize()
+        .with_context(|| format!("{}: the output folder does not exist", dir.display()))?;
+    Ok(relative_path(&kit, &dir).display().to_string())
+}
+
+/// `target` as seen from the folder `base` (both absolute).
+fn relative_path(target: &Path, base: &Path) -> PathBuf {
+    let t: Vec<Component> = target.components().collect();
+    let b: Vec<Component> = base.components().collect();
+    let common = t.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    let mut out = PathBuf::new();
+    for _ in common..b.len() {
+        out.push("..");
+    }
+    for c in &t[common..] {
+        out.push(c);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Relative paths climb out of the base and down into the target.
+    #[test]
+    fn relative_paths() {
+        assert_eq!(relative_path(Path::new("/a/kits/k.ron"), Path::new("/a/scores")), PathBuf::from("../kits/k.ron"));
+        assert_eq!(relative_path(Path::new("/a/k.ron"), Path::new("/a")), PathBuf::from("k.ron"));
+    }
+}
