@@ -9,6 +9,7 @@ pub mod app;
 pub mod cli;
 pub mod io;
 pub mod kit;
+pub mod mocap;
 pub mod motion;
 pub mod pitch;
 pub mod problem;

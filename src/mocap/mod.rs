@@ -1,0 +1,8 @@
+//! Motion capture: reading captures from real systems, cutting them into one-stroke motion
+//! units, the on-disk motion database, the synthetic performer that builds the shipped
+//! database, and joint-limit estimation (seed 000 Alg. 1).
+
+pub mod import;
+pub mod take;
+
+pub use take::{ImportError, Take, Track};

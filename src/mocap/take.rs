@@ -1,0 +1,85 @@
+//! A raw capture as read from a file: labelled 3D marker (and rigid-body) trajectories at
+//! a fixed rate, converted to metres, before any axis remapping or segmentation.
+
+use glam::{DQuat, DVec3};
+use std::path::PathBuf;
+
+/// One labelled trajectory: a marker, or a rigid body's origin.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Track {
+    /// Label as written in the file (e.g. "StickL:Tip", "RASI", "StickR").
+    pub label: String,
+    /// Position per frame, metres, in the file's own axes; `None` where the marker was not seen.
+    pub positions: Vec<Option<DVec3>>,
+    /// Orientation per frame for rigid bodies (file axes), empty for plain markers.
+    pub rotations: Vec<Option<DQuat>>,
+}
+
+/// A whole capture.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Take {
+    /// The file it came from.
+    pub source: PathBuf,
+    /// Frame rate, Hz.
+    pub rate_hz: f64,
+    /// Number of frames (every track has this many entries).
+    pub frames: usize,
+    /// Length unit found in the file ("mm", "cm", "m"), for reports.
+    pub file_unit: String,
+    /// The trajectories.
+    pub tracks: Vec<Track>,
+}
+
+impl Take {
+    /// The track whose label equals `label`, or failing that ends with `:label`
+    /// (C3D and Vicon prefix labels with the subject name); case-insensitive.
+    pub fn track(&self, label: &str) -> Option<&Track> {
+        let want = label.to_ascii_lowercase();
+        let lower = |t: &Track| t.label.to_ascii_lowercase();
+        self.tracks.iter().find(|t| lower(t) == want).or_else(|| {
+            self.tracks
+                .iter()
+                .find(|t| lower(t).ends_with(&format!(":{want}")))
+        })
+    }
+
+    /// All labels, in file order.
+    pub fn labels(&self) -> Vec<&str> {
+        self.tracks.iter().map(|t| t.label.as_str()).collect()
+    }
+}
+
+/// Why a capture file could not be read.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ImportError {
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file is not in the expected format, or is corrupt or truncated; `place` says
+    /// where (a byte offset, a line, a parameter).
+    #[error("{}: {place}: {message}", path.display())]
+    Format {
+        path: PathBuf,
+        place: String,
+        message: String,
+    },
+}
+
+impl ImportError {
+    /// A format problem at `place` in `path`.
+    pub fn format(
+        path: &std::path::Path,
+        place: impl Into<String>,
+        message: impl Into<String>,
+    ) -> Self {
+        ImportError::Format {
+            path: path.to_path_buf(),
+            place: place.into(),
+            message: message.into(),
+        }
+    }
+}
