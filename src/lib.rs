@@ -6,6 +6,7 @@
 //! simulation → sound and motion; `io` reads and writes files.
 
 pub mod app;
+pub mod body;
 pub mod cli;
 pub mod io;
 pub mod kit;

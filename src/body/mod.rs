@@ -1,0 +1,7 @@
+//! The simulated timpanist's upper body: the 11-segment skeleton with ball joints and its
+//! forward kinematics, and inverse kinematics for the arm chains.
+
+pub mod ik;
+pub mod skeleton;
+
+pub use skeleton::{Joint, Pose, Skeleton, JOINT_COUNT};
