@@ -114,7 +114,9 @@ pub fn solve(
                 e * (e.dot(jjt_e) / jjt_e.length_squared().max(1e-12))
             }
             IkMethod::PseudoInverse => safe_solve(jwjt, e, 1e-9),
-            IkMethod::DampedLeastSquares => safe_solve(jwjt + DMat3::IDENTITY * params.damping_m.powi(2), e, 0.0),
+            IkMethod::DampedLeastSquares => {
+                safe_solve(jwjt + DMat3::IDENTITY * params.damping_m.powi(2), e, 0.0)
+            }
         };
         let mut step: Vec<DVec3> = vec![DVec3::ZERO; pose.len()];
         for &(i, a, c, w) in &columns {
@@ -130,7 +132,8 @@ pub fn solve(
                 w = w.normalize() * params.max_step_rad;
             }
             let parent = frames.parent_rotation(j);
-            pose[i] = (parent.inverse() * DQuat::from_scaled_axis(w) * parent * pose[i]).normalize();
+            pose[i] =
+                (parent.inverse() * DQuat::from_scaled_axis(w) * parent * pose[i]).normalize();
         }
     }
     if iterations == params.max_iterations {
@@ -161,7 +164,9 @@ fn add_null_space_pull(
         let local = if local.w < 0.0 { -local } else { local };
         z[i] = frames.parent_rotation(joint) * local.to_scaled_axis() * (params.reference_gain * w);
     }
-    let jz = columns.iter().fold(DVec3::ZERO, |s, &(i, a, c, _)| s + c * a.dot(z[i]));
+    let jz = columns
+        .iter()
+        .fold(DVec3::ZERO, |s, &(i, a, c, _)| s + c * a.dot(z[i]));
     let y = safe_solve(jwjt + DMat3::IDENTITY * params.damping_m.powi(2), jz, 0.0);
     for &(i, a, c, w) in columns {
         step[i] -= a * (w * c.dot(y));
@@ -202,10 +207,18 @@ mod tests {
     fn reaches_reachable_targets() {
         let s = Skeleton::default();
         let target = DVec3::new(0.35, 0.55, 0.80);
-        for method in [IkMethod::Transpose, IkMethod::PseudoInverse, IkMethod::DampedLeastSquares] {
+        for method in [
+            IkMethod::Transpose,
+            IkMethod::PseudoInverse,
+            IkMethod::DampedLeastSquares,
+        ] {
             let params = IkParams {
                 method,
-                max_iterations: if method == IkMethod::Transpose { 5000 } else { 200 },
+                max_iterations: if method == IkMethod::Transpose {
+                    5000
+                } else {
+                    200
+                },
                 tolerance_m: 1e-4,
                 ..IkParams::default()
             };
@@ -220,13 +233,23 @@ mod tests {
     fn unreachable_target_degrades_gracefully() {
         let s = Skeleton::default();
         let target = DVec3::new(3.0, 3.0, 1.0);
-        let r = solve(&s, &bent_start(), Side::Right, target, None, &IkParams::default());
+        let r = solve(
+            &s,
+            &bent_start(),
+            Side::Right,
+            target,
+            None,
+            &IkParams::default(),
+        );
         assert!(!r.converged);
         assert!(r.pose.iter().all(|q| q.is_finite()));
         let tip = s.tip(&r.pose, Side::Right);
         let shoulder = s.forward(&r.pose).position[Joint::ShoulderR.index()];
         let reach = 0.30 + 0.26 + 0.08 + 0.33;
-        assert!((tip - shoulder).length() > reach - 0.01, "arm not stretched");
+        assert!(
+            (tip - shoulder).length() > reach - 0.01,
+            "arm not stretched"
+        );
         assert!((target - tip).length() - r.error_m < 1e-9);
     }
 
@@ -235,10 +258,24 @@ mod tests {
     fn reference_pull_keeps_task() {
         let s = Skeleton::default();
         let target = DVec3::new(0.3, 0.5, 0.85);
-        let free = solve(&s, &bent_start(), Side::Right, target, None, &IkParams::default());
+        let free = solve(
+            &s,
+            &bent_start(),
+            Side::Right,
+            target,
+            None,
+            &IkParams::default(),
+        );
         let mut reference = REST;
         reference[Joint::WristR.index()] = DQuat::from_rotation_x(-0.6);
-        let pulled = solve(&s, &bent_start(), Side::Right, target, Some(&reference), &IkParams::default());
+        let pulled = solve(
+            &s,
+            &bent_start(),
+            Side::Right,
+            target,
+            Some(&reference),
+            &IkParams::default(),
+        );
         assert!(pulled.error_m < 5e-4, "{}", pulled.error_m);
         let wrist = Joint::WristR.index();
         let dist = |p: &Pose| p[wrist].angle_between(reference[wrist]);

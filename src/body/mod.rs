@@ -4,4 +4,4 @@
 pub mod ik;
 pub mod skeleton;
 
-pub use skeleton::{Joint, Pose, Skeleton, JOINT_COUNT};
+pub use skeleton::{JOINT_COUNT, Joint, Pose, Skeleton};

@@ -88,8 +88,12 @@ impl Joint {
     /// The arm chain of one side from shoulder to grip.
     pub fn arm(side: crate::kit::Side) -> [Joint; 4] {
         match side {
-            crate::kit::Side::Left => [Joint::ShoulderL, Joint::ElbowL, Joint::WristL, Joint::GripL],
-            crate::kit::Side::Right => [Joint::ShoulderR, Joint::ElbowR, Joint::WristR, Joint::GripR],
+            crate::kit::Side::Left => {
+                [Joint::ShoulderL, Joint::ElbowL, Joint::WristL, Joint::GripL]
+            }
+            crate::kit::Side::Right => {
+                [Joint::ShoulderR, Joint::ElbowR, Joint::WristR, Joint::GripR]
+            }
         }
     }
 }
@@ -127,7 +131,10 @@ impl Skeleton {
         let mut set = |j: Joint, v: DVec3| offsets[j.index()] = v * h;
         set(Joint::Neck, DVec3::new(0.0, 0.0, 0.48));
         set(Joint::Head, DVec3::new(0.0, 0.0, 0.10));
-        for (sign, arm) in [(-1.0, Joint::arm(crate::kit::Side::Left)), (1.0, Joint::arm(crate::kit::Side::Right))] {
+        for (sign, arm) in [
+            (-1.0, Joint::arm(crate::kit::Side::Left)),
+            (1.0, Joint::arm(crate::kit::Side::Right)),
+        ] {
             set(arm[0], DVec3::new(0.19 * sign, 0.0, 0.44));
             set(arm[1], DVec3::new(0.0, 0.0, -0.30));
             set(arm[2], DVec3::new(0.0, 0.0, -0.26));
@@ -185,7 +192,9 @@ impl Frames {
 
     /// Rotation of the segment carrying `joint` (world from parent segment).
     pub fn parent_rotation(&self, joint: Joint) -> DQuat {
-        joint.parent().map_or(DQuat::IDENTITY, |p| self.rotation[p.index()])
+        joint
+            .parent()
+            .map_or(DQuat::IDENTITY, |p| self.rotation[p.index()])
     }
 }
 

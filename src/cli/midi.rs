@@ -21,24 +21,24 @@ pub fn import(
         None => (Kit::standard(), "standard".to_string()),
     };
     let options = ImportOptions {
-        track: track.map(|t| match t.parse::<usize>() {
-            Ok(i) => TrackChoice::Index(i),
-            Err(_) => TrackChoice::Name(t),
-        }),
+        track: track.map(|t| t.parse::<TrackChoice>().unwrap_or(TrackChoice::Name(t))),
         kit_ref,
         title,
         detect_rolls,
     };
     let (score, report) = midi_import::import_file(input, &kit, &options)?;
     if let Some(p) = score.problems(&kit).first() {
-        anyhow::bail!("{}: the imported score is not playable: {p}", input.display());
+        anyhow::bail!(
+            "{}: the imported score is not playable: {p}",
+            input.display()
+        );
     }
     score.save(output)?;
     println!(
-        "{} -> {}: {} notes from {}; {} duplicates dropped; {} notes moved by octaves",
+        "{} -> {}: {} beats from {}; {} duplicates dropped; {} notes moved by octaves",
         input.display(),
         output.display(),
-        report.notes,
+        score.beats.len(),
         report.source,
         report.duplicates_dropped,
         report.octave_moves
@@ -73,7 +73,10 @@ fn kit_reference(kit: &Path, score: &Path) -> anyhow::Result<String> {
     let kit = kit
         .canonicalize()
         .with_context(|| format!("{}: cannot resolve the kit path", kit.display()))?;
-    let dir = score.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let dir = score
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     let dir = dir
         .canonicalize()
         .with_context(|| format!("{}: the output folder does not exist", dir.display()))?;
@@ -102,7 +105,13 @@ mod tests {
     /// Relative paths climb out of the base and down into the target.
     #[test]
     fn relative_paths() {
-        assert_eq!(relative_path(Path::new("/a/kits/k.ron"), Path::new("/a/scores")), PathBuf::from("../kits/k.ron"));
-        assert_eq!(relative_path(Path::new("/a/k.ron"), Path::new("/a")), PathBuf::from("k.ron"));
+        assert_eq!(
+            relative_path(Path::new("/a/kits/k.ron"), Path::new("/a/scores")),
+            PathBuf::from("../kits/k.ron")
+        );
+        assert_eq!(
+            relative_path(Path::new("/a/k.ron"), Path::new("/a")),
+            PathBuf::from("k.ron")
+        );
     }
 }

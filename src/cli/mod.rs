@@ -3,6 +3,7 @@
 //! compute everything first and write atomically, so a failure leaves no file behind.
 
 mod check;
+mod midi;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -29,6 +30,36 @@ pub enum Command {
         #[arg(required = true)]
         files: Vec<PathBuf>,
     },
+    /// Import the timpani part of a Standard MIDI File (type 0 or 1) as a score.
+    ImportMidi {
+        /// The MIDI file.
+        input: PathBuf,
+        /// The score to write (.ron).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// The track to read, by index (from 0) or by (part of) its name; default: the
+        /// track or channel with GM program 48 (Timpani), a track named like "Timpani",
+        /// or the channel-10 percussion.
+        #[arg(long)]
+        track: Option<String>,
+        /// The kit to map pitches onto (default: the bundled standard kit).
+        #[arg(long)]
+        kit: Option<PathBuf>,
+        /// Title of the score (default: the file's sequence name or file name).
+        #[arg(long)]
+        title: Option<String>,
+        /// Turn runs of fast, evenly spaced repeated notes into rolls.
+        #[arg(long)]
+        detect_rolls: bool,
+    },
+    /// Export a score as a type 1 Standard MIDI File (tempo map, GM Timpani, velocities).
+    ExportMidi {
+        /// The score (.ron).
+        score: PathBuf,
+        /// The MIDI file to write.
+        #[arg(short, long)]
+        output: PathBuf,
+    },
 }
 
 /// Run the command line; returns the process exit code.
@@ -48,5 +79,17 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         None => crate::app::run(None).map(|()| ExitCode::SUCCESS),
         Some(Command::Edit { score }) => crate::app::run(score).map(|()| ExitCode::SUCCESS),
         Some(Command::Check { files }) => Ok(check::run(&files)),
+        Some(Command::ImportMidi {
+            input,
+            output,
+            track,
+            kit,
+            title,
+            detect_rolls,
+        }) => midi::import(&input, &output, track, kit.as_deref(), title, detect_rolls)
+            .map(|()| ExitCode::SUCCESS),
+        Some(Command::ExportMidi { score, output }) => {
+            midi::export(&score, &output).map(|()| ExitCode::SUCCESS)
+        }
     }
 }

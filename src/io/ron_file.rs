@@ -85,7 +85,8 @@ pub fn to_pretty<T: Serialize>(value: &T) -> String {
         .struct_names(true)
         .indentor("    ")
         .separate_tuple_members(false)
-        .enumerate_arrays(false);
+        .enumerate_arrays(false)
+        .depth_limit(2);
     let mut text = ron::ser::to_string_pretty(value, config)
         .expect("our score and kit types always serialise to RON");
     text.push('\n');
