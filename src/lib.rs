@@ -14,4 +14,5 @@ pub mod mocap;
 pub mod motion;
 pub mod pitch;
 pub mod problem;
+pub mod rng;
 pub mod score;

@@ -2,7 +2,9 @@
 //! units, the on-disk motion database, the synthetic performer that builds the shipped
 //! database, and joint-limit estimation (seed 000 Alg. 1).
 
+pub mod db;
 pub mod import;
+pub mod segment;
 pub mod take;
 
 pub use take::{ImportError, Take, Track};

@@ -1,0 +1,384 @@
+//! The motion database on disk (`mocap/`): an index in RON (`index.ron`: takes and their
+//! segmented motion units with labels) and one compact binary sample file per take
+//! (`takes/NAME.tmot`) holding both stick tips and, where the source has them, the
+//! upper-body joint rotations, at the capture rate.
+//!
+//! **`.tmot` sample files** (little-endian): the 8 bytes `TMOTION1`; u32 frame count N;
+//! u32 joint count J (0 or 11); f64 rate in Hz; then one zlib stream holding, for each
+//! tip (left, right), N validity bytes (1 = seen) followed by its x, y, z channels, and
+//! then the 4·J quaternion channels (w, x, y, z per joint in `index.joints` order). Each
+//! channel is quantised (positions to 10 µm, quaternion components to 1e-6), replaced by
+//! its second difference in time, and written as zigzag LEB128 varints. Positions are in
+//! the performer frame (metres; +x right, +y forward, +z up).
+
+use crate::body::skeleton::{JOINT_COUNT, Joint, Pose};
+use crate::io::ron_file::{self, FileError};
+use crate::kit::Side;
+use crate::score::{Dynamic, Grip, ImpactLocation, PlayingMode};
+use flate2::Compression;
+use flate2::read::ZlibDecoder;
+use flate2::write::ZlibEncoder;
+use glam::{DQuat, DVec3};
+use serde::{Deserialize, Serialize};
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+/// The database format this timpanist writes and the newest it reads.
+pub const DB_FORMAT_VERSION: u32 = 1;
+const MAGIC: &[u8; 8] = b"TMOTION1";
+const POSITION_STEP_M: f64 = 1e-5;
+const QUATERNION_STEP: f64 = 1e-6;
+
+/// `index.ron`: what the database holds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename = "MotionDb", deny_unknown_fields)]
+pub struct Index {
+    pub version: u32,
+    /// Where the data came from, in words.
+    pub description: String,
+    /// Sample rate of every take, Hz.
+    pub rate_hz: f64,
+    /// Joint names of the rotation channels, in file order (empty if no take has joints).
+    pub joints: Vec<String>,
+    pub takes: Vec<TakeEntry>,
+    pub units: Vec<UnitEntry>,
+}
+
+/// One take (one sample file).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TakeEntry {
+    /// Sample file, relative to the database folder.
+    pub file: String,
+    pub frames: usize,
+    pub performer: String,
+    /// The capture file it was imported from (or "synthetic").
+    pub source: String,
+}
+
+/// One motion unit: a single stroke from the end of the previous stroke's rebound to the
+/// end of its own.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UnitEntry {
+    /// Index into `takes`.
+    pub take: usize,
+    /// First frame.
+    pub start: usize,
+    /// Frame of the impact.
+    pub impact: usize,
+    /// Last frame, inclusive.
+    pub end: usize,
+    pub hand: Side,
+    pub mode: PlayingMode,
+    pub location: ImpactLocation,
+    pub dynamic: Dynamic,
+    pub grip: Grip,
+}
+
+/// The samples of one take.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TakeData {
+    /// Tip positions per frame, [left, right], m; `None` where not seen.
+    pub tips: [Vec<Option<DVec3>>; 2],
+    /// Joint rotations per frame, if the source has them.
+    pub joints: Option<Vec<Pose>>,
+}
+
+impl TakeData {
+    /// Frames in the take.
+    pub fn frames(&self) -> usize {
+        self.tips[0].len()
+    }
+
+    /// The tip track of one hand.
+    pub fn tip(&self, side: Side) -> &[Option<DVec3>] {
+        &self.tips[side_index(side)]
+    }
+}
+
+/// Index of a side in `[left, right]` arrays.
+pub fn side_index(side: Side) -> usize {
+    match side {
+        Side::Left => 0,
+        Side::Right => 1,
+    }
+}
+
+/// A loaded database.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MotionDb {
+    pub index: Index,
+    /// Samples of each take, in `index.takes` order.
+    pub takes: Vec<TakeData>,
+}
+
+/// Names of the joints, as written in `index.joints`.
+pub fn joint_names() -> Vec<String> {
+    Joint::ALL.iter().map(|j| j.name().to_string()).collect()
+}
+
+impl MotionDb {
+    /// Load `dir/index.ron` and every sample file it names.
+    pub fn load(dir: &Path) -> Result<MotionDb, FileError> {
+        let index_path = dir.join("index.ron");
+        let text = ron_file::read_text(&index_path)?;
+        let index: Index = ron_file::parse(&index_path, &text)?;
+        if index.version > DB_FORMAT_VERSION {
+            return Err(FileError::TooNew {
+                path: index_path,
+                found: index.version,
+                supported: DB_FORMAT_VERSION,
+            });
+        }
+        let takes = index
+            .takes
+            .iter()
+            .map(|t| {
+                let path = dir.join(&t.file);
+                let bytes = std::fs::read(&path).map_err(|e| FileError::io(&path, e))?;
+                let data = decode_take(&path, &bytes)?;
+                if data.frames() != t.frames {
+                    return Err(FileError::invalid(&path, "header", format!("{} frames, but index.ron says {}", data.frames(), t.frames)));
+                }
+                Ok(data)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        for (i, u) in index.units.iter().enumerate() {
+            let ok = index.takes.get(u.take).is_some_and(|t| u.start < u.impact && u.impact < u.end && u.end < t.frames);
+            if !ok {
+                return Err(FileError::invalid(&index_path, format!("unit {i}"), "frames outside its take, or start < impact < end violated"));
+            }
+        }
+        Ok(MotionDb { index, takes })
+    }
+
+    /// Write every sample file and then the index, each atomically.
+    pub fn save(&self, dir: &Path) -> Result<(), FileError> {
+        for (entry, data) in self.index.takes.iter().zip(&self.takes) {
+            let path = dir.join(&entry.file);
+            if let Some(parent) = path.parent() {
+                std::fs::create_dir_all(parent).map_err(|e| FileError::io(parent, e))?;
+            }
+            ron_file::write_atomic(&path, &encode_take(data, self.index.rate_hz))?;
+        }
+        ron_file::save(&dir.join("index.ron"), &self.index)
+    }
+
+    /// The tip samples of unit `u` for its own hand, from start to end.
+    pub fn unit_tip(&self, u: &UnitEntry) -> &[Option<DVec3>] {
+        &self.takes[u.take].tip(u.hand)[u.start..=u.end]
+    }
+}
+
+/// Serialise one take as a `.tmot` file.
+pub fn encode_take(data: &TakeData, rate_hz: f64) -> Vec<u8> {
+    let n = data.frames();
+    let mut out = Vec::new();
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&(n as u32).to_le_bytes());
+    let joints = if data.joints.is_some() { JOINT_COUNT } else { 0 };
+    out.extend_from_slice(&(joints as u32).to_le_bytes());
+    out.extend_from_slice(&rate_hz.to_le_bytes());
+    let mut z = ZlibEncoder::new(out, Compression::default());
+    let mut body = Vec::new();
+    for tip in &data.tips {
+        body.extend(tip.iter().map(|p| u8::from(p.is_some())));
+        for axis in 0..3 {
+            put_channel(&mut body, tip.iter().map(|p| p.map_or(0.0, |p| p[axis]) / POSITION_STEP_M));
+        }
+    }
+    if let Some(poses) = &data.joints {
+        for j in 0..JOINT_COUNT {
+            for c in 0..4 {
+                put_channel(&mut body, poses.iter().map(|p| canonical(p[j]).to_array()[(c + 3) % 4] / QUATERNION_STEP));
+            }
+        }
+    }
+    z.write_all(&body).expect("writing to memory cannot fail");
+    z.finish().expect("writing to memory cannot fail")
+}
+
+/// Read a `.tmot` file; `path` names it in errors. Corrupt or truncated data is an error.
+pub fn decode_take(path: &Path, bytes: &[u8]) -> Result<TakeData, FileError> {
+    let bad = |place: &str, msg: String| FileError::invalid(path, place.to_string(), msg);
+    if bytes.len() < 24 || &bytes[..8] != MAGIC {
+        return Err(bad("header", "not a timpanist .tmot sample file (expected the 24-byte TMOTION1 header)".into()));
+    }
+    let n = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes")) as usize;
+    let joints = u32::from_le_bytes(bytes[12..16].try_into().expect("4 bytes")) as usize;
+    if joints != 0 && joints != JOINT_COUNT {
+        return Err(bad("header", format!("{joints} joints; expected 0 or {JOINT_COUNT}")));
+    }
+    let mut body = Vec::new();
+    ZlibDecoder::new(&bytes[24..])
+        .take((n as u64 + 1) * 8 * (6 + 4 * JOINT_COUNT as u64) + 64)
+        .read_to_end(&mut body)
+        .map_err(|e| bad("sample data", format!("corrupt compressed data: {e}")))?;
+    let mut reader = Channels { body: &body, pos: 0 };
+    let mut tips: [Vec<Option<DVec3>>; 2] = [Vec::new(), Vec::new()];
+    for tip in &mut tips {
+        let seen = reader.bytes(n).ok_or_else(|| bad("sample data", "truncated validity flags".into()))?.to_vec();
+        let axes: Vec<Vec<f64>> = (0..3)
+            .map(|_| reader.channel(n, POSITION_STEP_M))
+            .collect::<Option<_>>()
+            .ok_or_else(|| bad("sample data", "truncated tip channel".into()))?;
+        *tip = (0..n)
+            .map(|f| (seen[f] == 1).then(|| DVec3::new(axes[0][f], axes[1][f], axes[2][f])))
+            .collect();
+    }
+    let joints = if joints == 0 {
+        None
+    } else {
+        let channels: Vec<Vec<f64>> = (0..4 * JOINT_COUNT)
+            .map(|_| reader.channel(n, QUATERNION_STEP))
+            .collect::<Option<_>>()
+            .ok_or_else(|| bad("sample data", "truncated joint channel".into()))?;
+        Some(
+            (0..n)
+                .map(|f| {
+                    std::array::from_fn(|j| {
+                        let c = |k: usize| channels[4 * j + k][f];
+                        DQuat::from_xyzw(c(1), c(2), c(3), c(0)).normalize()
+                    })
+                })
+                .collect(),
+        )
+    };
+    if reader.pos != body.len() {
+        return Err(bad("sample data", format!("{} bytes left over after the last channel", body.len() - reader.pos)));
+    }
+    Ok(TakeData { tips, joints })
+}
+
+/// The quaternion with w ≥ 0 (q and −q are the same rotation), so channels stay smooth.
+fn canonical(q: DQuat) -> DQuat {
+    if q.w < 0.0 { -q } else { q }
+}
+
+/// Append one channel: quantised, second-differenced, zigzag LEB128.
+fn put_channel(out: &mut Vec<u8>, values: impl Iterator<Item = f64>) {
+    let (mut prev, mut prev_delta) = (0i64, 0i64);
+    for v in values {
+        let q = v.round() as i64;
+        let delta = q - prev;
+        let dd = delta - prev_delta;
+        prev = q;
+        prev_delta = delta;
+        let mut z = ((dd << 1) ^ (dd >> 63)) as u64;
+        loop {
+            let byte = (z & 0x7f) as u8;
+            z >>= 7;
+            if z == 0 {
+                out.push(byte);
+                break;
+            }
+            out.push(byte | 0x80);
+        }
+    }
+}
+
+struct Channels<'a> {
+    body: &'a [u8],
+    pos: usize,
+}
+
+impl Channels<'_> {
+    fn bytes(&mut self, n: usize) -> Option<&[u8]> {
+        let slice = self.body.get(self.pos..self.pos.checked_add(n)?)?;
+        self.pos += n;
+        Some(slice)
+    }
+
+    fn varint(&mut self) -> Option<i64> {
+        let mut z = 0u64;
+        for shift in (0..64).step_by(7) {
+            let byte = *self.body.get(self.pos)?;
+            self.pos += 1;
+            z |= u64::from(byte & 0x7f) << shift;
+            if byte & 0x80 == 0 {
+                return Some((z >> 1) as i64 ^ -((z & 1) as i64));
+            }
+        }
+        None
+    }
+
+    fn channel(&mut self, n: usize, step: f64) -> Option<Vec<f64>> {
+        let (mut value, mut delta) = (0i64, 0i64);
+        (0..n)
+            .map(|_| {
+                delta = delta.checked_add(self.varint()?)?;
+                value = value.checked_add(delta)?;
+                Some(value as f64 * step)
+            })
+            .collect()
+    }
+}
+
+/// Where the shipped database lives in the source tree.
+pub fn default_dir() -> PathBuf {
+    PathBuf::from("mocap")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample_take() -> TakeData {
+        let n = 300;
+        let tip = |phase: f64| {
+            (0..n)
+                .map(|f| {
+                    let t = f as f64 / 250.0;
+                    (f % 97 != 0).then(|| DVec3::new(0.3 * phase, 0.5 + 0.01 * t, 0.8 + 0.2 * (t * 7.0 + phase).sin()))
+                })
+                .collect()
+        };
+        let poses = (0..n)
+            .map(|f| std::array::from_fn(|j| DQuat::from_rotation_x(0.001 * (f * (j + 1)) as f64)))
+            .collect();
+        TakeData {
+            tips: [tip(-1.0), tip(1.0)],
+            joints: Some(poses),
+        }
+    }
+
+    /// Encoding then decoding keeps positions to 10 µm, rotations to 1e-5 and gaps as gaps.
+    #[test]
+    fn tmot_round_trip() {
+        let data = sample_take();
+        let bytes = encode_take(&data, 250.0);
+        let back = decode_take(Path::new("t.tmot"), &bytes).unwrap();
+        for side in 0..2 {
+            for (a, b) in data.tips[side].iter().zip(&back.tips[side]) {
+                match (a, b) {
+                    (Some(a), Some(b)) => assert!((*a - *b).abs().max_element() <= 0.5e-5 + 1e-12),
+                    (None, None) => {}
+                    _ => panic!("gap not kept"),
+                }
+            }
+        }
+        for (pa, pb) in data.joints.as_ref().unwrap().iter().zip(back.joints.as_ref().unwrap()) {
+            for (a, b) in pa.iter().zip(pb) {
+                assert!(a.angle_between(*b) < 1e-5);
+            }
+        }
+    }
+
+    /// Truncated or corrupted sample files are errors, never panics.
+    #[test]
+    fn corrupt_files_are_errors() {
+        let bytes = encode_take(&sample_take(), 250.0);
+        for cut in [0, 7, 23, 24, 40, bytes.len() / 2, bytes.len() - 1] {
+            assert!(decode_take(Path::new("t.tmot"), &bytes[..cut]).is_err(), "cut at {cut}");
+        }
+        for at in (24..bytes.len()).step_by(bytes.len() / 40 + 1) {
+            let mut b = bytes.clone();
+            b[at] ^= 0x5a;
+            let _ = decode_take(Path::new("t.tmot"), &b);
+        }
+        let mut huge = bytes.clone();
+        huge[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
+        assert!(decode_take(Path::new("t.tmot"), &huge).is_err());
+    }
+}
