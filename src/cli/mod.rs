@@ -4,6 +4,7 @@
 
 mod check;
 mod midi;
+mod mocap;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -60,6 +61,29 @@ pub enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// Motion-capture database: build, inspect, import.
+    #[command(subcommand)]
+    Mocap(MocapCommand),
+}
+
+#[derive(Debug, Subcommand)]
+pub enum MocapCommand {
+    /// Build the synthetic motion database (bit-for-bit reproducible from the seed).
+    Synth {
+        /// The database folder to write.
+        #[arg(short, long, default_value = "mocap")]
+        output: PathBuf,
+        /// Seed of every random choice.
+        #[arg(long, default_value_t = 2008)]
+        seed: u64,
+    },
+    /// Per playing mode: tip height and depth range, impact speed, stroke duration; per
+    /// joint: the limit ellipsoid.
+    Stats {
+        /// The database folder.
+        #[arg(default_value = "mocap")]
+        dir: PathBuf,
+    },
 }
 
 /// Run the command line; returns the process exit code.
@@ -88,6 +112,12 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             detect_rolls,
         }) => midi::import(&input, &output, track, kit.as_deref(), title, detect_rolls)
             .map(|()| ExitCode::SUCCESS),
+        Some(Command::Mocap(MocapCommand::Synth { output, seed })) => {
+            mocap::synth(&output, seed).map(|()| ExitCode::SUCCESS)
+        }
+        Some(Command::Mocap(MocapCommand::Stats { dir })) => {
+            mocap::stats(&dir).map(|()| ExitCode::SUCCESS)
+        }
         Some(Command::ExportMidi { score, output }) => {
             midi::export(&score, &output).map(|()| ExitCode::SUCCESS)
         }

@@ -139,15 +139,26 @@ impl MotionDb {
                 let bytes = std::fs::read(&path).map_err(|e| FileError::io(&path, e))?;
                 let data = decode_take(&path, &bytes)?;
                 if data.frames() != t.frames {
-                    return Err(FileError::invalid(&path, "header", format!("{} frames, but index.ron says {}", data.frames(), t.frames)));
+                    return Err(FileError::invalid(
+                        &path,
+                        "header",
+                        format!("{} frames, but index.ron says {}", data.frames(), t.frames),
+                    ));
                 }
                 Ok(data)
             })
             .collect::<Result<Vec<_>, _>>()?;
         for (i, u) in index.units.iter().enumerate() {
-            let ok = index.takes.get(u.take).is_some_and(|t| u.start < u.impact && u.impact < u.end && u.end < t.frames);
+            let ok = index
+                .takes
+                .get(u.take)
+                .is_some_and(|t| u.start < u.impact && u.impact < u.end && u.end < t.frames);
             if !ok {
-                return Err(FileError::invalid(&index_path, format!("unit {i}"), "frames outside its take, or start < impact < end violated"));
+                return Err(FileError::invalid(
+                    &index_path,
+                    format!("unit {i}"),
+                    "frames outside its take, or start < impact < end violated",
+                ));
             }
         }
         Ok(MotionDb { index, takes })
@@ -177,7 +188,11 @@ pub fn encode_take(data: &TakeData, rate_hz: f64) -> Vec<u8> {
     let mut out = Vec::new();
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&(n as u32).to_le_bytes());
-    let joints = if data.joints.is_some() { JOINT_COUNT } else { 0 };
+    let joints = if data.joints.is_some() {
+        JOINT_COUNT
+    } else {
+        0
+    };
     out.extend_from_slice(&(joints as u32).to_le_bytes());
     out.extend_from_slice(&rate_hz.to_le_bytes());
     let mut z = ZlibEncoder::new(out, Compression::default());
@@ -185,13 +200,22 @@ pub fn encode_take(data: &TakeData, rate_hz: f64) -> Vec<u8> {
     for tip in &data.tips {
         body.extend(tip.iter().map(|p| u8::from(p.is_some())));
         for axis in 0..3 {
-            put_channel(&mut body, tip.iter().map(|p| p.map_or(0.0, |p| p[axis]) / POSITION_STEP_M));
+            put_channel(
+                &mut body,
+                tip.iter()
+                    .map(|p| p.map_or(0.0, |p| p[axis]) / POSITION_STEP_M),
+            );
         }
     }
     if let Some(poses) = &data.joints {
         for j in 0..JOINT_COUNT {
             for c in 0..4 {
-                put_channel(&mut body, poses.iter().map(|p| canonical(p[j]).to_array()[(c + 3) % 4] / QUATERNION_STEP));
+                put_channel(
+                    &mut body,
+                    poses
+                        .iter()
+                        .map(|p| canonical(p[j]).to_array()[(c + 3) % 4] / QUATERNION_STEP),
+                );
             }
         }
     }
@@ -203,22 +227,34 @@ pub fn encode_take(data: &TakeData, rate_hz: f64) -> Vec<u8> {
 pub fn decode_take(path: &Path, bytes: &[u8]) -> Result<TakeData, FileError> {
     let bad = |place: &str, msg: String| FileError::invalid(path, place.to_string(), msg);
     if bytes.len() < 24 || &bytes[..8] != MAGIC {
-        return Err(bad("header", "not a timpanist .tmot sample file (expected the 24-byte TMOTION1 header)".into()));
+        return Err(bad(
+            "header",
+            "not a timpanist .tmot sample file (expected the 24-byte TMOTION1 header)".into(),
+        ));
     }
     let n = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes")) as usize;
     let joints = u32::from_le_bytes(bytes[12..16].try_into().expect("4 bytes")) as usize;
     if joints != 0 && joints != JOINT_COUNT {
-        return Err(bad("header", format!("{joints} joints; expected 0 or {JOINT_COUNT}")));
+        return Err(bad(
+            "header",
+            format!("{joints} joints; expected 0 or {JOINT_COUNT}"),
+        ));
     }
     let mut body = Vec::new();
     ZlibDecoder::new(&bytes[24..])
         .take((n as u64 + 1) * 8 * (6 + 4 * JOINT_COUNT as u64) + 64)
         .read_to_end(&mut body)
         .map_err(|e| bad("sample data", format!("corrupt compressed data: {e}")))?;
-    let mut reader = Channels { body: &body, pos: 0 };
+    let mut reader = Channels {
+        body: &body,
+        pos: 0,
+    };
     let mut tips: [Vec<Option<DVec3>>; 2] = [Vec::new(), Vec::new()];
     for tip in &mut tips {
-        let seen = reader.bytes(n).ok_or_else(|| bad("sample data", "truncated validity flags".into()))?.to_vec();
+        let seen = reader
+            .bytes(n)
+            .ok_or_else(|| bad("sample data", "truncated validity flags".into()))?
+            .to_vec();
         let axes: Vec<Vec<f64>> = (0..3)
             .map(|_| reader.channel(n, POSITION_STEP_M))
             .collect::<Option<_>>()
@@ -246,7 +282,13 @@ pub fn decode_take(path: &Path, bytes: &[u8]) -> Result<TakeData, FileError> {
         )
     };
     if reader.pos != body.len() {
-        return Err(bad("sample data", format!("{} bytes left over after the last channel", body.len() - reader.pos)));
+        return Err(bad(
+            "sample data",
+            format!(
+                "{} bytes left over after the last channel",
+                body.len() - reader.pos
+            ),
+        ));
     }
     Ok(TakeData { tips, joints })
 }
@@ -330,7 +372,13 @@ mod tests {
             (0..n)
                 .map(|f| {
                     let t = f as f64 / 250.0;
-                    (f % 97 != 0).then(|| DVec3::new(0.3 * phase, 0.5 + 0.01 * t, 0.8 + 0.2 * (t * 7.0 + phase).sin()))
+                    (f % 97 != 0).then(|| {
+                        DVec3::new(
+                            0.3 * phase,
+                            0.5 + 0.01 * t,
+                            0.8 + 0.2 * (t * 7.0 + phase).sin(),
+                        )
+                    })
                 })
                 .collect()
         };
@@ -358,7 +406,13 @@ mod tests {
                 }
             }
         }
-        for (pa, pb) in data.joints.as_ref().unwrap().iter().zip(back.joints.as_ref().unwrap()) {
+        for (pa, pb) in data
+            .joints
+            .as_ref()
+            .unwrap()
+            .iter()
+            .zip(back.joints.as_ref().unwrap())
+        {
             for (a, b) in pa.iter().zip(pb) {
                 assert!(a.angle_between(*b) < 1e-5);
             }
@@ -370,7 +424,10 @@ mod tests {
     fn corrupt_files_are_errors() {
         let bytes = encode_take(&sample_take(), 250.0);
         for cut in [0, 7, 23, 24, 40, bytes.len() / 2, bytes.len() - 1] {
-            assert!(decode_take(Path::new("t.tmot"), &bytes[..cut]).is_err(), "cut at {cut}");
+            assert!(
+                decode_take(Path::new("t.tmot"), &bytes[..cut]).is_err(),
+                "cut at {cut}"
+            );
         }
         for at in (24..bytes.len()).step_by(bytes.len() / 40 + 1) {
             let mut b = bytes.clone();

@@ -4,7 +4,10 @@
 
 pub mod db;
 pub mod import;
+pub mod limits;
 pub mod segment;
+pub mod stats;
+pub mod synth;
 pub mod take;
 
 pub use take::{ImportError, Take, Track};

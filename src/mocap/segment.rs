@@ -71,7 +71,10 @@ pub fn fill_gaps(samples: &[Option<DVec3>], max_gap: usize) -> Vec<Option<DVec3>
         while i < out.len() && out[i].is_none() {
             i += 1;
         }
-        let (before, after) = (start.checked_sub(1).and_then(|b| out[b]), out.get(i).copied().flatten());
+        let (before, after) = (
+            start.checked_sub(1).and_then(|b| out[b]),
+            out.get(i).copied().flatten(),
+        );
         if let (Some(a), Some(b)) = (before, after)
             && i - start <= max_gap
         {
@@ -100,7 +103,9 @@ pub fn segment(tip: &[Option<DVec3>], rate_hz: f64, params: &SegmentParams) -> S
                 && velocity[i.saturating_sub(window)..i]
                     .iter()
                     .any(|v| *v < -params.min_approach_speed)
-                && velocity[i + 1..(i + 1 + window).min(n)].iter().any(|v| *v > 0.0)
+                && velocity[i + 1..(i + 1 + window).min(n)]
+                    .iter()
+                    .any(|v| *v > 0.0)
         })
         .collect();
     let plane = median(candidates.iter().map(|&i| height[i]).collect());
@@ -122,7 +127,14 @@ pub fn segment(tip: &[Option<DVec3>], rate_hz: f64, params: &SegmentParams) -> S
     let rebound_ends: Vec<Option<usize>> = impacts
         .iter()
         .enumerate()
-        .map(|(k, &i)| rebound_end(&velocity, i, impacts.get(k + 1).copied().unwrap_or(n), params))
+        .map(|(k, &i)| {
+            rebound_end(
+                &velocity,
+                i,
+                impacts.get(k + 1).copied().unwrap_or(n),
+                params,
+            )
+        })
         .collect();
     let units = (1..impacts.len().saturating_sub(1))
         .filter_map(|k| {
@@ -144,13 +156,21 @@ pub fn segment(tip: &[Option<DVec3>], rate_hz: f64, params: &SegmentParams) -> S
 
 /// The frame after `impact` (and before `next`) where the rebound's upward speed has
 /// fallen to the given fraction of its peak.
-fn rebound_end(velocity: &[f64], impact: usize, next: usize, params: &SegmentParams) -> Option<usize> {
+fn rebound_end(
+    velocity: &[f64],
+    impact: usize,
+    next: usize,
+    params: &SegmentParams,
+) -> Option<usize> {
     let span = velocity.get(impact + 1..next)?;
     let (peak_at, peak) = span
         .iter()
         .enumerate()
         .take_while(|(_, v)| v.is_finite())
-        .fold((0, 0.0f64), |best, (k, &v)| if v > best.1 { (k, v) } else { best });
+        .fold(
+            (0, 0.0f64),
+            |best, (k, &v)| if v > best.1 { (k, v) } else { best },
+        );
     if peak <= 0.0 {
         return None;
     }
@@ -169,7 +189,11 @@ fn vertical_velocity(height: &[f64], rate_hz: f64) -> Vec<f64> {
             let a = height[i.saturating_sub(1)];
             let b = height[(i + 1).min(n - 1)];
             let span = ((i + 1).min(n - 1) - i.saturating_sub(1)) as f64;
-            if span == 0.0 { 0.0 } else { (b - a) * rate_hz / span }
+            if span == 0.0 {
+                0.0
+            } else {
+                (b - a) * rate_hz / span
+            }
         })
         .collect()
 }
@@ -195,11 +219,19 @@ mod tests {
             .map(|f| {
                 let t = f as f64 / rate;
                 let k = impacts_s.partition_point(|&x| x <= t);
-                let prev = if k == 0 { impacts_s[0] - 0.6 } else { impacts_s[k - 1] };
+                let prev = if k == 0 {
+                    impacts_s[0] - 0.6
+                } else {
+                    impacts_s[k - 1]
+                };
                 let next = impacts_s.get(k).copied().unwrap_or(prev + 0.6);
                 let u = (t - prev) / (next - prev);
                 // Lift peaks at u = 0.65: rise slowly, fall fast.
-                let s = if u < 0.65 { (u / 0.65 * std::f64::consts::FRAC_PI_2).sin() } else { ((1.0 - u) / 0.35 * std::f64::consts::FRAC_PI_2).sin() };
+                let s = if u < 0.65 {
+                    (u / 0.65 * std::f64::consts::FRAC_PI_2).sin()
+                } else {
+                    ((1.0 - u) / 0.35 * std::f64::consts::FRAC_PI_2).sin()
+                };
                 Some(DVec3::new(0.1, 0.5, 0.76 + 0.3 * s))
             })
             .collect()
@@ -214,7 +246,11 @@ mod tests {
         let seg = segment(&tip, 250.0, &SegmentParams::default());
         assert_eq!(seg.impacts.len(), impacts.len());
         for (&found, &t) in seg.impacts.iter().zip(&impacts) {
-            assert!((found as f64 - t * 250.0).abs() <= 1.0, "{found} vs {}", t * 250.0);
+            assert!(
+                (found as f64 - t * 250.0).abs() <= 1.0,
+                "{found} vs {}",
+                t * 250.0
+            );
         }
         assert!((seg.plane_height_m.unwrap() - 0.76).abs() < 1e-3);
         assert_eq!(seg.units.len(), impacts.len() - 2);
@@ -243,8 +279,20 @@ mod tests {
     #[test]
     fn nothing_to_find() {
         let still = vec![Some(DVec3::new(0.0, 0.0, 1.0)); 500];
-        assert!(segment(&still, 250.0, &SegmentParams::default()).impacts.is_empty());
-        assert!(segment(&[], 250.0, &SegmentParams::default()).units.is_empty());
-        assert!(segment(&[None; 10], 250.0, &SegmentParams::default()).units.is_empty());
+        assert!(
+            segment(&still, 250.0, &SegmentParams::default())
+                .impacts
+                .is_empty()
+        );
+        assert!(
+            segment(&[], 250.0, &SegmentParams::default())
+                .units
+                .is_empty()
+        );
+        assert!(
+            segment(&[None; 10], 250.0, &SegmentParams::default())
+                .units
+                .is_empty()
+        );
     }
 }
