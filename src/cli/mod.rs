@@ -5,6 +5,7 @@
 mod check;
 mod midi;
 mod mocap;
+mod sticking;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -61,9 +62,40 @@ pub enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// Assign hands to the beats marked Auto and print the sticking.
+    Sticking {
+        /// The score (.ron).
+        score: PathBuf,
+        /// simple: preferred hand plus alternation (seed 003 Alg. 3.1); pairwise: pair
+        /// preferences blended by ρ^Δt (§4.2.2); optimal: dynamic programming over travel,
+        /// crossing and repetition costs.
+        #[arg(long, value_enum, default_value_t = StickingMethod::Optimal)]
+        method: StickingMethod,
+        /// Save the score with the hands filled in.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
     /// Motion-capture database: build, inspect, import.
     #[command(subcommand)]
     Mocap(MocapCommand),
+}
+
+/// The sticking methods, as named on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum StickingMethod {
+    Simple,
+    Pairwise,
+    Optimal,
+}
+
+impl From<StickingMethod> for crate::motion::sticking::Method {
+    fn from(m: StickingMethod) -> Self {
+        match m {
+            StickingMethod::Simple => Self::Simple,
+            StickingMethod::Pairwise => Self::Pairwise,
+            StickingMethod::Optimal => Self::Optimal,
+        }
+    }
 }
 
 #[derive(Debug, Subcommand)]
@@ -112,6 +144,11 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             detect_rolls,
         }) => midi::import(&input, &output, track, kit.as_deref(), title, detect_rolls)
             .map(|()| ExitCode::SUCCESS),
+        Some(Command::Sticking {
+            score,
+            method,
+            output,
+        }) => sticking::run(&score, method.into(), output.as_deref()).map(|()| ExitCode::SUCCESS),
         Some(Command::Mocap(MocapCommand::Synth { output, seed })) => {
             mocap::synth(&output, seed).map(|()| ExitCode::SUCCESS)
         }

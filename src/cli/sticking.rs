@@ -11,9 +11,16 @@ pub fn run(input: &Path, method: Method, output: Option<&Path>) -> anyhow::Resul
     let sides = sticking::assign(&score, &kit, method, &Params::default());
     let meter = score.meter_map();
     let times = score.beat_times();
-    println!("{:>5}  {:<16} {:>8}  {:<10} {:<5}", "beat", "position", "time s", "drum", "hand");
+    println!(
+        "{:>5}  {:<16} {:>8}  {:<10} {:<5}",
+        "beat", "position", "time s", "drum", "hand"
+    );
     for (i, (beat, side)) in score.beats.iter().zip(&sides).enumerate() {
-        let how = if beat.hand.side().is_some() { "" } else { " (auto)" };
+        let how = if beat.hand.side().is_some() {
+            ""
+        } else {
+            " (auto)"
+        };
         println!(
             "{i:>5}  {:<16} {:>8.3}  {:<10} {side:?}{how}",
             meter.position(beat.tick).to_string(),
@@ -23,8 +30,14 @@ pub fn run(input: &Path, method: Method, output: Option<&Path>) -> anyhow::Resul
     }
     println!(
         "{method:?} sticking: {} right, {} left, {} arm crossings",
-        sides.iter().filter(|s| **s == crate::kit::Side::Right).count(),
-        sides.iter().filter(|s| **s == crate::kit::Side::Left).count(),
+        sides
+            .iter()
+            .filter(|s| **s == crate::kit::Side::Right)
+            .count(),
+        sides
+            .iter()
+            .filter(|s| **s == crate::kit::Side::Left)
+            .count(),
         sticking::crossings(&score, &kit, &sides)
     );
     if let Some(out) = output {

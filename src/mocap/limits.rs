@@ -114,15 +114,15 @@ pub fn symmetric_eigen(m: DMat3) -> ([f64; 3], [DVec3; 3]) {
             let t = if theta == 0.0 { 1.0 } else { t };
             let c = 1.0 / (t * t + 1.0).sqrt();
             let s = t * c;
-            for k in 0..3 {
-                let (akp, akq) = (a[k][p], a[k][q]);
-                a[k][p] = c * akp - s * akq;
-                a[k][q] = s * akp + c * akq;
+            for row in &mut a {
+                let (akp, akq) = (row[p], row[q]);
+                row[p] = c * akp - s * akq;
+                row[q] = s * akp + c * akq;
             }
+            let (row_p, row_q) = (a[p], a[q]);
             for k in 0..3 {
-                let (apk, aqk) = (a[p][k], a[q][k]);
-                a[p][k] = c * apk - s * aqk;
-                a[q][k] = s * apk + c * aqk;
+                a[p][k] = c * row_p[k] - s * row_q[k];
+                a[q][k] = s * row_p[k] + c * row_q[k];
             }
             for row in &mut v {
                 let (vp, vq) = (row[p], row[q]);
@@ -181,8 +181,8 @@ mod tests {
             .collect();
         let limit = JointLimit::estimate(&samples).unwrap();
         assert!(limit.mean.angle_between(mean) < 0.01);
-        for k in 0..3 {
-            assert!(limit.axes[k].dot(axes[k]).abs() > 0.99, "axis {k}");
+        for (found, want) in limit.axes.iter().zip(axes) {
+            assert!(found.dot(want).abs() > 0.99, "axis {want}");
         }
         assert!(limit.semi_axes[0] > limit.semi_axes[1] && limit.semi_axes[1] > limit.semi_axes[2]);
         assert!(samples.iter().all(|q| limit.contains(*q)));

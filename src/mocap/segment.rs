@@ -176,7 +176,7 @@ fn rebound_end(
     }
     span[peak_at..]
         .iter()
-        .position(|&v| !(v > params.rebound_end_fraction * peak))
+        .position(|&v| v.is_nan() || v <= params.rebound_end_fraction * peak)
         .map(|k| impact + 1 + peak_at + k)
         .filter(|&e| e < next)
 }

@@ -112,7 +112,11 @@ struct JointTiming {
 /// Trunk, shoulder, elbow, wrist, grip: proximal peaks first and arrives gently; distal
 /// last and fast.
 const TIMING: [JointTiming; 5] = [
-    JointTiming { peak: 0.45, rebound: 0.4, arrival: 0.6 },
+    JointTiming {
+        peak: 0.45,
+        rebound: 0.4,
+        arrival: 0.6,
+    },
     JointTiming {
         peak: 0.50,
         rebound: 0.6,
