@@ -6,7 +6,10 @@ use std::process::Command;
 use timpanist::score::{Hand, LoadedScore};
 
 fn timpanist(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_timpanist")).args(args).output().unwrap()
+    Command::new(env!("CARGO_BIN_EXE_timpanist"))
+        .args(args)
+        .output()
+        .unwrap()
 }
 
 /// Each method, on each demo score, leaves no Auto hand and keeps fixed hands.
@@ -20,7 +23,14 @@ fn every_method_fills_every_auto_hand() {
         for method in ["simple", "pairwise", "optimal"] {
             // Keep the kit reference valid by writing next to a copy of the kits folder layout.
             let out = dir.path().join("out.ron");
-            let o = timpanist(&["sticking", path.to_str().unwrap(), "--method", method, "-o", out.to_str().unwrap()]);
+            let o = timpanist(&[
+                "sticking",
+                path.to_str().unwrap(),
+                "--method",
+                method,
+                "-o",
+                out.to_str().unwrap(),
+            ]);
             assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
             let stdout = String::from_utf8_lossy(&o.stdout);
             assert!(stdout.contains("arm crossings"), "{stdout}");

@@ -95,42 +95,61 @@ pub fn stats(dir: &Path) -> anyhow::Result<()> {
             );
         }
     }
-    if db.takes.iter().any(|t| t.joints.is_some()) {
-        println!(
-            "\njoint limits (seed 000 Alg. 1): semi-axes of the bounding ellipsoid as rotation angles, degrees; Table 1 as printed"
-        );
-        for joint in Joint::ALL {
-            let samples: Vec<_> = db
-                .takes
-                .iter()
-                .filter_map(|t| t.joints.as_ref())
-                .flat_map(|poses| poses.iter().step_by(5).map(move |p| p[joint.index()]))
-                .collect();
-            let Some(limit) = JointLimit::estimate(&samples) else {
-                continue;
-            };
-            let deg = limit.semi_axes.map(|a| (2.0 * a).to_degrees());
-            let table = TABLE_1
-                .iter()
-                .find(|(n, _)| joint.name().starts_with(n))
-                .map_or(String::new(), |(_, t)| format!("   Table 1: {:?}", t));
-            println!(
-                "  {:<11} {:>6.1} {:>6.1} {:>6.1}   axes ({:+.2} {:+.2} {:+.2}) ({:+.2} {:+.2} {:+.2}) ({:+.2} {:+.2} {:+.2}){table}",
-                joint.name(),
-                deg[0],
-                deg[1],
-                deg[2],
-                limit.axes[0].x,
-                limit.axes[0].y,
-                limit.axes[0].z,
-                limit.axes[1].x,
-                limit.axes[1].y,
-                limit.axes[1].z,
-                limit.axes[2].x,
-                limit.axes[2].y,
-                limit.axes[2].z,
-            );
-        }
+    for grip in [Grip::French, Grip::German] {
+        print_limits(&db, grip);
     }
     Ok(())
+}
+
+/// Joint limits of one grip from the frames of its motion units (each arm only while it
+/// plays), beside Table 1 of seed 000.
+fn print_limits(db: &MotionDb, grip: Grip) {
+    let units: Vec<_> = db
+        .index
+        .units
+        .iter()
+        .filter(|u| u.grip == grip && db.takes[u.take].joints.is_some())
+        .collect();
+    if units.is_empty() {
+        return;
+    }
+    println!(
+        "\n{grip:?} grip joint limits (seed 000 Alg. 1): semi-axes of the bounding ellipsoid as rotation angles, degrees"
+    );
+    for joint in Joint::ALL {
+        let samples: Vec<_> = units
+            .iter()
+            .filter(|u| !Joint::arm(u.hand.other()).contains(&joint))
+            .flat_map(|u| {
+                let poses = db.takes[u.take].joints.as_deref().unwrap_or_default();
+                poses[u.start..=u.end]
+                    .iter()
+                    .step_by(5)
+                    .map(move |p| p[joint.index()])
+            })
+            .collect();
+        let Some(limit) = JointLimit::estimate(&samples) else {
+            continue;
+        };
+        let deg = limit.semi_axes.map(|a| (2.0 * a).to_degrees());
+        let axes: Vec<String> = limit
+            .axes
+            .iter()
+            .map(|a| format!("({:+.2} {:+.2} {:+.2})", a.x, a.y, a.z))
+            .collect();
+        let table = TABLE_1
+            .iter()
+            .find(|(n, _)| joint.name().starts_with(n))
+            .map_or(String::new(), |(_, t)| {
+                format!("   Table 1 as printed: {t:?}")
+            });
+        println!(
+            "  {:<11} {:>6.1} {:>6.1} {:>6.1}   axes {}{table}",
+            joint.name(),
+            deg[0],
+            deg[1],
+            deg[2],
+            axes.join(" ")
+        );
+    }
 }

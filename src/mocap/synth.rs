@@ -524,3 +524,72 @@ pub fn synthesize(config: &SynthConfig) -> MotionDb {
 
 /// Joint count check kept next to the data layout it guards.
 const _: () = assert!(JOINT_COUNT == 11);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Segmentation finds every synthesised impact of a take to ±1 frame, and each
+    /// impact puts the tip on the membrane (within the 2 mm the IK tolerance and the
+    /// 250 Hz sampling of a fast stroke allow on the nearest frame, see below).
+    #[test]
+    fn segmentation_finds_every_synthetic_impact() {
+        let performer = Performer::new();
+        for (grip, mode) in [
+            (Grip::French, PlayingMode::Staccato),
+            (Grip::German, PlayingMode::Tenuto),
+        ] {
+            let mut rng = Rng::new(11);
+            let take = performer.take(
+                &mut rng,
+                grip,
+                mode,
+                ImpactLocation::Centre,
+                Side::Left,
+                &[Dynamic::P, Dynamic::F],
+                4,
+                250.0,
+            );
+            let seg = segment(take.data.tip(Side::Left), 250.0, &SegmentParams::default());
+            assert_eq!(seg.impacts.len(), take.strokes.len(), "{grip:?} {mode:?}");
+            for (&found, &(t, _)) in seg.impacts.iter().zip(&take.strokes) {
+                assert!(
+                    (found as f64 - t * 250.0).abs() <= 1.0,
+                    "{found} vs {}",
+                    t * 250.0
+                );
+            }
+            let membrane = performer.kit.drums[1].placement.head_height_m;
+            let lowest = take
+                .data
+                .tip(Side::Left)
+                .iter()
+                .flatten()
+                .map(|p| p.z)
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                lowest > membrane - 1e-3,
+                "the tip went {} mm through the head",
+                (membrane - lowest) * 1e3
+            );
+        }
+    }
+
+    /// The lift profile is 0 at both impacts, 1 at its peak, within [0, 1] between, and
+    /// leaves the first impact upward and reaches the second downward.
+    #[test]
+    fn lift_profile_shape() {
+        let t = TIMING[4];
+        assert_eq!(lift(0.0, t), 0.0);
+        assert!(lift(1.0, t).abs() < 1e-12);
+        assert!((lift(t.peak, t) - 1.0).abs() < 1e-12);
+        assert!(
+            (0..=1000)
+                .map(|i| lift(i as f64 / 1000.0, t))
+                .all(|s| (-1e-12..=1.0 + 1e-12).contains(&s))
+        );
+        assert!(lift(0.001, t) > 0.0 && lift(0.999, t) > 0.0);
+        let slope_in = (lift(1.0, t) - lift(0.999, t)) / 0.001;
+        assert!(slope_in < -5.0, "arrives fast: {slope_in}");
+    }
+}
