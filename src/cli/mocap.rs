@@ -26,7 +26,7 @@ pub fn synth(dir: &Path, seed: u64) -> anyhow::Result<()> {
         dir.display(),
         db.index.takes.len(),
         db.index.units.len(),
-        db.index.rate_hz
+        config.rate_hz
     );
     Ok(())
 }
@@ -43,11 +43,10 @@ const TABLE_1: [(&str, [f64; 3]); 4] = [
 pub fn stats(dir: &Path) -> anyhow::Result<()> {
     let db = MotionDb::load(dir)?;
     println!(
-        "{}: {} takes, {} units, {} Hz",
+        "{}: {} takes, {} units",
         dir.display(),
         db.index.takes.len(),
         db.index.units.len(),
-        db.index.rate_hz
     );
     for grip in [None, Some(Grip::French), Some(Grip::German)] {
         let rows = stats::by_mode(&db, grip);

@@ -4,7 +4,7 @@
 //! upper-body joint rotations, at the capture rate.
 //!
 //! **`.tmot` sample files** (little-endian): the 8 bytes `TMOTION1`; u32 frame count N;
-//! u32 joint count J (0 or 11); f64 rate in Hz; then one zlib stream holding, for each
+//! u32 joint count J (0 or 11); f64 sample rate in Hz; then one zlib stream holding, for each
 //! tip (left, right), N validity bytes (1 = seen) followed by its x, y, z channels, and
 //! then the 4·J quaternion channels (w, x, y, z per joint in `index.joints` order). Each
 //! channel is quantised (positions to 10 µm, quaternion components to 1e-6), replaced by
@@ -36,8 +36,6 @@ pub struct Index {
     pub version: u32,
     /// Where the data came from, in words.
     pub description: String,
-    /// Sample rate of every take, Hz.
-    pub rate_hz: f64,
     /// Joint names of the rotation channels, in file order (empty if no take has joints).
     pub joints: Vec<String>,
     pub takes: Vec<TakeEntry>,
@@ -51,6 +49,8 @@ pub struct TakeEntry {
     /// Sample file, relative to the database folder.
     pub file: String,
     pub frames: usize,
+    /// Sample rate, Hz.
+    pub rate_hz: f64,
     pub performer: String,
     /// The capture file it was imported from (or "synthetic").
     pub source: String,
@@ -79,6 +79,8 @@ pub struct UnitEntry {
 /// The samples of one take.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TakeData {
+    /// Sample rate, Hz.
+    pub rate_hz: f64,
     /// Tip positions per frame, [left, right], m; `None` where not seen.
     pub tips: [Vec<Option<DVec3>>; 2],
     /// Joint rotations per frame, if the source has them.
@@ -171,7 +173,7 @@ impl MotionDb {
             if let Some(parent) = path.parent() {
                 std::fs::create_dir_all(parent).map_err(|e| FileError::io(parent, e))?;
             }
-            ron_file::write_atomic(&path, &encode_take(data, self.index.rate_hz))?;
+            ron_file::write_atomic(&path, &encode_take(data))?;
         }
         ron_file::save(&dir.join("index.ron"), &self.index)
     }
@@ -183,7 +185,7 @@ impl MotionDb {
 }
 
 /// Serialise one take as a `.tmot` file.
-pub fn encode_take(data: &TakeData, rate_hz: f64) -> Vec<u8> {
+pub fn encode_take(data: &TakeData) -> Vec<u8> {
     let n = data.frames();
     let mut out = Vec::new();
     out.extend_from_slice(MAGIC);
@@ -194,7 +196,7 @@ pub fn encode_take(data: &TakeData, rate_hz: f64) -> Vec<u8> {
         0
     };
     out.extend_from_slice(&(joints as u32).to_le_bytes());
-    out.extend_from_slice(&rate_hz.to_le_bytes());
+    out.extend_from_slice(&data.rate_hz.to_le_bytes());
     let mut z = ZlibEncoder::new(out, Compression::default());
     let mut body = Vec::new();
     for tip in &data.tips {
@@ -234,6 +236,13 @@ pub fn decode_take(path: &Path, bytes: &[u8]) -> Result<TakeData, FileError> {
     }
     let n = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes")) as usize;
     let joints = u32::from_le_bytes(bytes[12..16].try_into().expect("4 bytes")) as usize;
+    let rate_hz = f64::from_le_bytes(bytes[16..24].try_into().expect("8 bytes"));
+    if !(rate_hz.is_finite() && rate_hz > 0.0) {
+        return Err(bad(
+            "header",
+            format!("sample rate {rate_hz} Hz is not positive"),
+        ));
+    }
     if joints != 0 && joints != JOINT_COUNT {
         return Err(bad(
             "header",
@@ -290,7 +299,11 @@ pub fn decode_take(path: &Path, bytes: &[u8]) -> Result<TakeData, FileError> {
             ),
         ));
     }
-    Ok(TakeData { tips, joints })
+    Ok(TakeData {
+        rate_hz,
+        tips,
+        joints,
+    })
 }
 
 /// The quaternion with w ≥ 0 (q and −q are the same rotation), so channels stay smooth.
@@ -386,6 +399,7 @@ mod tests {
             .map(|f| std::array::from_fn(|j| DQuat::from_rotation_x(0.001 * (f * (j + 1)) as f64)))
             .collect();
         TakeData {
+            rate_hz: 250.0,
             tips: [tip(-1.0), tip(1.0)],
             joints: Some(poses),
         }
@@ -395,7 +409,7 @@ mod tests {
     #[test]
     fn tmot_round_trip() {
         let data = sample_take();
-        let bytes = encode_take(&data, 250.0);
+        let bytes = encode_take(&data);
         let back = decode_take(Path::new("t.tmot"), &bytes).unwrap();
         for side in 0..2 {
             for (a, b) in data.tips[side].iter().zip(&back.tips[side]) {
@@ -422,7 +436,7 @@ mod tests {
     /// Truncated or corrupted sample files are errors, never panics.
     #[test]
     fn corrupt_files_are_errors() {
-        let bytes = encode_take(&sample_take(), 250.0);
+        let bytes = encode_take(&sample_take());
         for cut in [0, 7, 23, 24, 40, bytes.len() / 2, bytes.len() - 1] {
             assert!(
                 decode_take(Path::new("t.tmot"), &bytes[..cut]).is_err(),

@@ -21,6 +21,7 @@ pub struct UnitStats {
 /// Measure one unit of `db`.
 pub fn unit_stats(db: &MotionDb, u: &UnitEntry) -> UnitStats {
     let tip = db.unit_tip(u);
+    let rate_hz = db.takes[u.take].rate_hz;
     let range = |f: fn(glam::DVec3) -> f64| {
         let (lo, hi) = tip
             .iter()
@@ -36,14 +37,14 @@ pub fn unit_stats(db: &MotionDb, u: &UnitEntry) -> UnitStats {
         k.checked_sub(2).and_then(|j| tip[j]),
         k.checked_sub(1).and_then(|j| tip[j]),
     ) {
-        (Some(before), Some(at)) => (before.z - at.z) * db.index.rate_hz,
+        (Some(before), Some(at)) => (before.z - at.z) * rate_hz,
         _ => f64::NAN,
     };
     UnitStats {
         height_range_m: range(|p| p.z),
         depth_range_m: range(|p| p.y),
         impact_speed_mps: speed,
-        duration_s: (u.end - u.start) as f64 / db.index.rate_hz,
+        duration_s: (u.end - u.start) as f64 / rate_hz,
     }
 }
 

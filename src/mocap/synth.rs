@@ -384,6 +384,7 @@ impl Performer {
         });
         SynthTake {
             data: TakeData {
+                rate_hz,
                 tips,
                 joints: Some(poses),
             },
@@ -429,7 +430,6 @@ impl Performer {
         let mut index = Index {
             version: db::DB_FORMAT_VERSION,
             description: "SYNTHETIC motion database made by `timpanist mocap synth` (joint-space stroke synthesis on the 11-segment body model, forward kinematics to the stick tips). Not a real capture; see mocap/README.md.".into(),
-            rate_hz: config.rate_hz,
             joints: db::joint_names(),
             takes: Vec::new(),
             units: Vec::new(),
@@ -488,6 +488,7 @@ impl Performer {
                         index.takes.push(TakeEntry {
                             file: format!("takes/{name}.tmot"),
                             frames: synth.data.frames(),
+                            rate_hz: config.rate_hz,
                             performer: "synthetic".into(),
                             source: "synthetic".into(),
                         });
