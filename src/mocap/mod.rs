@@ -4,6 +4,7 @@
 
 pub mod db;
 pub mod import;
+pub mod ingest;
 pub mod limits;
 pub mod segment;
 pub mod stats;
