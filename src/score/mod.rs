@@ -3,6 +3,7 @@
 //! an optional roll; read from and written to strict, versioned RON files (`scores/*.ron`).
 
 pub mod meter;
+mod migrate;
 pub mod tempo;
 pub mod validate;
 
@@ -16,7 +17,7 @@ pub use meter::{BarBeat, MeterChange, MeterMap};
 pub use tempo::{TempoChange, TempoMap, TempoPoint};
 
 /// The score file format this timpanist writes and the newest it reads.
-pub const SCORE_FORMAT_VERSION: u32 = 1;
+pub const SCORE_FORMAT_VERSION: u32 = 2;
 
 /// Ticks per quarter note of new scores.
 pub const DEFAULT_TICKS_PER_QUARTER: u32 = 960;
@@ -244,6 +245,31 @@ impl Beat {
     }
 }
 
+/// A user edit of one hand's tip trajectory: a smooth displacement around a moment, zero
+/// outside `tick ± reach_ticks` (a cubic B-spline bump; impacts are never moved by it).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Handle {
+    pub hand: Side,
+    /// Centre of the edit, ticks.
+    pub tick: u64,
+    /// Half-width of its support, ticks.
+    pub reach_ticks: u64,
+    /// Displacement at the centre, m (performer frame: x right, y forward, z up).
+    pub offset_m: [f64; 3],
+}
+
+/// Pins one stroke's impact to an exact point (instead of its drum's impact location).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImpactPin {
+    pub hand: Side,
+    /// The stroke's tick (a beat's, or one stroke of a roll).
+    pub tick: u64,
+    /// Where the stick tip meets the head, m (performer frame).
+    pub point_m: [f64; 3],
+}
+
 /// A whole score, as saved in a `.ron` file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename = "Score", deny_unknown_fields)]
@@ -263,6 +289,10 @@ pub struct Score {
     pub meter: Vec<MeterChange>,
     /// The beats, in time order.
     pub beats: Vec<Beat>,
+    /// Edits of the composed tip trajectories (format 2).
+    pub handles: Vec<Handle>,
+    /// Impact points pinned by the user (format 2).
+    pub pins: Vec<ImpactPin>,
 }
 
 /// A score together with its kit, as loaded from disk.
@@ -296,6 +326,8 @@ impl Score {
                 denominator: 4,
             }],
             beats: Vec::new(),
+            handles: Vec::new(),
+            pins: Vec::new(),
         }
     }
 
@@ -309,7 +341,8 @@ impl Score {
         }
         let probe: Probe = ron_file::parse(path, text)?;
         let mut score: Score = match probe.version {
-            1 => ron_file::parse(path, text)?,
+            1 => migrate::from_v1(ron_file::parse(path, text)?),
+            2 => ron_file::parse(path, text)?,
             0 => {
                 return Err(FileError::invalid(
                     path,

@@ -85,6 +85,20 @@ pub fn problems(score: &Score, kit: &Kit) -> Vec<Problem> {
             }
         }
     }
+    for (i, h) in score.handles.iter().enumerate() {
+        let size = h.offset_m.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if h.reach_ticks == 0 || !(size.is_finite() && size <= 0.5) {
+            out.push(Problem::new(
+                format!("handle {i}"),
+                "a handle needs a positive reach and a finite offset of at most 0.5 m",
+            ));
+        }
+    }
+    for (i, p) in score.pins.iter().enumerate() {
+        if !p.point_m.iter().all(|v| v.is_finite() && v.abs() <= 3.0) {
+            out.push(Problem::new(format!("pin {i}"), "a pinned impact point must be finite and within 3 m of the player"));
+        }
+    }
     let mut i = 0;
     while i < score.beats.len() {
         let tick = score.beats[i].tick;
