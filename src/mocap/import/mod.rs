@@ -1,1 +1,266 @@
-//! Importers for capture files: C3D, OptiTrack Motive CSV, Vicon CSV and a plain CSV.
+//! Importers for capture files: C3D, OptiTrack Motive CSV, Vicon Nexus CSV and our own
+//! plain CSV, plus a C3D writer for our own exports.
+//!
+//! Every importer returns a [`Take`]: labelled tracks at one fixed rate, positions in
+//! metres in the file's own axes (converted from the file's length unit), `None` where a
+//! marker was not seen, and rotations for rigid bodies. A file that is not what it claims
+//! to be, or is corrupt or truncated, gives an [`ImportError::Format`] that names the place
+//! (byte offset, C3D parameter, or CSV line and column) and says what was expected; no
+//! file content can make an importer panic.
+//!
+//! * [`c3d`]: binary C3D (Intel, DEC and MIPS processor formats, integer or float data).
+//! * [`motive`]: OptiTrack Motive CSV export, format version 1.2x.
+//! * [`vicon`]: Vicon Nexus CSV export (the `Trajectories` section).
+//! * [`plain_csv`]: our own documented CSV (`time_s,<label>_x,<label>_y,<label>_z,…`).
+
+pub mod c3d;
+mod csv_text;
+pub mod motive;
+pub mod plain_csv;
+pub mod vicon;
+
+pub use c3d::write_c3d;
+
+use super::take::{ImportError, Take};
+use std::path::Path;
+
+/// A capture file format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// Binary C3D.
+    C3d,
+    /// OptiTrack Motive CSV export.
+    Motive,
+    /// Vicon Nexus CSV export.
+    Vicon,
+    /// Our own plain CSV.
+    Csv,
+}
+
+impl Format {
+    /// The format for a user-given name: `c3d`, `motive` (or `optitrack`), `vicon` (or
+    /// `nexus`), `csv` (or `plain`); case-insensitive.
+    pub fn from_name(s: &str) -> Option<Format> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "c3d" => Some(Format::C3d),
+            "motive" | "optitrack" => Some(Format::Motive),
+            "vicon" | "nexus" => Some(Format::Vicon),
+            "csv" | "plain" | "plain-csv" | "plain_csv" => Some(Format::Csv),
+            _ => None,
+        }
+    }
+
+    /// The name [`Format::from_name`] accepts for this format.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::C3d => "c3d",
+            Format::Motive => "motive",
+            Format::Vicon => "vicon",
+            Format::Csv => "csv",
+        }
+    }
+
+    /// Guess the format from the file's content, falling back on its extension (`.c3d`).
+    /// Text files are told apart by their first line: `Format Version,…` is Motive, a
+    /// Vicon section name (`Trajectories`, `Devices`, …) is Vicon, `time_s,…` is plain CSV.
+    pub fn guess(path: &Path, bytes: &[u8]) -> Option<Format> {
+        if let [first, 0x50, ..] = bytes {
+            // Header byte 1: the parameter block number (a small binary value, never a
+            // printable character or a line break); byte 2: the C3D key 0x50.
+            if (1..0x20).contains(first) && !matches!(first, 9 | 10 | 13) {
+                return Some(Format::C3d);
+            }
+        }
+        let head = &bytes[..bytes.len().min(4096)];
+        let text = String::from_utf8_lossy(head);
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+        let first_line = text.lines().map(str::trim).find(|l| !l.is_empty());
+        if let Some(line) = first_line {
+            let cell = line
+                .split(',')
+                .next()
+                .unwrap_or("")
+                .trim()
+                .trim_matches('"');
+            if cell.eq_ignore_ascii_case("Format Version") {
+                return Some(Format::Motive);
+            }
+            if vicon::is_section_name(cell) {
+                return Some(Format::Vicon);
+            }
+            if cell.eq_ignore_ascii_case("time_s") {
+                return Some(Format::Csv);
+            }
+        }
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+        if ext.eq_ignore_ascii_case("c3d") {
+            return Some(Format::C3d);
+        }
+        None
+    }
+}
+
+/// A length unit a capture file can be in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LengthUnit {
+    /// Millimetres.
+    Millimetre,
+    /// Centimetres.
+    Centimetre,
+    /// Metres.
+    Metre,
+}
+
+impl LengthUnit {
+    /// Parse a unit name as files and users write it: `mm`, `cm`, `m`, or the words
+    /// (`millimeters`, `Centimetres`, `Meters`, …); case-insensitive.
+    pub fn parse(s: &str) -> Option<LengthUnit> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "mm" | "millimeter" | "millimeters" | "millimetre" | "millimetres" => {
+                Some(LengthUnit::Millimetre)
+            }
+            "cm" | "centimeter" | "centimeters" | "centimetre" | "centimetres" => {
+                Some(LengthUnit::Centimetre)
+            }
+            "m" | "meter" | "meters" | "metre" | "metres" => Some(LengthUnit::Metre),
+            _ => None,
+        }
+    }
+
+    /// Metres per unit.
+    pub fn metres(self) -> f64 {
+        match self {
+            LengthUnit::Millimetre => 0.001,
+            LengthUnit::Centimetre => 0.01,
+            LengthUnit::Metre => 1.0,
+        }
+    }
+
+    /// The short symbol: "mm", "cm" or "m".
+    pub fn symbol(self) -> &'static str {
+        match self {
+            LengthUnit::Millimetre => "mm",
+            LengthUnit::Centimetre => "cm",
+            LengthUnit::Metre => "m",
+        }
+    }
+}
+
+/// Read a capture file. With `format` `None` the format is guessed from the content and
+/// extension ([`Format::guess`]).
+pub fn read(path: &Path, format: Option<Format>) -> Result<Take, ImportError> {
+    read_with_unit(path, format, None)
+}
+
+/// Read a capture file whose length unit is overridden by `unit` ("mm", "cm" or "m"),
+/// for files that state a wrong unit or none. `None` uses the file's own unit. The
+/// returned [`Take::file_unit`] is the unit actually used.
+pub fn read_with_unit(
+    path: &Path,
+    format: Option<Format>,
+    unit: Option<&str>,
+) -> Result<Take, ImportError> {
+    let unit = parse_unit_override(path, unit)?;
+    let bytes = std::fs::read(path).map_err(|source| ImportError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let format = match format {
+        Some(f) => f,
+        None => Format::guess(path, &bytes).ok_or_else(|| {
+            ImportError::format(
+                path,
+                "start of file",
+                "cannot tell the capture format: expected a C3D file, an OptiTrack Motive \
+                 CSV export (first line \"Format Version,…\"), a Vicon CSV export (a \
+                 \"Trajectories\" section) or a plain CSV (header \"time_s,…\"); name the \
+                 format explicitly if it is one of these",
+            )
+        })?,
+    };
+    read_bytes_with_unit(path, &bytes, format, unit)
+}
+
+/// Read a capture held in memory; `path` is only used for [`Take::source`] and errors.
+pub fn read_bytes(path: &Path, bytes: &[u8], format: Format) -> Result<Take, ImportError> {
+    read_bytes_with_unit(path, bytes, format, None)
+}
+
+/// [`read_bytes`] with the file's length unit overridden by `unit` (`None`: the file's).
+pub fn read_bytes_with_unit(
+    path: &Path,
+    bytes: &[u8],
+    format: Format,
+    unit: Option<LengthUnit>,
+) -> Result<Take, ImportError> {
+    match format {
+        Format::C3d => c3d::read(path, bytes, unit),
+        Format::Motive => motive::read(path, bytes, unit),
+        Format::Vicon => vicon::read(path, bytes, unit),
+        Format::Csv => plain_csv::read(path, bytes, unit),
+    }
+}
+
+fn parse_unit_override(path: &Path, unit: Option<&str>) -> Result<Option<LengthUnit>, ImportError> {
+    match unit {
+        None => Ok(None),
+        Some(s) => LengthUnit::parse(s).map(Some).ok_or_else(|| {
+            ImportError::format(
+                path,
+                "unit override",
+                format!("expected \"mm\", \"cm\" or \"m\", found \"{s}\""),
+            )
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn format_names_and_guessing() {
+        assert_eq!(Format::from_name("C3D"), Some(Format::C3d));
+        assert_eq!(Format::from_name("optitrack"), Some(Format::Motive));
+        assert_eq!(Format::from_name("nexus"), Some(Format::Vicon));
+        assert_eq!(Format::from_name("csv"), Some(Format::Csv));
+        assert_eq!(Format::from_name("bvh"), None);
+        for f in [Format::C3d, Format::Motive, Format::Vicon, Format::Csv] {
+            assert_eq!(Format::from_name(f.name()), Some(f));
+        }
+        let p = Path::new("x.csv");
+        assert_eq!(
+            Format::guess(p, b"Format Version,1.23,Take Name,a\r\n"),
+            Some(Format::Motive)
+        );
+        assert_eq!(
+            Format::guess(p, b"\xef\xbb\xbfDevices,,\n1000\n"),
+            Some(Format::Vicon)
+        );
+        assert_eq!(
+            Format::guess(p, b"Trajectories\n100\n"),
+            Some(Format::Vicon)
+        );
+        assert_eq!(Format::guess(p, b"time_s,a_x,a_y,a_z\n"), Some(Format::Csv));
+        assert_eq!(Format::guess(p, b"\nPlain text"), None);
+        assert_eq!(Format::guess(p, b"\x02\x50\x00"), Some(Format::C3d));
+        assert_eq!(Format::guess(Path::new("a.C3D"), b""), Some(Format::C3d));
+        assert_eq!(Format::guess(p, b""), None);
+    }
+
+    #[test]
+    fn units() {
+        assert_eq!(
+            LengthUnit::parse("Millimeters"),
+            Some(LengthUnit::Millimetre)
+        );
+        assert_eq!(LengthUnit::parse(" cm "), Some(LengthUnit::Centimetre));
+        assert_eq!(LengthUnit::parse("Meters"), Some(LengthUnit::Metre));
+        assert_eq!(LengthUnit::parse("in"), None);
+        let e = parse_unit_override(Path::new("f"), Some("inch")).unwrap_err();
+        assert!(
+            e.to_string().contains("expected \"mm\", \"cm\" or \"m\""),
+            "{e}"
+        );
+    }
+}

@@ -1,0 +1,227 @@
+//! Text helpers shared by the CSV importers: decoding, splitting lines into cells (CRLF,
+//! quoted cells and trailing commas tolerated) and reading numbers and positions with
+//! errors that name the line and column.
+//!
+//! Line and column numbers are 1-based; a column is a CSV cell (field), not a character.
+
+use crate::mocap::take::ImportError;
+use glam::DVec3;
+use std::borrow::Cow;
+use std::path::Path;
+
+/// One line of a CSV file split into cells.
+pub(super) struct Row<'a> {
+    /// 1-based line number.
+    pub line: usize,
+    /// The cells, trimmed of surrounding spaces and quotes.
+    pub cells: Vec<Cow<'a, str>>,
+}
+
+impl Row<'_> {
+    /// The cell at 0-based `col`, or "" past the end of the row.
+    pub fn cell(&self, col: usize) -> &str {
+        self.cells.get(col).map(|c| c.as_ref()).unwrap_or("")
+    }
+
+    /// True when every cell is empty (a blank line, or only commas).
+    pub fn is_blank(&self) -> bool {
+        self.cells.iter().all(|c| c.is_empty())
+    }
+
+    /// The number of cells once trailing empty cells are dropped.
+    pub fn used_width(&self) -> usize {
+        self.cells
+            .iter()
+            .rposition(|c| !c.is_empty())
+            .map_or(0, |i| i + 1)
+    }
+}
+
+/// The file as text: UTF-8 (invalid sequences replaced), a byte-order mark dropped.
+pub(super) fn decode(bytes: &[u8]) -> Cow<'_, str> {
+    let bytes = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes);
+    String::from_utf8_lossy(bytes)
+}
+
+/// Every line of `text`, split into cells; line endings LF or CRLF.
+pub(super) fn rows(text: &str) -> impl Iterator<Item = Row<'_>> {
+    text.lines().enumerate().map(|(i, l)| Row {
+        line: i + 1,
+        cells: split_cells(l),
+    })
+}
+
+/// Split one line at commas. A cell in double quotes may hold commas; `""` inside quotes
+/// is a quote. Cells are trimmed of spaces and tabs.
+pub(super) fn split_cells(line: &str) -> Vec<Cow<'_, str>> {
+    let line = line.strip_suffix('\r').unwrap_or(line);
+    if !line.contains('"') {
+        return line.split(',').map(|c| Cow::Borrowed(c.trim())).collect();
+    }
+    let mut cells = Vec::new();
+    let mut cur = String::new();
+    let mut quoted = false;
+    let mut chars = line.chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' if quoted && chars.peek() == Some(&'"') => {
+                cur.push('"');
+                chars.next();
+            }
+            '"' => quoted = !quoted,
+            ',' if !quoted => cells.push(Cow::Owned(std::mem::take(&mut cur).trim().to_string())),
+            _ => cur.push(c),
+        }
+    }
+    cells.push(Cow::Owned(cur.trim().to_string()));
+    cells
+}
+
+/// "line L, column C" for a 0-based column index.
+pub(super) fn place(line: usize, col: usize) -> String {
+    format!("line {line}, column {}", col + 1)
+}
+
+/// The number in cell `col` of `row`: `None` for an empty (or absent) cell.
+pub(super) fn number(path: &Path, row: &Row, col: usize) -> Result<Option<f64>, ImportError> {
+    let cell = row.cell(col);
+    if cell.is_empty() {
+        return Ok(None);
+    }
+    match cell.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(Some(v)),
+        Ok(_) => Err(ImportError::format(
+            path,
+            place(row.line, col),
+            format!("expected a finite number, found \"{cell}\""),
+        )),
+        Err(_) => Err(ImportError::format(
+            path,
+            place(row.line, col),
+            format!("expected a number, found \"{}\"", shorten(cell)),
+        )),
+    }
+}
+
+/// The number in cell `col` of `row`, which must not be empty; `what` names it.
+pub(super) fn required_number(
+    path: &Path,
+    row: &Row,
+    col: usize,
+    what: &str,
+) -> Result<f64, ImportError> {
+    number(path, row, col)?.ok_or_else(|| {
+        ImportError::format(
+            path,
+            place(row.line, col),
+            format!("expected a number ({what}), found an empty cell"),
+        )
+    })
+}
+
+/// The position in cells `cols` (X, Y, Z) of `row`, times `scale` (metres per file
+/// unit): `None` when all three are empty; an error when only some are.
+pub(super) fn position(
+    path: &Path,
+    row: &Row,
+    cols: [usize; 3],
+    scale: f64,
+) -> Result<Option<DVec3>, ImportError> {
+    let x = number(path, row, cols[0])?;
+    let y = number(path, row, cols[1])?;
+    let z = number(path, row, cols[2])?;
+    match (x, y, z) {
+        (Some(x), Some(y), Some(z)) => Ok(Some(DVec3::new(x, y, z) * scale)),
+        (None, None, None) => Ok(None),
+        _ => {
+            let empty = [x, y, z]
+                .iter()
+                .position(Option::is_none)
+                .map_or(cols[0], |i| cols[i]);
+            Err(ImportError::format(
+                path,
+                place(row.line, empty),
+                "expected all three coordinates X, Y, Z or none, found this one empty \
+                 while others of the same marker are given",
+            ))
+        }
+    }
+}
+
+/// Check that a data row has the header's `width` cells: fewer means the row was cut
+/// short; more is allowed only as empty cells (a trailing comma).
+pub(super) fn check_width(path: &Path, row: &Row, width: usize) -> Result<(), ImportError> {
+    if row.cells.len() < width {
+        return Err(ImportError::format(
+            path,
+            format!("line {}", row.line),
+            format!(
+                "expected {width} cells as in the header, found {} (row cut short: is the \
+                 file truncated?)",
+                row.cells.len()
+            ),
+        ));
+    }
+    if row.used_width() > width {
+        return Err(ImportError::format(
+            path,
+            place(row.line, row.used_width() - 1),
+            format!(
+                "expected at most {width} cells as in the header, found a value past the last \
+                 header column"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// `s` cut to a readable length for an error message.
+pub(super) fn shorten(s: &str) -> Cow<'_, str> {
+    const MAX: usize = 40;
+    match s.char_indices().nth(MAX) {
+        Some((i, _)) => Cow::Owned(format!("{}…", &s[..i])),
+        None => Cow::Borrowed(s),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn splits_quotes_crlf_and_trailing_commas() {
+        let cells = split_cells("a, \"b,c\" ,\"d\"\"e\",\r");
+        assert_eq!(cells, vec!["a", "b,c", "d\"e", ""]);
+        let r = Row {
+            line: 3,
+            cells: split_cells("1,2,,"),
+        };
+        assert_eq!(r.used_width(), 2);
+        assert!(check_width(Path::new("f"), &r, 3).is_ok());
+        assert!(check_width(Path::new("f"), &r, 5).is_err());
+        assert!(check_width(Path::new("f"), &r, 1).is_err());
+        assert_eq!(shorten("abc"), "abc");
+        assert_eq!(shorten(&"é".repeat(50)).chars().count(), 41);
+    }
+
+    #[test]
+    fn numbers_name_line_and_column() {
+        let r = Row {
+            line: 7,
+            cells: split_cells("1.5,abc,,inf"),
+        };
+        let p = Path::new("t.csv");
+        assert_eq!(number(p, &r, 0).unwrap(), Some(1.5));
+        assert_eq!(number(p, &r, 2).unwrap(), None);
+        assert_eq!(number(p, &r, 9).unwrap(), None);
+        let e = number(p, &r, 1).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "t.csv: line 7, column 2: expected a number, found \"abc\""
+        );
+        assert!(number(p, &r, 3).is_err());
+        assert!(required_number(p, &r, 2, "time").is_err());
+        assert!(position(p, &r, [0, 2, 2], 1.0).is_err());
+        assert_eq!(position(p, &r, [2, 2, 2], 1.0).unwrap(), None);
+    }
+}

@@ -1,0 +1,508 @@
+//! OptiTrack Motive CSV export (format version 1.2x).
+//!
+//! # Layout
+//!
+//! ```text
+//! Format Version,1.23,Take Name,…,Export Frame Rate,250.000000,…,Total Exported Frames,N,Rotation Type,Quaternion,Length Units,Meters,Coordinate Space,Global
+//!
+//! ,Type,Rigid Body,Rigid Body,…,Rigid Body Marker,…,Marker,…
+//! ,Name,StickL,StickL,…,StickL:Marker1,…
+//! ,ID,1,1,…
+//! ,,Rotation,Rotation,Rotation,Rotation,Position,Position,Position,Mean Marker Error,Position,…
+//! Frame,Time (Seconds),X,Y,Z,W,X,Y,Z,,X,Y,Z,…
+//! 0,0.000000,0.01,0.02,…
+//! ```
+//!
+//! * Line 1: key/value pairs. Used: `Export Frame Rate` (else `Capture Frame Rate`) for
+//!   the rate, `Length Units` (`Meters`, `Centimeters`, `Millimeters`; metres if absent),
+//!   `Rotation Type` (only `Quaternion` is supported; Euler types are refused with a
+//!   clear error, as their axis convention is not pinned down here) and `Total Exported
+//!   Frames` (checked against the rows, so a truncated export is caught).
+//! * Header rows until the `Frame` row: `Type`, `Name`, optionally `ID` (told apart by
+//!   their second cell, or by order when it is empty), and the Rotation/Position row.
+//!   Columns are grouped by consecutive equal type, name and ID.
+//! * `Rigid Body` (and skeleton `Bone`) columns give a track with positions and
+//!   rotations (quaternion X, Y, Z, W, normalised); `Marker`, `Rigid Body Marker` and
+//!   `Bone Marker` columns give position-only tracks. Other types and columns (`Mean
+//!   Marker Error`, `Marker Quality`) are ignored. Tracks are labelled by name; a rigid
+//!   body marker (the solved position) whose name is also a measured marker's gets the
+//!   label `<name> (solved)`, and any other repeated label gets ` (2)`, ` (3)`, ….
+//! * Data rows: frame, time in seconds, then values; an empty cell is a missing sample.
+//!   The time step must match the rate to 1 %.
+
+use super::LengthUnit;
+use super::csv_text::{self, Row};
+use super::plain_csv::quaternion;
+use crate::mocap::take::{ImportError, Take, Track};
+use std::path::Path;
+
+/// What a group of columns is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    RigidBody,
+    SolvedMarker,
+    Marker,
+}
+
+/// One track's columns (0-based cell indices).
+struct Entity {
+    kind: Kind,
+    label: String,
+    /// Column of the type cell, for errors.
+    first_col: usize,
+    position: [Option<usize>; 3],
+    rotation: [Option<usize>; 4],
+}
+
+/// Read a Motive CSV export; `unit` overrides `Length Units`.
+pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take, ImportError> {
+    let text = csv_text::decode(bytes);
+    let mut rows = csv_text::rows(&text);
+    let err = |place: String, msg: String| ImportError::format(path, place, msg);
+
+    // Line 1: key/value pairs.
+    let first = rows.next().ok_or_else(|| {
+        err(
+            "line 1".into(),
+            "expected \"Format Version,…\", found an empty file".into(),
+        )
+    })?;
+    if !first.cell(0).eq_ignore_ascii_case("Format Version") {
+        return Err(err(
+            csv_text::place(first.line, 0),
+            format!(
+                "expected \"Format Version\" (a Motive CSV export), found \"{}\"",
+                csv_text::shorten(first.cell(0))
+            ),
+        ));
+    }
+    let meta = |key: &str| -> Option<(usize, &str)> {
+        (0..first.cells.len())
+            .step_by(2)
+            .find(|&c| first.cell(c).eq_ignore_ascii_case(key))
+            .map(|c| (c + 1, first.cell(c + 1)))
+    };
+    let (rate_col, rate_text) = meta("Export Frame Rate")
+        .or_else(|| meta("Capture Frame Rate"))
+        .ok_or_else(|| {
+            err(
+                "line 1".into(),
+                "expected an \"Export Frame Rate\" or \"Capture Frame Rate\" entry, found neither"
+                    .into(),
+            )
+        })?;
+    let rate_hz = match rate_text.parse::<f64>() {
+        Ok(r) if r.is_finite() && r > 0.0 => r,
+        _ => {
+            return Err(err(
+                csv_text::place(first.line, rate_col),
+                format!(
+                    "expected a frame rate above 0 Hz, found \"{}\"",
+                    csv_text::shorten(rate_text)
+                ),
+            ));
+        }
+    };
+    let unit = match (unit, meta("Length Units")) {
+        (Some(u), _) => u,
+        (None, None) => LengthUnit::Metre,
+        (None, Some((col, name))) => LengthUnit::parse(name).ok_or_else(|| {
+            err(
+                csv_text::place(first.line, col),
+                format!(
+                    "expected Length Units Meters, Centimeters or Millimeters, found \"{}\"",
+                    csv_text::shorten(name)
+                ),
+            )
+        })?,
+    };
+    let scale = unit.metres();
+    let rotation_type = meta("Rotation Type");
+    let total_frames = match meta("Total Exported Frames") {
+        Some((col, t)) if !t.is_empty() => Some(t.parse::<usize>().map_err(|_| {
+            err(
+                csv_text::place(first.line, col),
+                format!("expected a frame count, found \"{}\"", csv_text::shorten(t)),
+            )
+        })?),
+        _ => None,
+    };
+
+    // Header rows up to the "Frame" row.
+    let mut header: Vec<Row> = Vec::new();
+    let frame_row = loop {
+        let Some(row) = rows.next() else {
+            return Err(err(
+                "end of file".into(),
+                "expected the column header row \"Frame,Time (Seconds),X,Y,Z,…\", found the end \
+                 of the file"
+                    .into(),
+            ));
+        };
+        if row.cell(0).eq_ignore_ascii_case("Frame") {
+            break row;
+        }
+        if row.is_blank() {
+            if header.is_empty() {
+                continue;
+            }
+            return Err(err(
+                format!("line {}", row.line),
+                "expected a header row (Type, Name, ID, Rotation/Position) or the \"Frame\" \
+                 row, found a blank line"
+                    .into(),
+            ));
+        }
+        if header.len() >= 6 {
+            return Err(err(
+                format!("line {}", row.line),
+                "expected the \"Frame,Time (Seconds),…\" row after at most 5 header rows".into(),
+            ));
+        }
+        header.push(row);
+    };
+    let (type_row, name_row, id_row, kind_row) = classify_header(path, &header, &frame_row)?;
+    let width = frame_row
+        .used_width()
+        .max(header.iter().map(Row::used_width).max().unwrap_or(0));
+
+    // Group the columns into tracks.
+    let mut entities: Vec<Entity> = Vec::new();
+    let mut prev_key: Option<(String, String, String)> = None;
+    for col in 2..width {
+        let ty = type_row.cell(col);
+        let key = (
+            ty.to_string(),
+            name_row.cell(col).to_string(),
+            id_row.map_or("", |r| r.cell(col)).to_string(),
+        );
+        let new = prev_key.as_ref() != Some(&key);
+        prev_key = Some(key);
+        let kind = match ty.to_ascii_lowercase().as_str() {
+            "rigid body" | "bone" => Kind::RigidBody,
+            "rigid body marker" | "bone marker" => Kind::SolvedMarker,
+            "marker" => Kind::Marker,
+            _ => continue,
+        };
+        if new {
+            entities.push(Entity {
+                kind,
+                label: name_row.cell(col).to_string(),
+                first_col: col,
+                position: [None; 3],
+                rotation: [None; 4],
+            });
+        }
+        let Some(e) = entities.last_mut() else {
+            continue;
+        };
+        let axis = frame_row.cell(col).to_ascii_uppercase();
+        let part = kind_row.cell(col);
+        let slot = match (part.to_ascii_lowercase().as_str(), axis.as_str()) {
+            ("position", "X") => &mut e.position[0],
+            ("position", "Y") => &mut e.position[1],
+            ("position", "Z") => &mut e.position[2],
+            ("rotation", "X") if kind == Kind::RigidBody => &mut e.rotation[0],
+            ("rotation", "Y") if kind == Kind::RigidBody => &mut e.rotation[1],
+            ("rotation", "Z") if kind == Kind::RigidBody => &mut e.rotation[2],
+            ("rotation", "W") if kind == Kind::RigidBody => &mut e.rotation[3],
+            _ => continue,
+        };
+        if slot.is_some() {
+            return Err(err(
+                csv_text::place(frame_row.line, col),
+                format!(
+                    "expected one {part} {axis} column for \"{}\", found a second",
+                    e.label
+                ),
+            ));
+        }
+        *slot = Some(col);
+    }
+    for e in &entities {
+        if e.position.iter().any(Option::is_none) {
+            return Err(err(
+                csv_text::place(type_row.line, e.first_col),
+                format!(
+                    "expected Position X, Y and Z columns for \"{}\", found only some or none",
+                    e.label
+                ),
+            ));
+        }
+        let rot = e.rotation.iter().filter(|c| c.is_some()).count();
+        if rot > 0 {
+            if let Some((col, t)) =
+                rotation_type.filter(|(_, t)| !t.eq_ignore_ascii_case("Quaternion"))
+            {
+                return Err(err(
+                    csv_text::place(first.line, col),
+                    format!(
+                        "expected Rotation Type Quaternion, found \"{}\" (Euler angles are not \
+                         supported: export again with Rotation Type Quaternion)",
+                        csv_text::shorten(t)
+                    ),
+                ));
+            }
+            if rot != 4 {
+                return Err(err(
+                    csv_text::place(kind_row.line, e.first_col),
+                    format!(
+                        "expected Rotation X, Y, Z and W columns for \"{}\", found {rot} of them",
+                        e.label
+                    ),
+                ));
+            }
+        }
+    }
+    let labels = unique_labels(&entities);
+    let mut tracks: Vec<Track> = entities
+        .iter()
+        .zip(labels)
+        .map(|(_, label)| Track {
+            label,
+            positions: Vec::new(),
+            rotations: Vec::new(),
+        })
+        .collect();
+
+    // Data rows.
+    let step = 1.0 / rate_hz;
+    let mut prev_time: Option<f64> = None;
+    let mut frames = 0usize;
+    let mut blank_at: Option<usize> = None;
+    for row in rows {
+        if row.is_blank() {
+            blank_at.get_or_insert(row.line);
+            continue;
+        }
+        if let Some(b) = blank_at {
+            return Err(err(
+                format!("line {b}"),
+                "expected a data row, found a blank line inside the data".into(),
+            ));
+        }
+        csv_text::check_width(path, &row, width)?;
+        csv_text::required_number(path, &row, 0, "frame number")?;
+        let t = csv_text::required_number(path, &row, 1, "time in seconds")?;
+        if let Some(p) = prev_time {
+            let d = t - p;
+            if (d - step).abs() > 0.01 * step + 2e-6 {
+                return Err(err(
+                    csv_text::place(row.line, 1),
+                    format!(
+                        "expected a time step of {step:.6} s (the export frame rate \
+                         {rate_hz} Hz), found {d:.6} s from the previous row"
+                    ),
+                ));
+            }
+        }
+        prev_time = Some(t);
+        for (e, track) in entities.iter().zip(tracks.iter_mut()) {
+            let [Some(x), Some(y), Some(z)] = e.position else {
+                continue;
+            };
+            track
+                .positions
+                .push(csv_text::position(path, &row, [x, y, z], scale)?);
+            if let [Some(qx), Some(qy), Some(qz), Some(qw)] = e.rotation {
+                track
+                    .rotations
+                    .push(quaternion(path, &row, [qx, qy, qz, qw])?);
+            }
+        }
+        frames += 1;
+    }
+    if frames == 0 {
+        return Err(err(
+            format!("line {}", frame_row.line + 1),
+            "expected data rows after the \"Frame\" row, found none".into(),
+        ));
+    }
+    if let Some(n) = total_frames.filter(|&n| n != frames) {
+        return Err(err(
+            "line 1".into(),
+            format!(
+                "expected {n} data rows as \"Total Exported Frames\" says, found {frames}: the \
+                 export is truncated or was edited"
+            ),
+        ));
+    }
+    Ok(Take {
+        source: path.to_path_buf(),
+        rate_hz,
+        frames,
+        file_unit: unit.symbol().to_string(),
+        tracks,
+    })
+}
+
+/// Tell the header rows apart: (Type, Name, ID if present, Rotation/Position).
+fn classify_header<'r, 'a>(
+    path: &Path,
+    header: &'r [Row<'a>],
+    frame_row: &Row,
+) -> Result<(&'r Row<'a>, &'r Row<'a>, Option<&'r Row<'a>>, &'r Row<'a>), ImportError> {
+    let tag = |r: &Row| -> String {
+        let t = if r.cell(0).is_empty() {
+            r.cell(1)
+        } else {
+            r.cell(0)
+        };
+        t.to_ascii_lowercase()
+    };
+    let is_kind_row = |r: &Row| {
+        (2..r.cells.len()).any(|c| {
+            let v = r.cell(c);
+            v.eq_ignore_ascii_case("Position") || v.eq_ignore_ascii_case("Rotation")
+        })
+    };
+    let (mut ty, mut name, mut id, mut kind) = (None, None, None, None);
+    let mut untagged = Vec::new();
+    for r in header {
+        match tag(r).as_str() {
+            "type" => ty = Some(r),
+            "name" => name = Some(r),
+            "id" => id = Some(r),
+            _ if is_kind_row(r) => kind = Some(r),
+            _ => untagged.push(r),
+        }
+    }
+    for r in untagged {
+        if ty.is_none() {
+            ty = Some(r);
+        } else if name.is_none() {
+            name = Some(r);
+        } else if id.is_none() {
+            id = Some(r);
+        }
+    }
+    let missing = |what: &str| {
+        ImportError::format(
+            path,
+            format!("line {}", frame_row.line),
+            format!("expected a {what} row above the \"Frame\" row, found none"),
+        )
+    };
+    Ok((
+        ty.ok_or_else(|| missing("Type"))?,
+        name.ok_or_else(|| missing("Name"))?,
+        id,
+        kind.ok_or_else(|| missing("Rotation/Position"))?,
+    ))
+}
+
+/// Labels without repeats: a solved rigid-body marker sharing a measured marker's name
+/// gets " (solved)"; any other repeat gets " (2)", " (3)", ….
+fn unique_labels(entities: &[Entity]) -> Vec<String> {
+    let mut out: Vec<String> = Vec::with_capacity(entities.len());
+    for e in entities {
+        let mut label = e.label.clone();
+        if e.kind == Kind::SolvedMarker
+            && entities
+                .iter()
+                .any(|o| o.kind == Kind::Marker && o.label == e.label)
+        {
+            label = format!("{label} (solved)");
+        }
+        if out.contains(&label) {
+            let base = label.clone();
+            let mut n = 2;
+            while out.contains(&label) {
+                label = format!("{base} ({n})");
+                n += 1;
+            }
+        }
+        out.push(label);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HEAD: &str = "Format Version,1.23,Take Name,t,Export Frame Rate,100.000000,Total Exported Frames,2,Rotation Type,Quaternion,Length Units,Millimeters\n\n";
+
+    fn p() -> &'static Path {
+        Path::new("m.csv")
+    }
+
+    #[test]
+    fn brief_style_header_without_id_row() {
+        let text = format!(
+            "{HEAD},,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Marker,Marker,Marker\n\
+             ,,A,A,A,A,A,A,A,A,A,A\n\
+             ,,Rotation,Rotation,Rotation,Rotation,Position,Position,Position,Position,Position,Position\n\
+             Frame,Time (Seconds),X,Y,Z,W,X,Y,Z,X,Y,Z\n\
+             0,0.000000,0,0,0,1,1000,0,0,,,\n\
+             1,0.010000,,,,,,,,1,2,3,\n"
+        );
+        let take = read(p(), text.as_bytes(), None).unwrap();
+        assert_eq!(take.labels(), vec!["A", "A (2)"]);
+        assert_eq!(take.file_unit, "mm");
+        assert_eq!(take.tracks[0].positions[0], Some(glam::DVec3::X));
+        assert_eq!(
+            take.tracks[0].rotations,
+            vec![Some(glam::DQuat::IDENTITY), None]
+        );
+        assert!(take.tracks[1].rotations.is_empty());
+        assert_eq!(take.tracks[1].positions[0], None);
+    }
+
+    #[test]
+    fn errors() {
+        let body = ",Type,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body\n\
+                    ,Name,A,A,A,A,A,A,A\n\
+                    ,,Rotation,Rotation,Rotation,Rotation,Position,Position,Position\n\
+                    Frame,Time (Seconds),X,Y,Z,W,X,Y,Z\n";
+        let ok_rows = "0,0,0,0,0,1,1,2,3\n1,0.01,0,0,0,1,1,2,3\n";
+        let cases = [
+            (format!("Format,1\n\n{body}{ok_rows}"), "line 1, column 1"),
+            (
+                format!("{}{body}{ok_rows}", HEAD.replace("Quaternion", "XYZ")),
+                "line 1, column 10: expected Rotation Type Quaternion",
+            ),
+            (
+                format!("{}{body}{ok_rows}", HEAD.replace("Millimeters", "Inches")),
+                "line 1, column 12",
+            ),
+            (
+                format!("{}{body}{ok_rows}", HEAD.replace("100.000000", "fast")),
+                "line 1, column 6",
+            ),
+            (
+                format!("{HEAD}{body}0,0,0,0,0,1,1,2,3\n"),
+                "Total Exported Frames",
+            ),
+            (
+                format!("{HEAD}{body}0,0,0,0,0,1,1,2,3\n1,0.02,0,0,0,1,1,2,3\n"),
+                "line 8, column 2: expected a time step",
+            ),
+            (
+                format!("{HEAD}{body}0,0,0,0,0,1,1,2,3\n1,0.01,0,0,0,1,1,x,3\n"),
+                "line 8, column 8: expected a number, found \"x\"",
+            ),
+            (
+                format!("{HEAD}{body}0,0,0,0,0,1,1,2,3\n1,0.01,0,0,0,1,1\n"),
+                "line 8: expected 9 cells",
+            ),
+            (
+                format!("{HEAD}{body}0,0,0,0,0,2.5,1,2,3\n1,0.01,0,0,0,1,1,2,3\n"),
+                "line 7, column 3: expected a unit quaternion",
+            ),
+            (format!("{HEAD}{body}"), "line 7: expected data rows"),
+            (
+                format!("{HEAD},Type,Marker\n"),
+                "expected the column header row",
+            ),
+            (
+                format!("{HEAD},Type,Marker,Marker\nFrame,Time,X,Y\n"),
+                "expected a Name row",
+            ),
+        ];
+        for (text, want) in cases {
+            let e = read(p(), text.as_bytes(), None).unwrap_err().to_string();
+            assert!(e.contains(want), "want {want:?} in {e}");
+        }
+    }
+}

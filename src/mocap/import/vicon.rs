@@ -1,0 +1,289 @@
+//! Vicon Nexus CSV export: the `Trajectories` section.
+//!
+//! # Layout
+//!
+//! ```text
+//! Devices                      ← optional sections before (skipped)
+//! …
+//!
+//! Trajectories
+//! 100                          ← frame rate, Hz
+//! ,,Subject:LASI,,,Subject:RASI,,,
+//! Frame,Sub Frame,X,Y,Z,X,Y,Z
+//! ,,mm,mm,mm,mm,mm,mm          ← units (mm if the row is absent)
+//! 1,0,123.4,-56.7,890.1,,,     ← empty cells: marker not seen
+//! …
+//!                              ← a blank line (or the next section) ends it
+//! Model Outputs
+//! …
+//! ```
+//!
+//! Each label's columns run up to the next label; of them, the ones headed exactly `X`,
+//! `Y`, `Z` are its position (velocity and acceleration columns `X'`, `X''` are ignored).
+//! Units may be `mm`, `cm` or `m` per trajectory. Frame numbers must rise by one per row.
+
+use super::LengthUnit;
+use super::csv_text::{self, Row};
+use crate::mocap::take::{ImportError, Take, Track};
+use std::path::Path;
+
+/// Section names a Nexus CSV export uses.
+const SECTIONS: [&str; 6] = [
+    "Trajectories",
+    "Devices",
+    "Joints",
+    "Model Outputs",
+    "Segments",
+    "Events",
+];
+
+/// True for a Nexus CSV section name (case-insensitive).
+pub fn is_section_name(s: &str) -> bool {
+    SECTIONS.iter().any(|n| n.eq_ignore_ascii_case(s.trim()))
+}
+
+/// One trajectory's columns.
+struct Columns {
+    label: String,
+    xyz: [usize; 3],
+}
+
+/// Read the `Trajectories` section of a Vicon Nexus CSV export; `unit` overrides the
+/// units row.
+pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take, ImportError> {
+    let text = csv_text::decode(bytes);
+    let mut rows = csv_text::rows(&text);
+    let err = |place: String, msg: String| ImportError::format(path, place, msg);
+    let mut next_row = |what: &str, after: usize| {
+        rows.next().ok_or_else(|| {
+            ImportError::format(
+                path,
+                format!("line {}", after + 1),
+                format!("expected {what}, found the end of the file"),
+            )
+        })
+    };
+
+    // Find the section.
+    let mut line = 0;
+    loop {
+        let Ok(row) = next_row("", line) else {
+            return Err(err(
+                "whole file".into(),
+                "expected a \"Trajectories\" section (a Vicon Nexus CSV export), found none".into(),
+            ));
+        };
+        line = row.line;
+        if row.cell(0).eq_ignore_ascii_case("Trajectories") && row.used_width() == 1 {
+            break;
+        }
+    }
+
+    let rate_row = next_row("the frame rate after \"Trajectories\"", line)?;
+    let rate_hz = match csv_text::number(path, &rate_row, 0)? {
+        Some(r) if r > 0.0 => r,
+        other => {
+            return Err(err(
+                csv_text::place(rate_row.line, 0),
+                format!(
+                    "expected the frame rate in Hz, found {}",
+                    other.map_or("an empty cell".to_string(), |r| r.to_string())
+                ),
+            ));
+        }
+    };
+    let label_row = next_row("the trajectory label row", rate_row.line)?;
+    let axis_row = next_row("the row \"Frame,Sub Frame,X,Y,Z,…\"", label_row.line)?;
+    if !axis_row.cell(0).eq_ignore_ascii_case("Frame") {
+        return Err(err(
+            csv_text::place(axis_row.line, 0),
+            format!(
+                "expected \"Frame\" (the row \"Frame,Sub Frame,X,Y,Z,…\"), found \"{}\"",
+                csv_text::shorten(axis_row.cell(0))
+            ),
+        ));
+    }
+    let width = axis_row.used_width().max(label_row.used_width());
+
+    // Trajectories.
+    let label_cols: Vec<usize> = (2..width)
+        .filter(|&c| !label_row.cell(c).is_empty())
+        .collect();
+    let mut columns = Vec::with_capacity(label_cols.len());
+    for (i, &c) in label_cols.iter().enumerate() {
+        let end = label_cols.get(i + 1).copied().unwrap_or(width);
+        let find = |axis: &str| (c..end).find(|&k| axis_row.cell(k).eq_ignore_ascii_case(axis));
+        let (Some(x), Some(y), Some(z)) = (find("X"), find("Y"), find("Z")) else {
+            return Err(err(
+                csv_text::place(label_row.line, c),
+                format!(
+                    "expected X, Y and Z columns under \"{}\" (line {}), found only some or none",
+                    label_row.cell(c),
+                    axis_row.line
+                ),
+            ));
+        };
+        columns.push(Columns {
+            label: label_row.cell(c).to_string(),
+            xyz: [x, y, z],
+        });
+    }
+
+    // Units row (optional), then data.
+    let mut pending: Option<Row> = None;
+    let mut scales = vec![LengthUnit::Millimetre; columns.len()];
+    if let Some(row) = rows.next() {
+        let is_units = row.cell(0).is_empty() && !row.is_blank();
+        if is_units {
+            for (c, s) in columns.iter().zip(scales.iter_mut()) {
+                let cells = c.xyz.map(|k| row.cell(k));
+                let parsed = cells.map(LengthUnit::parse);
+                match parsed {
+                    [Some(a), Some(b), Some(d)] if a == b && b == d => *s = a,
+                    _ if unit.is_some() => {}
+                    _ => {
+                        return Err(err(
+                            csv_text::place(row.line, c.xyz[0]),
+                            format!(
+                                "expected the same unit mm, cm or m for X, Y and Z of \"{}\", \
+                                 found \"{}\", \"{}\", \"{}\" (give a unit override if the data \
+                                 are in one of these)",
+                                c.label, cells[0], cells[1], cells[2]
+                            ),
+                        ));
+                    }
+                }
+            }
+        } else {
+            pending = Some(row);
+        }
+    }
+    if let Some(u) = unit {
+        scales.iter_mut().for_each(|s| *s = u);
+    }
+    let file_unit = scales
+        .first()
+        .copied()
+        .or(unit)
+        .unwrap_or(LengthUnit::Millimetre);
+
+    let mut tracks: Vec<Track> = columns
+        .iter()
+        .map(|c| Track {
+            label: c.label.clone(),
+            positions: Vec::new(),
+            rotations: Vec::new(),
+        })
+        .collect();
+    let mut prev_frame: Option<f64> = None;
+    let mut frames = 0usize;
+    let mut last_line = axis_row.line;
+    for row in pending.into_iter().chain(rows) {
+        last_line = row.line;
+        // A blank line or the next section's name ends the section.
+        if row.is_blank() || is_section_name(row.cell(0)) {
+            break;
+        }
+        csv_text::check_width(path, &row, width)?;
+        let frame = csv_text::required_number(path, &row, 0, "frame number")?;
+        if let Some(p) = prev_frame
+            && frame != p + 1.0
+        {
+            return Err(err(
+                csv_text::place(row.line, 0),
+                format!(
+                    "expected frame {} after frame {p} (one row per frame), found {frame}",
+                    p + 1.0
+                ),
+            ));
+        }
+        prev_frame = Some(frame);
+        for ((c, track), s) in columns.iter().zip(tracks.iter_mut()).zip(&scales) {
+            track
+                .positions
+                .push(csv_text::position(path, &row, c.xyz, s.metres())?);
+        }
+        frames += 1;
+    }
+    if frames == 0 {
+        return Err(err(
+            format!("line {}", last_line),
+            "expected data rows in the Trajectories section, found none".into(),
+        ));
+    }
+    Ok(Take {
+        source: path.to_path_buf(),
+        rate_hz,
+        frames,
+        file_unit: file_unit.symbol().to_string(),
+        tracks,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn p() -> &'static Path {
+        Path::new("v.csv")
+    }
+
+    #[test]
+    fn reads_without_units_row_and_stops_at_next_section() {
+        let text = "Trajectories\n120\n,,S:A,,,S:B,,,\nFrame,Sub Frame,X,Y,Z,X,Y,Z\n\
+                    5,0,1000,0,0,,,\n6,0,0,0,0,1,1,1\nModel Outputs\n120\n";
+        let take = read(p(), text.as_bytes(), None).unwrap();
+        assert_eq!(take.frames, 2);
+        assert_eq!(take.rate_hz, 120.0);
+        assert_eq!(take.file_unit, "mm");
+        assert_eq!(take.track("A").unwrap().positions[0], Some(glam::DVec3::X));
+        assert_eq!(take.track("B").unwrap().positions[0], None);
+        let take = read(p(), text.as_bytes(), Some(LengthUnit::Metre)).unwrap();
+        assert_eq!(
+            take.track("A").unwrap().positions[0],
+            Some(glam::DVec3::X * 1000.0)
+        );
+    }
+
+    #[test]
+    fn errors() {
+        let head = "Trajectories\n100\n,,S:A,,\nFrame,Sub Frame,X,Y,Z\n,,mm,mm,mm\n";
+        let cases = [
+            (
+                "Devices\n100\n".to_string(),
+                "whole file: expected a \"Trajectories\" section",
+            ),
+            (
+                "Trajectories\nfast\n".to_string(),
+                "line 2, column 1: expected a number",
+            ),
+            (
+                "Trajectories\n100\n,,A,,\nTime\n".to_string(),
+                "line 4, column 1",
+            ),
+            (
+                "Trajectories\n100\n,,A,,\nFrame,Sub Frame,X,Y,Q\n".to_string(),
+                "line 3, column 3",
+            ),
+            (head.to_string(), "expected data rows"),
+            (
+                format!("{head}1,0,1,2,3\n3,0,1,2,3\n"),
+                "line 7, column 1: expected frame 2",
+            ),
+            (format!("{head}1,0,1,2\n"), "line 6: expected 5 cells"),
+            (
+                format!("{head}1,0,1,2,z\n"),
+                "line 6, column 5: expected a number, found \"z\"",
+            ),
+            (
+                "Trajectories\n100\n,,A,,\nFrame,Sub Frame,X,Y,Z\n,,in,in,in\n1,0,1,2,3\n"
+                    .to_string(),
+                "line 5, column 3",
+            ),
+        ];
+        for (text, want) in cases {
+            let e = read(p(), text.as_bytes(), None).unwrap_err().to_string();
+            assert!(e.contains(want), "want {want:?} in {e}");
+        }
+    }
+}

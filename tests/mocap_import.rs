@@ -1,0 +1,498 @@
+//! Capture importers end to end on real and realistic files: the three C3D samples from
+//! ezc3d (Optotrak, Qualisys, Vicon; MIT licence in tests/fixtures/c3d/LICENSE-ezc3d),
+//! hand-made Motive, Vicon Nexus and plain CSV exports of two timpani sticks, the C3D
+//! writer's round trip, and a fuzz-style sweep that cuts and corrupts every fixture at
+//! many offsets and checks that reading never panics.
+
+use glam::{DQuat, DVec3};
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::{Path, PathBuf};
+use timpanist::mocap::import::{self, Format, c3d, plain_csv, write_c3d};
+use timpanist::mocap::{ImportError, Take, Track};
+
+fn fixture(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures")
+        .join(rel)
+}
+
+fn load(rel: &str) -> Take {
+    let path = fixture(rel);
+    import::read(&path, None).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn seen(t: &Track) -> usize {
+    t.positions.iter().filter(|p| p.is_some()).count()
+}
+
+fn assert_near(a: DVec3, b: DVec3, tol: f64) {
+    assert!(a.distance(b) < tol, "{a} vs {b}");
+}
+
+// ---------------------------------------------------------------- C3D: real files
+
+#[test]
+fn c3d_real_files_have_the_expected_markers_rate_and_frames() {
+    // (file, markers, rate, frames read, frames the header declares)
+    let expect = [
+        ("c3d/ezc3d_Optotrak.c3d", 54, 30.0, 29, 1149),
+        ("c3d/ezc3d_Qualisys.c3d", 55, 200.0, 340, 340),
+        ("c3d/ezc3d_Vicon.c3d", 51, 100.0, 580, 580),
+    ];
+    for (rel, markers, rate, frames, declared) in expect {
+        let take = load(rel);
+        assert_eq!(take.tracks.len(), markers, "{rel}");
+        assert_eq!(take.rate_hz, rate, "{rel}");
+        assert_eq!(take.frames, frames, "{rel}");
+        assert_eq!(take.file_unit, "mm", "{rel}");
+        for t in &take.tracks {
+            assert_eq!(t.positions.len(), frames, "{rel} {}", t.label);
+            assert!(t.rotations.is_empty());
+        }
+        let bytes = std::fs::read(fixture(rel)).unwrap();
+        let info = c3d::inspect(&fixture(rel), &bytes).unwrap();
+        assert_eq!(info.declared_frames, declared, "{rel}");
+        assert_eq!(info.frames, frames, "{rel}");
+        assert_eq!(info.processor, c3d::Processor::Intel);
+        assert!(info.float_data);
+    }
+    // The Optotrak sample is cut short: its header says frames 1..1149, but its data
+    // section holds 29 whole frames (25056 bytes of 54 × 16), and nothing more.
+    let info = c3d::inspect(
+        &fixture("c3d/ezc3d_Optotrak.c3d"),
+        &std::fs::read(fixture("c3d/ezc3d_Optotrak.c3d")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(info.data_offset + 29 * 54 * 16, 28640);
+    // Analog channels interleaved with the points are skipped.
+    let q = c3d::inspect(
+        &fixture("c3d/ezc3d_Qualisys.c3d"),
+        &std::fs::read(fixture("c3d/ezc3d_Qualisys.c3d")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(q.analog_values_per_frame, 69 * 10);
+}
+
+#[test]
+fn c3d_labels_match_the_files() {
+    let opto = load("c3d/ezc3d_Optotrak.c3d");
+    let qual = load("c3d/ezc3d_Qualisys.c3d");
+    let vicon = load("c3d/ezc3d_Vicon.c3d");
+    for take in [&opto, &qual, &vicon] {
+        println!("{}: {:?}", take.source.display(), &take.labels()[..6]);
+        assert!(
+            take.labels()
+                .iter()
+                .all(|l| !l.is_empty() && l.trim() == *l)
+        );
+    }
+    assert_eq!(opto.labels()[0], "Marker_1");
+    assert_eq!(opto.labels()[53], "Marker_54");
+    assert_eq!(qual.labels()[..4], ["L_IAS", "L_IPS", "R_IPS", "R_IAS"]);
+    assert_eq!(qual.labels()[54], "R_SAJ");
+    assert_eq!(vicon.labels()[0], "boite:gauche_ext");
+    assert_eq!(vicon.labels()[8], "Daphnee:ASISr");
+    assert_eq!(vicon.labels()[50], "Daphnee:LATH");
+    // Subject prefixes are found by Take::track.
+    assert_eq!(vicon.track("ASISr").unwrap().label, "Daphnee:ASISr");
+}
+
+#[test]
+fn c3d_positions_are_finite_plausible_and_missing_where_invalid() {
+    for rel in [
+        "c3d/ezc3d_Optotrak.c3d",
+        "c3d/ezc3d_Qualisys.c3d",
+        "c3d/ezc3d_Vicon.c3d",
+    ] {
+        let take = load(rel);
+        for t in &take.tracks {
+            for p in t.positions.iter().flatten() {
+                assert!(p.is_finite(), "{rel} {}", t.label);
+                assert!(p.length() < 3.0, "{rel} {} at {p}", t.label);
+            }
+        }
+    }
+    // Values read with a Python struct dump of the files (mm in the file, m here).
+    let qual = load("c3d/ezc3d_Qualisys.c3d");
+    let ias = qual.track("L_IAS").unwrap();
+    assert_near(
+        ias.positions[0].unwrap(),
+        DVec3::new(-0.22012, 0.30642, 0.84634),
+        1e-5,
+    );
+    assert_eq!(qual.tracks.iter().map(seen).sum::<usize>(), 55 * 340);
+
+    let vicon = load("c3d/ezc3d_Vicon.c3d");
+    let asis = vicon.track("Daphnee:ASISr").unwrap();
+    assert_near(
+        asis.positions[0].unwrap(),
+        DVec3::new(0.66712, 0.30580, 0.17521),
+        1e-5,
+    );
+    // 305 samples carry residual −1 (invalid) in this file.
+    let missing: usize = vicon.tracks.iter().map(|t| vicon.frames - seen(t)).sum();
+    assert_eq!(missing, 305);
+    let gauche = vicon.track("boite:gauche_ext").unwrap();
+    assert_eq!(seen(gauche), 574);
+
+    let opto = load("c3d/ezc3d_Optotrak.c3d");
+    assert_eq!(seen(opto.track("Marker_52").unwrap()), 0);
+    assert_eq!(seen(opto.track("Marker_53").unwrap()), 0);
+    assert_eq!(seen(opto.track("Marker_54").unwrap()), 28);
+    assert_near(
+        opto.track("Marker_1").unwrap().positions[0].unwrap(),
+        DVec3::new(0.32631, 0.32863, -0.36617),
+        1e-5,
+    );
+}
+
+#[test]
+fn c3d_unit_override_rescales() {
+    let path = fixture("c3d/ezc3d_Qualisys.c3d");
+    let mm = import::read(&path, Some(Format::C3d)).unwrap();
+    let m = import::read_with_unit(&path, None, Some("m")).unwrap();
+    assert_eq!(m.file_unit, "m");
+    let a = mm.tracks[0].positions[0].unwrap();
+    let b = m.tracks[0].positions[0].unwrap();
+    assert_near(a * 1000.0, b, 1e-9);
+    let e = import::read_with_unit(&path, None, Some("furlong")).unwrap_err();
+    assert!(e.to_string().contains("unit override"), "{e}");
+}
+
+// ---------------------------------------------------------------- C3D: writer
+
+#[test]
+fn c3d_writer_round_trips_a_real_capture() {
+    let take = load("c3d/ezc3d_Vicon.c3d");
+    let bytes = write_c3d(&take);
+    assert_eq!(bytes.len() % 512, 0);
+    assert_eq!(
+        Format::guess(Path::new("out.bin"), &bytes),
+        Some(Format::C3d)
+    );
+    let back = import::read_bytes(Path::new("out.c3d"), &bytes, Format::C3d).unwrap();
+    assert_eq!(back.labels(), take.labels());
+    assert_eq!(back.rate_hz, take.rate_hz);
+    assert_eq!(back.frames, take.frames);
+    assert_eq!(back.file_unit, "mm");
+    for (a, b) in take.tracks.iter().zip(&back.tracks) {
+        for (pa, pb) in a.positions.iter().zip(&b.positions) {
+            match (pa, pb) {
+                (Some(x), Some(y)) => assert_near(*x, *y, 1e-6),
+                (None, None) => {}
+                _ => panic!("{}: {pa:?} became {pb:?}", a.label),
+            }
+        }
+    }
+}
+
+#[test]
+fn c3d_writer_round_trips_gaps_and_drops_rotations() {
+    let take = Take {
+        source: "ours.c3d".into(),
+        rate_hz: 250.0,
+        frames: 5,
+        file_unit: "m".into(),
+        tracks: vec![
+            Track {
+                label: "StickL".into(),
+                positions: vec![
+                    Some(DVec3::new(0.1, 0.2, 0.3)),
+                    None,
+                    None,
+                    Some(DVec3::ONE),
+                    Some(DVec3::NEG_ONE),
+                ],
+                rotations: vec![Some(DQuat::IDENTITY); 5],
+            },
+            Track {
+                label: "StickR:Tip".into(),
+                positions: vec![None; 5],
+                rotations: vec![],
+            },
+        ],
+    };
+    let back = import::read_bytes(Path::new("x.c3d"), &write_c3d(&take), Format::C3d).unwrap();
+    assert_eq!(back.labels(), ["StickL", "StickR:Tip"]);
+    assert_eq!(back.frames, 5);
+    assert_eq!(back.rate_hz, 250.0);
+    assert_eq!(back.tracks[0].positions[1], None);
+    assert_near(back.tracks[0].positions[4].unwrap(), DVec3::NEG_ONE, 1e-6);
+    assert_eq!(back.tracks[1].positions, vec![None; 5]);
+    assert!(back.tracks[0].rotations.is_empty());
+}
+
+// ---------------------------------------------------------------- Motive
+
+#[test]
+fn motive_export_with_rigid_bodies_markers_and_gaps() {
+    let take = load("motive/timpani_roll_250hz.csv");
+    assert_eq!(take.rate_hz, 250.0);
+    assert_eq!(take.frames, 48);
+    assert_eq!(take.file_unit, "m");
+    println!("{:?}", take.labels());
+    assert_eq!(take.tracks.len(), 2 + 6 + 6 + 1);
+    assert_eq!(take.labels()[..2], ["StickL", "StickL:Marker1 (solved)"]);
+    assert!(take.labels().contains(&"StickR:Marker3"));
+    assert!(take.labels().contains(&"Unlabeled 1000"));
+
+    let left = take.track("StickL").unwrap();
+    let right = take.track("StickR").unwrap();
+    assert_eq!(left.rotations.len(), 48);
+    assert_eq!(seen(left), 48);
+    // StickR was lost for frames 10–14 (rigid body, its solved and measured markers).
+    for f in 0..48 {
+        let lost = (10..=14).contains(&f);
+        assert_eq!(right.positions[f].is_none(), lost, "frame {f}");
+        assert_eq!(right.rotations[f].is_none(), lost, "frame {f}");
+        let m = take.track("StickR:Marker2").unwrap();
+        assert_eq!(m.positions[f].is_none(), lost);
+    }
+    // A measured marker's own gap, and a marker that appears late.
+    let m2 = take.track("StickL:Marker2").unwrap();
+    assert_eq!(m2.positions[20..23], [None, None, None]);
+    assert_eq!(seen(m2), 45);
+    assert_eq!(seen(take.track("Unlabeled 1000").unwrap()), 18);
+
+    // The quaternion is read as X, Y, Z, W: the solved tip marker is the body's position
+    // plus its rotation applied to the marker's offset (0.02, 0, 0.30) in the body frame.
+    let tip = take.track("StickL:Marker3 (solved)").unwrap();
+    for f in 0..48 {
+        let (p, q) = (left.positions[f].unwrap(), left.rotations[f].unwrap());
+        assert!(q.is_normalized());
+        assert_near(
+            p + q * DVec3::new(0.02, 0.0, 0.30),
+            tip.positions[f].unwrap(),
+            5e-6,
+        );
+    }
+    assert!(left.rotations[5].unwrap().angle_between(DQuat::IDENTITY) > 0.1);
+}
+
+#[test]
+fn motive_units_and_truncation() {
+    let path = fixture("motive/timpani_roll_250hz.csv");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let mm = text.replacen("Length Units,Meters", "Length Units,Millimeters", 1);
+    let take = import::read_bytes(&path, mm.as_bytes(), Format::Motive).unwrap();
+    let metres = load("motive/timpani_roll_250hz.csv");
+    assert_eq!(take.file_unit, "mm");
+    assert_near(
+        take.tracks[0].positions[0].unwrap() * 1000.0,
+        metres.tracks[0].positions[0].unwrap(),
+        1e-12,
+    );
+    // Rotations do not scale.
+    assert_eq!(take.tracks[0].rotations, metres.tracks[0].rotations);
+    // A cut export is caught by the frame count in line 1.
+    let cut: String = text.lines().take(40).map(|l| format!("{l}\n")).collect();
+    let e = import::read_bytes(&path, cut.as_bytes(), Format::Motive).unwrap_err();
+    assert!(e.to_string().contains("Total Exported Frames"), "{e}");
+}
+
+// ---------------------------------------------------------------- Vicon
+
+#[test]
+fn vicon_export_skips_devices_and_stops_at_model_outputs() {
+    let take = load("vicon/timpani_strokes_100hz.csv");
+    assert_eq!(take.rate_hz, 100.0);
+    assert_eq!(take.frames, 30);
+    assert_eq!(take.file_unit, "mm");
+    assert_eq!(take.tracks.len(), 8);
+    assert_eq!(take.labels()[0], "Timpanist:RSHO");
+    assert!(take.track("RElbowAngles").is_none());
+    let tip = take.track("STICKR_TIP").unwrap();
+    assert_eq!(tip.label, "Timpanist:STICKR_TIP");
+    assert_near(
+        tip.positions[0].unwrap(),
+        DVec3::new(0.25, 0.982, 0.83),
+        1e-9,
+    );
+    // Gaps: frames 12–15 (rows 11..15) of the right stick tip, the left finger from 28.
+    assert_eq!(tip.positions[11..15], [None, None, None, None]);
+    assert_eq!(seen(tip), 26);
+    assert_eq!(seen(take.track("LFIN").unwrap()), 27);
+    assert!(
+        take.tracks
+            .iter()
+            .flat_map(|t| t.rotations.iter())
+            .next()
+            .is_none()
+    );
+}
+
+// ---------------------------------------------------------------- plain CSV
+
+#[test]
+fn plain_csv_fixture_and_round_trip() {
+    let take = load("csv/two_sticks_250hz.csv");
+    assert!((take.rate_hz - 250.0).abs() < 1e-6);
+    assert_eq!(take.frames, 20);
+    assert_eq!(take.labels(), ["StickL:Tip", "StickL", "StickR:Tip"]);
+    let body = take.track("StickL").unwrap();
+    assert_eq!(body.rotations.len(), 20);
+    assert!(take.track("StickL:Tip").unwrap().rotations.is_empty());
+    assert_eq!(
+        take.track("StickL:Tip").unwrap().positions[6..9],
+        [None, None, None]
+    );
+
+    // Our exports: any take written as plain CSV reads back the same.
+    let motive = load("motive/timpani_roll_250hz.csv");
+    let text = plain_csv::write(&motive);
+    let back = import::read_bytes(Path::new("x.csv"), text.as_bytes(), Format::Csv).unwrap();
+    assert_eq!(back.labels(), motive.labels());
+    assert_eq!(back.frames, motive.frames);
+    assert!((back.rate_hz - motive.rate_hz).abs() < 1e-9);
+    for (a, b) in motive.tracks.iter().zip(&back.tracks) {
+        assert_eq!(a.positions, b.positions, "{}", a.label);
+        assert_eq!(a.rotations.len(), b.rotations.len());
+        for (qa, qb) in a.rotations.iter().zip(&b.rotations) {
+            assert_eq!(qa.is_some(), qb.is_some());
+            if let (Some(x), Some(y)) = (qa, qb) {
+                assert!(x.abs_diff_eq(*y, 1e-12));
+            }
+        }
+    }
+}
+
+// ---------------------------------------------------------------- guessing
+
+#[test]
+fn formats_are_guessed_from_content() {
+    let cases = [
+        ("c3d/ezc3d_Vicon.c3d", Format::C3d),
+        ("motive/timpani_roll_250hz.csv", Format::Motive),
+        ("vicon/timpani_strokes_100hz.csv", Format::Vicon),
+        ("csv/two_sticks_250hz.csv", Format::Csv),
+    ];
+    for (rel, format) in cases {
+        let bytes = std::fs::read(fixture(rel)).unwrap();
+        assert_eq!(Format::guess(&fixture(rel), &bytes), Some(format), "{rel}");
+    }
+    let e = import::read_bytes(Path::new("x.csv"), b"hello", Format::Vicon).unwrap_err();
+    assert!(e.to_string().contains("Trajectories"), "{e}");
+    let missing = import::read(&fixture("nope.c3d"), None).unwrap_err();
+    assert!(matches!(missing, ImportError::Io { .. }));
+}
+
+// ---------------------------------------------------------------- robustness
+
+/// A small deterministic pseudo-random sequence (xorshift), for offsets.
+struct Rng(u64);
+
+impl Rng {
+    fn below(&mut self, n: usize) -> usize {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 % n.max(1) as u64) as usize
+    }
+}
+
+/// Read `bytes` as its own format and (a prefix of it) as every other; a panic fails
+/// with the case named. Returns whether its own format gave an error; an error must name
+/// a place.
+fn read_all_formats(bytes: &[u8], own: Format, case: &str) -> bool {
+    let mut own_failed = false;
+    for format in [Format::C3d, Format::Motive, Format::Vicon, Format::Csv] {
+        let input = if format == own {
+            bytes
+        } else {
+            &bytes[..bytes.len().min(16 * 1024)]
+        };
+        let r = catch_unwind(AssertUnwindSafe(|| {
+            import::read_bytes(Path::new("fuzz"), input, format)
+        }));
+        match r {
+            Err(_) => panic!("{case}: reading as {format:?} panicked"),
+            Ok(Err(ImportError::Format { place, message, .. })) => {
+                assert!(!place.is_empty() && !message.is_empty(), "{case}");
+                own_failed |= format == own;
+            }
+            Ok(Err(e)) => panic!("{case}: unexpected error {e}"),
+            Ok(Ok(take)) => {
+                for t in &take.tracks {
+                    assert_eq!(t.positions.len(), take.frames, "{case}");
+                    assert!(t.rotations.is_empty() || t.rotations.len() == take.frames);
+                }
+            }
+        }
+    }
+    own_failed
+}
+
+#[test]
+fn corrupt_and_truncated_files_never_panic() {
+    let files = [
+        ("c3d/ezc3d_Optotrak.c3d", Format::C3d),
+        ("c3d/ezc3d_Qualisys.c3d", Format::C3d),
+        ("c3d/ezc3d_Vicon.c3d", Format::C3d),
+        ("motive/timpani_roll_250hz.csv", Format::Motive),
+        ("vicon/timpani_strokes_100hz.csv", Format::Vicon),
+        ("csv/two_sticks_250hz.csv", Format::Csv),
+    ];
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    for (rel, format) in files {
+        let original = std::fs::read(fixture(rel)).unwrap();
+        let len = original.len();
+        // Where the structure is: the header and parameters for C3D, else the whole file.
+        // A C3D file cut after its first whole frames is still valid (it reads those
+        // frames), so the many single-byte corruptions work on such a short copy.
+        let (head, values): (usize, &[u8]) = match format {
+            Format::C3d => (
+                c3d::inspect(Path::new(rel), &original).unwrap().data_offset,
+                &[0x00, 0xff, 0x80, 0x7f],
+            ),
+            _ => (len, &[0x00, 0xff, b',', b'\n']),
+        };
+        let short = &original[..len.min(head + 8192)];
+
+        // Truncations: every byte of the first 600, then spread over the header part and
+        // the data.
+        let mut cuts: Vec<usize> = (0..600.min(len)).collect();
+        cuts.extend((0..150).map(|_| rng.below(head)));
+        for cut in cuts {
+            let failed = read_all_formats(&original[..cut], format, &format!("{rel} cut at {cut}"));
+            if format == Format::C3d {
+                assert!(
+                    failed,
+                    "{rel} cut at {cut} (inside header/parameters) was accepted"
+                );
+            }
+        }
+        for _ in 0..20 {
+            let cut = head + rng.below(len - head);
+            read_all_formats(&original[..cut], format, &format!("{rel} cut at {cut}"));
+        }
+
+        // Corruptions: single bytes set to telling values, over the first 600 bytes and
+        // spread over the rest.
+        let mut bytes = short.to_vec();
+        let mut spots: Vec<usize> = (0..600.min(bytes.len())).step_by(3).collect();
+        spots.extend((0..250).map(|_| rng.below(bytes.len())));
+        for at in spots {
+            for &value in values {
+                bytes[at] = value;
+                read_all_formats(&bytes, format, &format!("{rel} byte {at} = {value:#x}"));
+            }
+            bytes[at] = short[at];
+        }
+        // Runs of garbage, including in the full file's data.
+        let mut full = original.clone();
+        for i in 0..40 {
+            let (buf, orig) = if i % 4 == 0 {
+                (&mut full, &original[..])
+            } else {
+                (&mut bytes, short)
+            };
+            let at = rng.below(buf.len());
+            let end = (at + 1 + rng.below(64)).min(buf.len());
+            for b in &mut buf[at..end] {
+                *b = rng.below(256) as u8;
+            }
+            read_all_formats(buf, format, &format!("{rel} garbage at {at}..{end}"));
+            buf[at..end].copy_from_slice(&orig[at..end]);
+        }
+    }
+}
