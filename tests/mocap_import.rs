@@ -43,12 +43,22 @@ fn c3d_real_files_have_the_expected_markers_rate_and_frames() {
         let take = load(rel);
         assert_eq!(take.tracks.len(), markers, "{rel}");
         assert_eq!(take.rate_hz, rate, "{rel}");
-        assert_eq!(take.frames, frames, "{rel}");
+        assert_eq!(take.frames, declared, "{rel}");
         assert_eq!(take.file_unit, "mm", "{rel}");
         for t in &take.tracks {
-            assert_eq!(t.positions.len(), frames, "{rel} {}", t.label);
+            assert_eq!(t.positions.len(), declared, "{rel} {}", t.label);
+            assert!(
+                t.positions[frames..].iter().all(Option::is_none),
+                "frames past the data are missing"
+            );
             assert!(t.rotations.is_empty());
         }
+        assert_eq!(
+            take.notes.is_empty(),
+            frames == declared,
+            "{rel}: {:?}",
+            take.notes
+        );
         let bytes = std::fs::read(fixture(rel)).unwrap();
         let info = c3d::inspect(&fixture(rel), &bytes).unwrap();
         assert_eq!(info.declared_frames, declared, "{rel}");
@@ -211,6 +221,7 @@ fn c3d_writer_round_trips_gaps_and_drops_rotations() {
                 rotations: vec![],
             },
         ],
+        notes: Vec::new(),
     };
     let back = import::read_bytes(Path::new("x.c3d"), &write_c3d(&take), Format::C3d).unwrap();
     assert_eq!(back.labels(), ["StickL", "StickR:Tip"]);

@@ -3,6 +3,8 @@
 
 use crate::body::skeleton::Joint;
 use crate::mocap::db::MotionDb;
+use crate::mocap::import::Format;
+use crate::mocap::ingest::{IngestOptions, UpAxis, ingest};
 use crate::mocap::limits::JointLimit;
 use crate::mocap::{stats, synth};
 use crate::score::{Dynamic, Grip};
@@ -151,4 +153,81 @@ fn print_limits(db: &MotionDb, grip: Grip) {
             axes.join(" ")
         );
     }
+}
+
+/// What `mocap import` was asked to do.
+pub struct ImportArgs {
+    pub files: Vec<std::path::PathBuf>,
+    pub format: Option<Format>,
+    pub tips: [String; 2],
+    pub up: Option<UpAxis>,
+    pub unit: Option<String>,
+    pub tip_offset_m: Option<glam::DVec3>,
+    pub mode: Option<crate::score::PlayingMode>,
+    pub location: Option<crate::score::ImpactLocation>,
+    pub hand: Option<crate::kit::Side>,
+    pub dynamic: Option<Dynamic>,
+    pub grip: Option<Grip>,
+    pub performer: String,
+    pub output: std::path::PathBuf,
+}
+
+/// Import captures into the database at `args.output` (created if absent). Every file
+/// is read and cut before anything is written, so a bad file leaves the database as it was.
+pub fn import(args: ImportArgs) -> anyhow::Result<()> {
+    let mut db = if args.output.join("index.ron").exists() {
+        MotionDb::load(&args.output)?
+    } else {
+        MotionDb::empty("Imported motion captures")
+    };
+    for path in &args.files {
+        let bytes = std::fs::read(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let format = args.format.or_else(|| Format::guess(path, &bytes));
+        let take = crate::mocap::import::read_with_unit(path, format, args.unit.as_deref())?;
+        let up = args.up.unwrap_or(if format == Some(Format::Motive) {
+            UpAxis::Y
+        } else {
+            UpAxis::Z
+        });
+        let options = IngestOptions {
+            tips: args.tips.clone(),
+            up,
+            tip_offset_m: args.tip_offset_m,
+            mode: args.mode,
+            location: args.location,
+            dynamic: args.dynamic,
+            grip: args.grip,
+            hand: args.hand,
+            performer: args.performer.clone(),
+            segment: Default::default(),
+        };
+        let report = ingest(&mut db, path, &take, &options)?;
+        let plane = |p: Option<f64>| p.map_or("-".into(), |z| format!("{z:.3} m"));
+        println!(
+            "{}: {} frames at {} Hz ({}); left {} impacts -> {} units (membrane {}), right {} impacts -> {} units (membrane {})",
+            path.display(),
+            take.frames,
+            take.rate_hz,
+            take.file_unit,
+            report.impacts[0],
+            report.units[0],
+            plane(report.plane_height_m[0]),
+            report.impacts[1],
+            report.units[1],
+            plane(report.plane_height_m[1]),
+        );
+        for note in take.notes.iter().chain(&report.notices) {
+            eprintln!("note: {}: {note}", path.display());
+        }
+    }
+    std::fs::create_dir_all(&args.output)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", args.output.display()))?;
+    db.save(&args.output)?;
+    println!(
+        "{}: {} takes, {} units",
+        args.output.display(),
+        db.index.takes.len(),
+        db.index.units.len()
+    );
+    Ok(())
 }

@@ -2,11 +2,15 @@
 //! Errors print as one line (`error: …`) and exit non-zero; commands that write a file
 //! compute everything first and write atomically, so a failure leaves no file behind.
 
+mod args;
 mod check;
 mod midi;
 mod mocap;
 mod sticking;
 
+use args::{
+    DynamicArg, GripArg, LocationArg, ModeArg, SideArg, UpArg, parse_format, parse_pair, parse_vec3,
+};
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -109,6 +113,49 @@ pub enum MocapCommand {
         #[arg(long, default_value_t = 2008)]
         seed: u64,
     },
+    /// Read captures (C3D, OptiTrack Motive CSV, Vicon CSV, plain CSV), cut them into
+    /// strokes and add them to a database.
+    Import {
+        /// Capture files.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// File format (default: recognised from the content).
+        #[arg(long, value_parser = parse_format)]
+        format: Option<crate::mocap::import::Format>,
+        /// Labels of the left and right stick-tip markers or rigid bodies, e.g. "StickL,StickR".
+        #[arg(long, value_parser = parse_pair)]
+        tips: (String, String),
+        /// Which axis of the capture points up (default: y for Motive, z otherwise).
+        #[arg(long, value_enum)]
+        up: Option<UpArg>,
+        /// Length unit of the file, overriding what it says: mm, cm or m.
+        #[arg(long)]
+        unit: Option<String>,
+        /// For rigid bodies: the tip in the body's frame, metres, "x,y,z".
+        #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+        tip_offset: Option<glam::DVec3>,
+        /// Playing mode of every stroke (default: from the file name).
+        #[arg(long, value_enum)]
+        mode: Option<ModeArg>,
+        /// Impact location (default: from the file name, else the playing spot).
+        #[arg(long, value_enum)]
+        location: Option<LocationArg>,
+        /// Keep only this hand's strokes.
+        #[arg(long, value_enum)]
+        hand: Option<SideArg>,
+        /// Dynamic (default: from the file name, else mf).
+        #[arg(long, value_enum)]
+        dynamic: Option<DynamicArg>,
+        /// Grip (default: from the file name, else French).
+        #[arg(long, value_enum)]
+        grip: Option<GripArg>,
+        /// Who played.
+        #[arg(long, default_value = "unknown")]
+        performer: String,
+        /// The database folder (created, or added to).
+        #[arg(short, long)]
+        output: PathBuf,
+    },
     /// Per playing mode: tip height and depth range, impact speed, stroke duration; per
     /// joint: the limit ellipsoid.
     Stats {
@@ -152,6 +199,36 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Some(Command::Mocap(MocapCommand::Synth { output, seed })) => {
             mocap::synth(&output, seed).map(|()| ExitCode::SUCCESS)
         }
+        Some(Command::Mocap(MocapCommand::Import {
+            files,
+            format,
+            tips,
+            up,
+            unit,
+            tip_offset,
+            mode,
+            location,
+            hand,
+            dynamic,
+            grip,
+            performer,
+            output,
+        })) => mocap::import(mocap::ImportArgs {
+            files,
+            format,
+            tips: [tips.0, tips.1],
+            up: up.map(Into::into),
+            unit,
+            tip_offset_m: tip_offset,
+            mode: mode.map(Into::into),
+            location: location.map(Into::into),
+            hand: hand.map(Into::into),
+            dynamic: dynamic.map(Into::into),
+            grip: grip.map(Into::into),
+            performer,
+            output,
+        })
+        .map(|()| ExitCode::SUCCESS),
         Some(Command::Mocap(MocapCommand::Stats { dir })) => {
             mocap::stats(&dir).map(|()| ExitCode::SUCCESS)
         }

@@ -121,6 +121,20 @@ pub fn joint_names() -> Vec<String> {
 }
 
 impl MotionDb {
+    /// A database with no takes yet.
+    pub fn empty(description: &str) -> MotionDb {
+        MotionDb {
+            index: Index {
+                version: DB_FORMAT_VERSION,
+                description: description.to_string(),
+                joints: joint_names(),
+                takes: Vec::new(),
+                units: Vec::new(),
+            },
+            takes: Vec::new(),
+        }
+    }
+
     /// Load `dir/index.ron` and every sample file it names.
     pub fn load(dir: &Path) -> Result<MotionDb, FileError> {
         let index_path = dir.join("index.ron");

@@ -304,6 +304,7 @@ mod tests {
                 track("Player:TipL", Side::Left),
                 track("Player:TipR", Side::Right),
             ],
+            notes: Vec::new(),
         };
         let mut db = MotionDb {
             index: Index {

@@ -28,6 +28,8 @@ pub struct Take {
     pub file_unit: String,
     /// The trajectories.
     pub tracks: Vec<Track>,
+    /// What the reader noticed and worked around (e.g. a data section cut short).
+    pub notes: Vec<String>,
 }
 
 impl Take {

@@ -155,10 +155,16 @@ impl Shaped<'_> {
         let u = self.unit;
         let (frame, scale) = if t <= self.impact_s {
             let back = (self.impact_s - t) / self.prep_s;
-            (u.impact as f64 - back * (u.impact - u.start) as f64, self.prep_scale)
+            (
+                u.impact as f64 - back * (u.impact - u.start) as f64,
+                self.prep_scale,
+            )
         } else {
             let on = (t - self.impact_s) / self.rebound_s;
-            (u.impact as f64 + on * (u.end - u.impact) as f64, self.rebound_scale)
+            (
+                u.impact as f64 + on * (u.end - u.impact) as f64,
+                self.rebound_scale,
+            )
         };
         let mut rel = sample(self.take, frame) - self.origin;
         if let Some(n) = self.mirror_normal {
@@ -179,7 +185,10 @@ fn sample(track: &[Option<DVec3>], frame: f64) -> DVec3 {
     let (p0, p1, p2, p3) = (get(i - 1), get(i), get(i + 1), get(i + 2));
     let x2 = x * x;
     let x3 = x2 * x;
-    0.5 * ((2.0 * p1) + (p2 - p0) * x + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * x2 + (3.0 * p1 - p0 - 3.0 * p2 + p3) * x3)
+    0.5 * ((2.0 * p1)
+        + (p2 - p0) * x
+        + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * x2
+        + (3.0 * p1 - p0 - 3.0 * p2 + p3) * x3)
 }
 
 fn nearest_present(track: &[Option<DVec3>], k: usize) -> DVec3 {
@@ -213,14 +222,22 @@ fn smootherstep(x: f64) -> f64 {
 pub fn compose(strokes: &[PlannedStroke], db: &MotionDb, params: &ComposeParams) -> Composition {
     let rate = params.rate_hz;
     let snap = |t: f64| (t * rate).round() / rate;
-    let first = strokes.iter().map(|s| snap(s.time_s)).fold(0.0f64, f64::min);
-    let last = strokes.iter().map(|s| snap(s.time_s)).fold(0.0f64, f64::max);
+    let first = strokes
+        .iter()
+        .map(|s| snap(s.time_s))
+        .fold(0.0f64, f64::min);
+    let last = strokes
+        .iter()
+        .map(|s| snap(s.time_s))
+        .fold(0.0f64, f64::max);
     let start_s = ((first - params.margin_s - 1.0).min(0.0) * rate).floor() / rate;
     let n = ((last + params.margin_s + 1.0 - start_s) * rate).ceil() as usize + 1;
     let mut tips = [Vec::with_capacity(n), Vec::with_capacity(n)];
     let mut tags = [Vec::with_capacity(n), Vec::with_capacity(n)];
     for hand in [Side::Left, Side::Right] {
-        let mine: Vec<usize> = (0..strokes.len()).filter(|&i| strokes[i].hand == hand).collect();
+        let mine: Vec<usize> = (0..strokes.len())
+            .filter(|&i| strokes[i].hand == hand)
+            .collect();
         let shaped = shape(strokes, &mine, db, params);
         let (pieces, joins) = timeline(&shaped, hand, strokes, params);
         let h = side_index(hand);
@@ -238,13 +255,19 @@ pub fn compose(strokes: &[PlannedStroke], db: &MotionDb, params: &ComposeParams)
                 Some(j) if t > j.centre - j.half => {
                     let w = smootherstep((t - (j.centre - j.half)) / (2.0 * j.half));
                     let (a, b) = (&pieces[p], &pieces[p + 1]);
-                    (eval(a) * (1.0 - w) + eval(b) * w, if w < 0.5 { a } else { b })
+                    (
+                        eval(a) * (1.0 - w) + eval(b) * w,
+                        if w < 0.5 { a } else { b },
+                    )
                 }
                 _ => (eval(&pieces[p]), &pieces[p]),
             };
             tips[h].push(position);
             tags[h].push(match main {
-                Piece::Hold(_) => Tag { stroke: None, phase: Phase::Rest },
+                Piece::Hold(_) => Tag {
+                    stroke: None,
+                    phase: Phase::Rest,
+                },
                 Piece::Stroke(j) => {
                     let s = &shaped[*j];
                     let phase = if (t - s.impact_s).abs() < 0.5 / rate {
@@ -254,12 +277,18 @@ pub fn compose(strokes: &[PlannedStroke], db: &MotionDb, params: &ComposeParams)
                     } else {
                         Phase::Rebound
                     };
-                    Tag { stroke: Some(mine[*j]), phase }
+                    Tag {
+                        stroke: Some(mine[*j]),
+                        phase,
+                    }
                 }
             });
         }
     }
-    let impact_samples = strokes.iter().map(|s| ((snap(s.time_s) - start_s) * rate).round() as usize).collect();
+    let impact_samples = strokes
+        .iter()
+        .map(|s| ((snap(s.time_s) - start_s) * rate).round() as usize)
+        .collect();
     Composition {
         rate_hz: rate,
         start_s,
@@ -271,7 +300,12 @@ pub fn compose(strokes: &[PlannedStroke], db: &MotionDb, params: &ComposeParams)
 }
 
 /// Fit each of one hand's strokes (`mine`, indices into `strokes`) to its neighbours.
-fn shape<'a>(strokes: &'a [PlannedStroke], mine: &[usize], db: &'a MotionDb, params: &ComposeParams) -> Vec<Shaped<'a>> {
+fn shape<'a>(
+    strokes: &'a [PlannedStroke],
+    mine: &[usize],
+    db: &'a MotionDb,
+    params: &ComposeParams,
+) -> Vec<Shaped<'a>> {
     let rate = params.rate_hz;
     let mut shaped: Vec<Shaped> = mine
         .iter()
@@ -282,10 +316,15 @@ fn shape<'a>(strokes: &'a [PlannedStroke], mine: &[usize], db: &'a MotionDb, par
             let take = data.tip(unit.hand);
             let origin = take[unit.impact].unwrap_or_else(|| nearest_present(take, unit.impact));
             let from = (-origin.truncate()).normalize_or(glam::DVec2::NEG_Y);
-            let to = stroke.toward_player.truncate().normalize_or(glam::DVec2::NEG_Y);
+            let to = stroke
+                .toward_player
+                .truncate()
+                .normalize_or(glam::DVec2::NEG_Y);
             let turn = DQuat::from_rotation_z(from.angle_to(to));
-            let mirror_normal = (unit.hand != stroke.hand).then(|| DVec3::new(-from.y, from.x, 0.0));
-            let dynamic = (0.35 + 0.7 * stroke.dynamic.velocity()) / (0.35 + 0.7 * unit.dynamic.velocity());
+            let mirror_normal =
+                (unit.hand != stroke.hand).then(|| DVec3::new(-from.y, from.x, 0.0));
+            let dynamic =
+                (0.35 + 0.7 * stroke.dynamic.velocity()) / (0.35 + 0.7 * unit.dynamic.velocity());
             Shaped {
                 stroke,
                 unit,
@@ -318,14 +357,25 @@ fn shape<'a>(strokes: &'a [PlannedStroke], mine: &[usize], db: &'a MotionDb, par
 }
 
 /// The pieces of one hand's timeline and the joins between them.
-fn timeline(shaped: &[Shaped], hand: Side, strokes: &[PlannedStroke], params: &ComposeParams) -> (Vec<Piece>, Vec<Join>) {
-    let rest_above = |s: &PlannedStroke| s.target + s.toward_player * params.rest_back_m + DVec3::Z * params.rest_height_m;
+fn timeline(
+    shaped: &[Shaped],
+    hand: Side,
+    strokes: &[PlannedStroke],
+    params: &ComposeParams,
+) -> (Vec<Piece>, Vec<Join>) {
+    let rest_above = |s: &PlannedStroke| {
+        s.target + s.toward_player * params.rest_back_m + DVec3::Z * params.rest_height_m
+    };
     let f = params.blend_fraction;
     let Some(first) = shaped.first() else {
         // An idle hand rests above the first drum struck on its side, or in front of it.
         let anchor = strokes
             .iter()
-            .min_by(|a, b| (a.target.x * hand.sign()).total_cmp(&(b.target.x * hand.sign())).reverse())
+            .min_by(|a, b| {
+                (a.target.x * hand.sign())
+                    .total_cmp(&(b.target.x * hand.sign()))
+                    .reverse()
+            })
             .map_or(DVec3::new(0.25 * hand.sign(), 0.35, 0.95), rest_above);
         return (vec![Piece::Hold(anchor)], Vec::new());
     };
@@ -360,8 +410,14 @@ fn timeline(shaped: &[Shaped], hand: Side, strokes: &[PlannedStroke], params: &C
                 s.at(end).lerp(next.at(begin), 0.5)
             };
             pieces.push(Piece::Hold(hold));
-            joins.push(Join { centre: end, half: f * s.rebound_s.min(wait / 2.0) });
-            joins.push(Join { centre: begin, half: f * next.prep_s.min(wait / 2.0) });
+            joins.push(Join {
+                centre: end,
+                half: f * s.rebound_s.min(wait / 2.0),
+            });
+            joins.push(Join {
+                centre: begin,
+                half: f * next.prep_s.min(wait / 2.0),
+            });
         }
     }
     (pieces, joins)

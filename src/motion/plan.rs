@@ -54,7 +54,14 @@ impl Default for PlanParams {
 }
 
 /// How far apart a unit's labels are from what a stroke needs (0 = the same).
-fn match_cost(u: &UnitEntry, mode: PlayingMode, location: ImpactLocation, dynamic: Dynamic, grip: Grip, hand: Side) -> f64 {
+fn match_cost(
+    u: &UnitEntry,
+    mode: PlayingMode,
+    location: ImpactLocation,
+    dynamic: Dynamic,
+    grip: Grip,
+    hand: Side,
+) -> f64 {
     let (r1, a1) = u.location.polar();
     let (r2, a2) = location.polar();
     let angle = ((a1 - a2 + 540.0).rem_euclid(360.0) - 180.0).abs() / 180.0;
@@ -68,7 +75,12 @@ fn match_cost(u: &UnitEntry, mode: PlayingMode, location: ImpactLocation, dynami
 
 /// The strokes of `score` in time order, each with a motion unit from `db`.
 /// Errors if the database is empty.
-pub fn plan(score: &Score, kit: &Kit, db: &MotionDb, params: &PlanParams) -> Result<Vec<PlannedStroke>, String> {
+pub fn plan(
+    score: &Score,
+    kit: &Kit,
+    db: &MotionDb,
+    params: &PlanParams,
+) -> Result<Vec<PlannedStroke>, String> {
     if db.index.units.is_empty() {
         return Err("the motion database has no units".into());
     }
@@ -80,14 +92,19 @@ pub fn plan(score: &Score, kit: &Kit, db: &MotionDb, params: &PlanParams) -> Res
         let (radius, angle) = beat.location.polar();
         let mut push = |tick: u64, hand: Side| {
             let pinned = score.pins.iter().find(|p| p.tick == tick && p.hand == hand);
-            let target = pinned.map_or_else(|| drum.point_on_head(radius, angle), |p| DVec3::from_array(p.point_m));
+            let target = pinned.map_or_else(
+                || drum.point_on_head(radius, angle),
+                |p| DVec3::from_array(p.point_m),
+            );
             strokes.push(PlannedStroke {
                 beat: b,
                 tick,
                 hand,
                 time_s: tempo.seconds_at(tick as f64),
                 target,
-                toward_player: (-drum.centre().truncate()).normalize_or(glam::DVec2::NEG_Y).extend(0.0),
+                toward_player: (-drum.centre().truncate())
+                    .normalize_or(glam::DVec2::NEG_Y)
+                    .extend(0.0),
                 drum: beat.drum,
                 mode: beat.mode,
                 dynamic: beat.dynamic,
@@ -118,10 +135,17 @@ fn choose_units(strokes: &mut [PlannedStroke], score: &Score, db: &MotionDb, par
     let mut last = [usize::MAX; 2];
     for (i, s) in strokes.iter_mut().enumerate() {
         let location = score.beats[s.beat].location;
-        let costs: Vec<f64> = db.index.units.iter().map(|u| match_cost(u, s.mode, location, s.dynamic, score.grip, s.hand)).collect();
+        let costs: Vec<f64> = db
+            .index
+            .units
+            .iter()
+            .map(|u| match_cost(u, s.mode, location, s.dynamic, score.grip, s.hand))
+            .collect();
         let best = costs.iter().copied().fold(f64::INFINITY, f64::min);
         let h = crate::mocap::db::side_index(s.hand);
-        let mut near: Vec<usize> = (0..costs.len()).filter(|&k| costs[k] <= best + params.near_equal).collect();
+        let mut near: Vec<usize> = (0..costs.len())
+            .filter(|&k| costs[k] <= best + params.near_equal)
+            .collect();
         if near.len() > 1 {
             near.retain(|&k| k != last[h]);
         }
@@ -138,7 +162,12 @@ mod tests {
     use std::path::Path;
 
     fn demo(name: &str) -> LoadedScore {
-        LoadedScore::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scores").join(name)).unwrap()
+        LoadedScore::load(
+            &Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("scores")
+                .join(name),
+        )
+        .unwrap()
     }
 
     fn shipped_db() -> MotionDb {
@@ -151,8 +180,17 @@ mod tests {
         let db = shipped_db();
         let rolls = demo("roll-exercise.ron");
         let strokes = plan(&rolls.score, &rolls.kit, &db, &PlanParams::default()).unwrap();
-        let plain = rolls.score.beats.iter().filter(|b| b.roll.is_none()).count();
-        assert_eq!(strokes.len(), plain + 16 + 32, "a 2-beat and a 4-beat roll of 32nds");
+        let plain = rolls
+            .score
+            .beats
+            .iter()
+            .filter(|b| b.roll.is_none())
+            .count();
+        assert_eq!(
+            strokes.len(),
+            plain + 16 + 32,
+            "a 2-beat and a 4-beat roll of 32nds"
+        );
         let etude = demo("etude-modes.ron");
         for s in plan(&etude.score, &etude.kit, &db, &PlanParams::default()).unwrap() {
             let u = &db.index.units[s.unit];
@@ -169,8 +207,23 @@ mod tests {
         let a = plan(&s.score, &s.kit, &db, &PlanParams::default()).unwrap();
         let b = plan(&s.score, &s.kit, &db, &PlanParams::default()).unwrap();
         assert_eq!(a, b);
-        let c = plan(&s.score, &s.kit, &db, &PlanParams { seed: 99, ..PlanParams::default() }).unwrap();
-        assert_ne!(a.iter().map(|s| s.unit).collect::<Vec<_>>(), c.iter().map(|s| s.unit).collect::<Vec<_>>());
-        assert_eq!(a.iter().map(|s| s.time_s).collect::<Vec<_>>(), c.iter().map(|s| s.time_s).collect::<Vec<_>>());
+        let c = plan(
+            &s.score,
+            &s.kit,
+            &db,
+            &PlanParams {
+                seed: 99,
+                ..PlanParams::default()
+            },
+        )
+        .unwrap();
+        assert_ne!(
+            a.iter().map(|s| s.unit).collect::<Vec<_>>(),
+            c.iter().map(|s| s.unit).collect::<Vec<_>>()
+        );
+        assert_eq!(
+            a.iter().map(|s| s.time_s).collect::<Vec<_>>(),
+            c.iter().map(|s| s.time_s).collect::<Vec<_>>()
+        );
     }
 }

@@ -49,7 +49,12 @@ mod tests {
         assert_eq!(s.version, super::SCORE_FORMAT_VERSION);
         assert!(s.handles.is_empty() && s.pins.is_empty());
         let bad = v1.replace("beats: []", "beats: [], handles: []");
-        let err = Score::parse(Path::new("v1.ron"), &bad).unwrap_err().to_string();
-        assert!(err.starts_with("v1.ron:3:") && err.contains("handles"), "{err}");
+        let err = Score::parse(Path::new("v1.ron"), &bad)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.starts_with("v1.ron:3:") && err.contains("handles"),
+            "{err}"
+        );
     }
 }

@@ -96,7 +96,10 @@ pub fn problems(score: &Score, kit: &Kit) -> Vec<Problem> {
     }
     for (i, p) in score.pins.iter().enumerate() {
         if !p.point_m.iter().all(|v| v.is_finite() && v.abs() <= 3.0) {
-            out.push(Problem::new(format!("pin {i}"), "a pinned impact point must be finite and within 3 m of the player"));
+            out.push(Problem::new(
+                format!("pin {i}"),
+                "a pinned impact point must be finite and within 3 m of the player",
+            ));
         }
     }
     let mut i = 0;

@@ -38,8 +38,9 @@
 //!   be meant unsigned) and `POINT:LONG_FRAMES` / `TRIAL` fields are used when they show
 //!   the header overflowed.
 //! * **A data section that stops early** (fewer whole frames in the file than declared)
-//!   is read up to the last whole frame, as ezc3d does; [`inspect`] reports both counts.
-//!   A file with no whole frame at all is refused. (The Optotrak sample shipped with
+//!   is read up to the last whole frame; the take keeps the declared length with the
+//!   frames that are not in the file marked missing, and says so in its notes ([`inspect`]
+//!   reports both counts). A file with no whole frame at all is refused. (The Optotrak sample shipped with
 //!   ezc3d declares 1149 frames but holds 29.)
 
 use super::LengthUnit;
@@ -391,12 +392,41 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
                 .push((!invalid && v.is_finite()).then_some(v));
         }
     }
+    let mut notes = Vec::new();
+    // Keep the declared length (the frames not in the file marked missing) unless the
+    // header claims more samples than any real capture holds.
+    const MAX_PADDED_SAMPLES: usize = 50_000_000;
+    let frames = if info.frames < info.declared_frames {
+        let pad = info.declared_frames.saturating_mul(info.points.max(1)) <= MAX_PADDED_SAMPLES;
+        let kept = if pad {
+            info.declared_frames
+        } else {
+            info.frames
+        };
+        notes.push(format!(
+            "the data section holds {} of the {} frames the header declares; {}",
+            info.frames,
+            info.declared_frames,
+            if pad {
+                "the rest are marked missing"
+            } else {
+                "only those are read"
+            }
+        ));
+        for t in &mut tracks {
+            t.positions.resize(kept, None);
+        }
+        kept
+    } else {
+        info.frames
+    };
     Ok(Take {
         source: path.to_path_buf(),
         rate_hz: info.rate_hz,
-        frames: info.frames,
+        frames,
         file_unit: unit.symbol().to_string(),
         tracks,
+        notes,
     })
 }
 
@@ -977,6 +1007,7 @@ mod tests {
                 track("StickR:Tip", 0.2),
                 track("Ü", 0.3),
             ],
+            notes: Vec::new(),
         }
     }
 
@@ -1051,7 +1082,18 @@ mod tests {
         let frame = 3 * 16;
         let cut = &bytes[..info.data_offset + 4 * frame + 5];
         let back = read(Path::new("x"), cut, None).unwrap();
-        assert_eq!(back.frames, 4);
+        assert_eq!(back.frames, 10, "the declared length is kept");
+        assert!(
+            back.tracks
+                .iter()
+                .all(|t| t.positions[4..].iter().all(Option::is_none))
+        );
+        assert!(
+            back.tracks
+                .iter()
+                .any(|t| t.positions[..4].iter().any(Option::is_some))
+        );
+        assert_eq!(back.notes.len(), 1);
         let e = read(Path::new("x"), &bytes[..info.data_offset + 5], None).unwrap_err();
         assert!(e.to_string().contains("truncated"), "{e}");
     }

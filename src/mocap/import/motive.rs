@@ -333,6 +333,7 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         frames,
         file_unit: unit.symbol().to_string(),
         tracks,
+        notes: Vec::new(),
     })
 }
 

@@ -105,6 +105,7 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         frames: times.len(),
         file_unit: unit.symbol().to_string(),
         tracks,
+        notes: Vec::new(),
     })
 }
 
@@ -415,6 +416,7 @@ mod tests {
                     ],
                 },
             ],
+            notes: Vec::new(),
         };
         let back = read(p(), write(&take).as_bytes(), None).unwrap();
         assert_eq!(back.labels(), take.labels());

@@ -1,0 +1,191 @@
+//! `timpanist mocap import` end to end: a Motive-style CSV export with one rigid body per
+//! stick (Y up, metres, 250 Hz), written from a synthetic take whose impacts are known,
+//! is cut into the right units; bad input leaves the database untouched.
+
+use glam::{DQuat, DVec3};
+use std::fmt::Write as _;
+use std::path::Path;
+use std::process::Command;
+use timpanist::body::{Joint, Skeleton};
+use timpanist::kit::Side;
+use timpanist::mocap::db::MotionDb;
+use timpanist::mocap::synth::{SynthConfig, synthesize};
+use timpanist::score::{Dynamic, Grip, ImpactLocation, PlayingMode};
+
+fn timpanist(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_timpanist"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// Performer frame (Z up) to Motive's Y-up frame, for positions and rotations.
+fn to_y_up(p: DVec3) -> DVec3 {
+    DVec3::new(p.x, p.z, -p.y)
+}
+
+/// A Motive CSV export of `db`'s first take: rigid bodies StickL and StickR, pivot at the
+/// grip, rotated with the stick, so the tip sits at (0, 0, −stick length) in the body.
+fn motive_csv(db: &MotionDb) -> String {
+    let skeleton = Skeleton::default();
+    let poses = db.takes[0].joints.as_ref().unwrap();
+    let n = poses.len();
+    let to_y_up_rotation = DQuat::from_rotation_x(-std::f64::consts::FRAC_PI_2);
+    let mut out = format!(
+        "Format Version,1.23,Take Name,legato_spot,Take Notes,,Capture Frame Rate,250.000000,Export Frame Rate,250.000000,Capture Start Time,2024-05-14 03.12.45.120 PM,Capture Start Frame,0,Total Frames in Take,{n},Total Exported Frames,{n},Rotation Type,Quaternion,Length Units,Meters,Coordinate Space,Global\n\n"
+    );
+    out += ",Type,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body\n";
+    out += ",Name,StickL,StickL,StickL,StickL,StickL,StickL,StickL,StickL,StickR,StickR,StickR,StickR,StickR,StickR,StickR,StickR\n";
+    out += ",ID,1,1,1,1,1,1,1,1,2,2,2,2,2,2,2,2\n";
+    out += ",,Rotation,Rotation,Rotation,Rotation,Position,Position,Position,Mean Marker Error,Rotation,Rotation,Rotation,Rotation,Position,Position,Position,Mean Marker Error\n";
+    out += "Frame,Time (Seconds),X,Y,Z,W,X,Y,Z,,X,Y,Z,W,X,Y,Z,\n";
+    for (f, pose) in poses.iter().enumerate() {
+        let frames = skeleton.forward(pose);
+        write!(out, "{f},{:.6}", f as f64 / 250.0).unwrap();
+        for grip in [Joint::GripL, Joint::GripR] {
+            let q = to_y_up_rotation * frames.rotation[grip.index()];
+            let p = to_y_up(frames.position[grip.index()]);
+            write!(
+                out,
+                ",{:.7},{:.7},{:.7},{:.7},{:.7},{:.7},{:.7},0.000300",
+                q.x, q.y, q.z, q.w, p.x, p.y, p.z
+            )
+            .unwrap();
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// The Motive export imports with rigid-body tips, Y up, labels from the file name, and
+/// yields the units the synthetic take was cut into (impacts ±1 frame).
+#[test]
+fn motive_rigid_body_export_imports() {
+    let source = synthesize(&SynthConfig {
+        grips: vec![Grip::French],
+        modes: vec![PlayingMode::Legato],
+        locations: vec![ImpactLocation::PlayingSpot],
+        hands: vec![Side::Right],
+        dynamics: vec![Dynamic::F],
+        strokes_per_dynamic: 6,
+        ..SynthConfig::default()
+    });
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("legato_spot_f_french.csv");
+    std::fs::write(&csv, motive_csv(&source)).unwrap();
+    let db_dir = dir.path().join("db");
+    let stick = Skeleton::default().stick_length_m;
+    let offset = format!("0,0,-{stick}");
+    let out = timpanist(&[
+        "mocap",
+        "import",
+        csv.to_str().unwrap(),
+        "--format",
+        "motive",
+        "--tips",
+        "StickL,StickR",
+        "--tip-offset",
+        &offset,
+        "-o",
+        db_dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let db = MotionDb::load(&db_dir).unwrap();
+    let right: Vec<_> = db
+        .index
+        .units
+        .iter()
+        .filter(|u| u.hand == Side::Right)
+        .collect();
+    assert_eq!(right.len(), source.index.units.len());
+    for (ours, theirs) in right.iter().zip(&source.index.units) {
+        assert!(
+            ours.impact.abs_diff(theirs.impact) <= 1,
+            "{} vs {}",
+            ours.impact,
+            theirs.impact
+        );
+        assert_eq!(
+            (ours.mode, ours.location, ours.dynamic, ours.grip),
+            (
+                PlayingMode::Legato,
+                ImpactLocation::PlayingSpot,
+                Dynamic::F,
+                Grip::French
+            )
+        );
+    }
+    let tip = db.takes[0].tip(Side::Right)[right[0].impact].unwrap();
+    assert!(
+        (tip.z - 0.76).abs() < 0.012,
+        "tip back in the performer frame: {tip}"
+    );
+
+    // A second file with an unknown label fails and leaves the database as it was.
+    let before = std::fs::read_to_string(db_dir.join("index.ron")).unwrap();
+    let out = timpanist(&[
+        "mocap",
+        "import",
+        csv.to_str().unwrap(),
+        "--tips",
+        "StickL,Nope",
+        "-o",
+        db_dir.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("Nope"));
+    assert_eq!(
+        std::fs::read_to_string(db_dir.join("index.ron")).unwrap(),
+        before
+    );
+}
+
+/// The real C3D files import (they hold no strokes, so no units) without error, and a
+/// corrupt capture fails with one line naming it.
+#[test]
+fn c3d_and_corrupt_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let c3d = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/c3d/ezc3d_Vicon.c3d");
+    let db_dir = dir.path().join("db");
+    let out = timpanist(&[
+        "mocap",
+        "import",
+        c3d.to_str().unwrap(),
+        "--tips",
+        "Daphnee:WRIST,Daphnee:INDEX",
+        "--mode",
+        "legato",
+        "-o",
+        db_dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("580 frames at 100 Hz"));
+    let bad = dir.path().join("bad.c3d");
+    std::fs::write(&bad, &std::fs::read(&c3d).unwrap()[..700]).unwrap();
+    let out = timpanist(&[
+        "mocap",
+        "import",
+        bad.to_str().unwrap(),
+        "--tips",
+        "a,b",
+        "--mode",
+        "legato",
+        "-o",
+        dir.path().join("db2").to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.starts_with("error: ") && err.contains("bad.c3d"),
+        "{err}"
+    );
+    assert!(!dir.path().join("db2").exists());
+}
