@@ -151,7 +151,13 @@ fn content_errors_name_the_place() {
 #[test]
 fn newer_format_is_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let path = temp_score(dir.path(), &demo_text().replace("version: 1", "version: 9"));
+    let path = temp_score(
+        dir.path(),
+        &demo_text().replace(
+            &format!("version: {}", timpanist::score::SCORE_FORMAT_VERSION),
+            "version: 9",
+        ),
+    );
     let err = String::from_utf8_lossy(&check(&[&path]).stderr).to_string();
     assert!(err.contains("format version 9 is newer"), "{err}");
 }
