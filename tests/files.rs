@@ -29,7 +29,12 @@ fn check(files: &[&Path]) -> std::process::Output {
 /// Write `text` to a temporary score file next to a copy of the standard kit path layout.
 fn temp_score(dir: &Path, text: &str) -> PathBuf {
     let path = dir.join("bad.ron");
-    std::fs::write(&path, text.replace("../kits/standard.ron", "standard")).unwrap();
+    std::fs::write(
+        &path,
+        text.replace("../kits/standard.ron", "standard")
+            .replace("../kits/solo.ron", "solo"),
+    )
+    .unwrap();
     path
 }
 
@@ -132,7 +137,7 @@ fn content_errors_name_the_place() {
     let dir = tempfile::tempdir().unwrap();
     let path = temp_score(
         dir.path(),
-        &demo_text().replace("drum: 3, location: Rim", "drum: 7, location: Rim"),
+        &demo_text().replace("drum: 0, location: Rim", "drum: 7, location: Rim"),
     );
     let err = String::from_utf8_lossy(&check(&[&path]).stderr).to_string();
     assert!(

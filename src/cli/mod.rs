@@ -4,6 +4,7 @@
 
 mod args;
 mod check;
+mod compose;
 mod midi;
 mod mocap;
 mod sticking;
@@ -78,6 +79,23 @@ pub enum Command {
         /// Save the score with the hands filled in.
         #[arg(short, long)]
         output: Option<PathBuf>,
+    },
+    /// Compose the two stick-tip trajectories of a score from the motion database.
+    Compose {
+        /// The score (.ron).
+        score: PathBuf,
+        /// CSV to write: time, then x, y, z, beat and phase per hand.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Also draw tip height and depth against time, beats marked, as a PNG.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// The motion database folder.
+        #[arg(long, default_value = "mocap")]
+        db: PathBuf,
+        /// Seed of the choice among near-equal motion units.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
     },
     /// Motion-capture database: build, inspect, import.
     #[command(subcommand)]
@@ -196,6 +214,13 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             method,
             output,
         }) => sticking::run(&score, method.into(), output.as_deref()).map(|()| ExitCode::SUCCESS),
+        Some(Command::Compose {
+            score,
+            output,
+            plot,
+            db,
+            seed,
+        }) => compose::run(&score, &db, &output, plot.as_deref(), seed).map(|()| ExitCode::SUCCESS),
         Some(Command::Mocap(MocapCommand::Synth { output, seed })) => {
             mocap::synth(&output, seed).map(|()| ExitCode::SUCCESS)
         }

@@ -20,6 +20,7 @@ pub const KIT_FORMAT_VERSION: u32 = 1;
 pub const BUNDLED_KITS: &[(&str, &str)] = &[
     ("standard", include_str!("../../kits/standard.ron")),
     ("pair", include_str!("../../kits/pair.ron")),
+    ("solo", include_str!("../../kits/solo.ron")),
 ];
 
 /// A side of the body.

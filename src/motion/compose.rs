@@ -4,8 +4,8 @@
 //! **Splicing.** Each unit is time-warped so that its impact lands exactly on the
 //! stroke's (sample-snapped) time: its preparation is fitted to the time since the same
 //! hand's previous stroke and its rebound to the time until the next one; a gap shorter
-//! than the unit's natural rebound + preparation compresses both and lowers the lift by
-//! √(compression), as players do; a longer gap stretches them up to 1.5× and then holds.
+//! than the unit's natural rebound + preparation compresses both in time and lowers the
+//! lift in the same proportion, as players do (a roll is played low); a longer gap stretches them up to 1.5× and then holds.
 //! In space the unit's motion relative to its impact point is turned about the vertical
 //! to face the target drum, mirrored when taken from the other hand, scaled with the
 //! dynamic (height ∝ 0.35 + 0.7·velocity, as in the database), and placed on the
@@ -166,7 +166,21 @@ impl Shaped<'_> {
                 self.rebound_scale,
             )
         };
-        let mut rel = sample(self.take, frame) - self.origin;
+        // Next to the impact the data has a kink (the rebound): interpolate linearly there
+        // so the curve cannot overshoot through the head.
+        let raw = if (frame - u.impact as f64).abs() < 1.0 {
+            let i = frame.floor();
+            let (a, b) = (
+                nearest_present(self.take, i as usize),
+                nearest_present(self.take, i as usize + 1),
+            );
+            a.lerp(b, frame - i)
+        } else {
+            sample(self.take, frame)
+        };
+        let mut rel = raw - self.origin;
+        // The unit's impact is its lowest point: nothing goes below the head.
+        rel.z = rel.z.max(0.0);
         if let Some(n) = self.mirror_normal {
             rel -= 2.0 * rel.dot(n) * n;
         }
@@ -348,8 +362,8 @@ fn shape<'a>(
             shaped[k - 1].rebound_s *= f;
             shaped[k].prep_s *= f;
             if f < 1.0 {
-                shaped[k - 1].rebound_scale *= f.sqrt();
-                shaped[k].prep_scale *= f.sqrt();
+                shaped[k - 1].rebound_scale *= f;
+                shaped[k].prep_scale *= f;
             }
         }
     }

@@ -1,6 +1,9 @@
-//! From score to motion: hand assignment (sticking) now; motion-unit planning, splicing and
-//! co-articulation build on it.
+//! From score to motion: hand assignment (sticking), planning strokes with motion units,
+//! splicing and co-articulating them into two stick-tip trajectories, and the user's
+//! edit handles on top.
 
 pub mod compose;
+pub mod handles;
+pub mod perform;
 pub mod plan;
 pub mod sticking;

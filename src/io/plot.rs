@@ -1,0 +1,135 @@
+//! PNG figures of time series (for `compose --plot` and other reports): stacked panels
+//! sharing a time axis, lines per series, point markers and vertical guide lines, drawn
+//! with plotters and the font egui ships (no system fonts needed); written atomically.
+
+use plotters::prelude::*;
+use std::path::Path;
+use std::sync::Once;
+
+/// One line of a panel.
+pub struct Series {
+    pub label: String,
+    pub colour: RGBColor,
+    /// (time s, value) points.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// One panel: a y label, lines and markers.
+pub struct Panel {
+    pub y_label: String,
+    pub series: Vec<Series>,
+    /// (time s, value, colour) dots, e.g. impacts.
+    pub markers: Vec<(f64, f64, RGBColor)>,
+}
+
+/// A figure of stacked panels over a common time axis.
+pub struct Figure {
+    pub title: String,
+    pub panels: Vec<Panel>,
+    /// Times of vertical guide lines (e.g. beats), s.
+    pub guides: Vec<f64>,
+    pub size: (u32, u32),
+}
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // The font is compiled in; registering it cannot fail for a valid TTF.
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            epaint_default_fonts::UBUNTU_LIGHT,
+        );
+    });
+}
+
+fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+        (l.min(v), h.max(v))
+    });
+    if lo.is_finite() && hi > lo {
+        let pad = 0.05 * (hi - lo);
+        (lo - pad, hi + pad)
+    } else {
+        (lo.min(0.0) - 1.0, hi.max(0.0) + 1.0)
+    }
+}
+
+impl Figure {
+    /// Draw the figure to a PNG at `path`, atomically.
+    pub fn save_png(&self, path: &Path) -> Result<(), String> {
+        register_font();
+        let dir = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        let tmp = tempfile::Builder::new()
+            .prefix(".timpanist-")
+            .suffix(".png")
+            .tempfile_in(dir)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        self.draw(tmp.path())
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        tmp.persist(path)
+            .map_err(|e| format!("{}: {}", path.display(), e.error))?;
+        Ok(())
+    }
+
+    fn draw(&self, file: &Path) -> Result<(), Box<dyn std::error::Error>> {
+        let root = BitMapBackend::new(file, self.size).into_drawing_area();
+        root.fill(&WHITE)?;
+        let root = root.titled(&self.title, ("sans-serif", 22))?;
+        let (t0, t1) = range(
+            self.panels
+                .iter()
+                .flat_map(|p| p.series.iter().flat_map(|s| s.points.iter().map(|p| p.0))),
+        );
+        let areas = root.split_evenly((self.panels.len().max(1), 1));
+        for (panel, area) in self.panels.iter().zip(&areas) {
+            let (y0, y1) = range(
+                panel
+                    .series
+                    .iter()
+                    .flat_map(|s| s.points.iter().map(|p| p.1)),
+            );
+            let mut chart = ChartBuilder::on(area)
+                .margin(8)
+                .x_label_area_size(32)
+                .y_label_area_size(56)
+                .build_cartesian_2d(t0..t1, y0..y1)?;
+            chart
+                .configure_mesh()
+                .x_desc("time (s)")
+                .y_desc(panel.y_label.as_str())
+                .light_line_style(WHITE.mix(0.0))
+                .draw()?;
+            for &g in self.guides.iter().filter(|g| (t0..=t1).contains(*g)) {
+                chart.draw_series(LineSeries::new([(g, y0), (g, y1)], BLACK.mix(0.12)))?;
+            }
+            for s in &panel.series {
+                chart
+                    .draw_series(LineSeries::new(
+                        s.points.iter().copied(),
+                        s.colour.stroke_width(2),
+                    ))?
+                    .label(s.label.as_str())
+                    .legend(move |(x, y)| {
+                        PathElement::new([(x, y), (x + 16, y)], s.colour.stroke_width(2))
+                    });
+            }
+            chart.draw_series(
+                panel
+                    .markers
+                    .iter()
+                    .map(|&(t, v, c)| Circle::new((t, v), 4, c.filled())),
+            )?;
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK.mix(0.3))
+                .draw()?;
+        }
+        root.present()?;
+        Ok(())
+    }
+}

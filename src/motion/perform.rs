@@ -1,0 +1,23 @@
+//! The whole path from a score to its two stick-tip trajectories: plan (sticking and
+//! motion units), compose, then apply the user's handles.
+
+use super::compose::{ComposeParams, Composition, compose};
+use super::handles;
+use super::plan::{PlanParams, plan};
+use crate::kit::Kit;
+use crate::mocap::db::MotionDb;
+use crate::score::Score;
+
+/// Compose `score` on `kit` from `db`.
+pub fn trajectories(
+    score: &Score,
+    kit: &Kit,
+    db: &MotionDb,
+    plan_params: &PlanParams,
+    compose_params: &ComposeParams,
+) -> Result<Composition, String> {
+    let strokes = plan(score, kit, db, plan_params)?;
+    let mut comp = compose(&strokes, db, compose_params);
+    handles::apply(&mut comp, score);
+    Ok(comp)
+}
