@@ -10,12 +10,30 @@ use timpanist::app::EditorApp;
 fn opens_demo_score() {
     let demo = Path::new(env!("CARGO_MANIFEST_DIR")).join("scores/etude-modes.ron");
     let mut harness = Harness::new_eframe(|_cc| EditorApp::new(Some(&demo)));
+    harness.state_mut().wait_for_composition();
     harness.run();
     let app = harness.state();
     assert!(app.error().is_none(), "{:?}", app.error());
     assert_eq!(app.loaded().unwrap().score.beats.len(), 16);
     harness.get_by_label("Etude in five modes and three spots");
     harness.get_by_label("Standard set (32/29/26/23 inch)");
+}
+
+/// The editor composes the open score's stick-tip trajectories in the background and
+/// shows them once they arrive.
+#[test]
+fn composes_in_the_background() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::env::set_current_dir(root).unwrap();
+    let demo = root.join("scores/improvisation.ron");
+    let mut harness = Harness::new_eframe(|_cc| EditorApp::new(Some(&demo)));
+    let strokes = harness
+        .state_mut()
+        .wait_for_composition()
+        .map(|c| c.strokes.len());
+    assert_eq!(strokes, Some(5));
+    harness.run();
+    harness.get_by_label("Right tip");
 }
 
 /// A score that fails to load is reported in the window instead of crashing.

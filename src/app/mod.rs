@@ -3,10 +3,14 @@
 //! The document (the score) is the only state that is saved; the UI reads it.
 
 mod timeline;
+mod tips_plot;
 
+use crate::mocap::db::MotionDb;
+use crate::motion::compose::{ComposeParams, Composition};
 use crate::score::LoadedScore;
 use eframe::egui;
 use std::path::{Path, PathBuf};
+use std::sync::mpsc;
 
 /// The demo score opened when no file is given (compiled in, so it opens anywhere).
 pub const DEMO_SCORE_PATH: &str = "scores/etude-modes.ron";
@@ -28,6 +32,12 @@ pub struct EditorApp {
     status: String,
     /// The window title last sent, so it is only sent when it changes.
     shown_title: String,
+    /// The composed trajectories of the open score, when ready.
+    composition: Option<Composition>,
+    /// A composition being made on a worker thread.
+    composing: Option<mpsc::Receiver<Result<Composition, String>>>,
+    /// Why there is no composition, if it failed.
+    compose_error: Option<String>,
 }
 
 impl EditorApp {
@@ -38,6 +48,9 @@ impl EditorApp {
             error: None,
             status: String::new(),
             shown_title: String::new(),
+            composition: None,
+            composing: None,
+            compose_error: None,
         };
         match path {
             Some(p) => app.open(p),
@@ -65,9 +78,63 @@ impl EditorApp {
             Ok(loaded) => {
                 self.status = "opened the bundled demo score".into();
                 self.doc = Some(Document { loaded, path: None });
+                self.start_composing(None);
             }
             Err(e) => self.error = Some(e.to_string()),
         }
+    }
+
+    /// Compose the open score on a worker thread (the UI never waits for it).
+    fn start_composing(&mut self, ctx: Option<egui::Context>) {
+        let Some(doc) = &self.doc else { return };
+        let (score, kit) = (doc.loaded.score.clone(), doc.loaded.kit.clone());
+        let (tx, rx) = mpsc::channel();
+        self.composing = Some(rx);
+        self.composition = None;
+        self.compose_error = None;
+        std::thread::spawn(move || {
+            let db_dir = crate::mocap::db::default_dir();
+            let result = MotionDb::load(&db_dir)
+                .map_err(|e| format!("no motion database: {e}"))
+                .and_then(|db| {
+                    crate::motion::perform::trajectories(
+                        &score,
+                        &kit,
+                        &db,
+                        &Default::default(),
+                        &ComposeParams::default(),
+                    )
+                });
+            let _ = tx.send(result);
+            if let Some(ctx) = ctx {
+                ctx.request_repaint();
+            }
+        });
+    }
+
+    /// Take a finished composition, if one has arrived.
+    fn poll_composition(&mut self) {
+        if let Some(rx) = &self.composing
+            && let Ok(result) = rx.try_recv()
+        {
+            self.composing = None;
+            match result {
+                Ok(c) => self.composition = Some(c),
+                Err(e) => self.compose_error = Some(e),
+            }
+        }
+    }
+
+    /// Wait for the composition in progress (for tests and batch use).
+    pub fn wait_for_composition(&mut self) -> Option<&Composition> {
+        if let Some(rx) = self.composing.take() {
+            match rx.recv() {
+                Ok(Ok(c)) => self.composition = Some(c),
+                Ok(Err(e)) => self.compose_error = Some(e),
+                Err(_) => self.compose_error = Some("the composing thread stopped".into()),
+            }
+        }
+        self.composition.as_ref()
     }
 
     fn open(&mut self, path: &Path) {
@@ -82,6 +149,7 @@ impl EditorApp {
                     path: Some(path.to_path_buf()),
                 });
                 self.error = None;
+                self.start_composing(None);
             }
             Err(e) => self.error = Some(e.to_string()),
         }
@@ -205,6 +273,10 @@ impl eframe::App for EditorApp {
         if ctx.input_mut(|i| i.consume_key(egui::Modifiers::COMMAND, egui::Key::O)) {
             self.open_dialog();
         }
+        self.poll_composition();
+        if self.composing.is_some() {
+            ctx.request_repaint_after(std::time::Duration::from_millis(50));
+        }
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         egui::Panel::bottom("status").show(ui, |ui| ui.label(&self.status));
         egui::Panel::left("score")
@@ -221,6 +293,20 @@ impl eframe::App for EditorApp {
             }
             if let Some(doc) = &self.doc {
                 timeline::show(ui, &doc.loaded);
+            }
+            ui.add_space(8.0);
+            match (&self.composition, &self.compose_error) {
+                (Some(c), _) => tips_plot::show(ui, c),
+                (None, Some(e)) => {
+                    ui.label(format!("Composed stick tips unavailable: {e}"));
+                }
+                (None, None) if self.composing.is_some() => {
+                    ui.horizontal(|ui| {
+                        ui.spinner();
+                        ui.label("Composing stick-tip trajectories…");
+                    });
+                }
+                _ => {}
             }
         });
     }
