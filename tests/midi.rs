@@ -17,16 +17,7 @@ use timpanist::score::{
 };
 
 fn beat(tick: u64, drum: usize) -> Beat {
-    Beat {
-        tick,
-        hand: Hand::Auto,
-        mode: PlayingMode::Legato,
-        dynamic: Dynamic::Mf,
-        drum,
-        pitch: None,
-        location: ImpactLocation::PlayingSpot,
-        roll: None,
-    }
+    Beat::plain(tick, drum)
 }
 
 /// Import `bytes` as "test.mid" on the standard kit, checking the score has no problems.

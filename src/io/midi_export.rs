@@ -222,19 +222,10 @@ fn timpani_events<'a>(score: &Score, kit: &Kit, payloads: &'a [Vec<u8>]) -> Vec<
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::score::{Beat, Dynamic, TempoPoint};
+    use crate::score::{Beat, TempoPoint};
 
     fn beat(tick: u64, drum: usize) -> Beat {
-        Beat {
-            tick,
-            hand: Hand::Auto,
-            mode: PlayingMode::Legato,
-            dynamic: Dynamic::Mf,
-            drum,
-            pitch: None,
-            location: ImpactLocation::PlayingSpot,
-            roll: None,
-        }
+        Beat::plain(tick, drum)
     }
 
     /// Absolute ticks and kinds of a track's events.

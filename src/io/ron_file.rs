@@ -64,6 +64,20 @@ impl FileError {
     }
 }
 
+/// The error for a format `version` this program cannot read: 0 never existed, anything
+/// above `supported` comes from a newer timpanist.
+pub fn unsupported_version(path: &Path, found: u32, supported: u32) -> FileError {
+    if found == 0 {
+        FileError::invalid(path, "version", "format version 0 does not exist")
+    } else {
+        FileError::TooNew {
+            path: path.to_path_buf(),
+            found,
+            supported,
+        }
+    }
+}
+
 /// Read a whole text file.
 pub fn read_text(path: &Path) -> Result<String, FileError> {
     std::fs::read_to_string(path).map_err(|e| FileError::io(path, e))

@@ -208,19 +208,12 @@ impl Kit {
         let probe: Probe = ron_file::parse(path, text)?;
         let kit: Kit = match probe.version {
             1 => ron_file::parse(path, text)?,
-            0 => {
-                return Err(FileError::invalid(
-                    path,
-                    "version",
-                    "format version 0 does not exist",
-                ));
-            }
             found => {
-                return Err(FileError::TooNew {
-                    path: path.to_path_buf(),
+                return Err(ron_file::unsupported_version(
+                    path,
                     found,
-                    supported: KIT_FORMAT_VERSION,
-                });
+                    KIT_FORMAT_VERSION,
+                ));
             }
         };
         if let Some(p) = validate::problems(&kit).into_iter().next() {

@@ -538,7 +538,7 @@ impl Costs<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::score::{Beat, Dynamic, ImpactLocation, PlayingMode, Roll};
+    use crate::score::{Beat, ImpactLocation, Roll};
 
     /// Ticks in `s` seconds at the default 100 bpm and 960 ticks per quarter.
     fn ticks(s: f64) -> u64 {
@@ -546,16 +546,7 @@ mod tests {
     }
 
     fn beat(tick: u64, drum: usize) -> Beat {
-        Beat {
-            tick,
-            hand: Hand::Auto,
-            mode: PlayingMode::Legato,
-            dynamic: Dynamic::Mf,
-            drum,
-            pitch: None,
-            location: ImpactLocation::PlayingSpot,
-            roll: None,
-        }
+        Beat::plain(tick, drum)
     }
 
     /// A score of auto beats at (tick, drum).

@@ -235,6 +235,20 @@ pub struct Beat {
 }
 
 impl Beat {
+    /// A plain stroke: legato, mf, at the playing spot, hand left to the sticking.
+    pub fn plain(tick: u64, drum: usize) -> Beat {
+        Beat {
+            tick,
+            hand: Hand::Auto,
+            mode: PlayingMode::Legato,
+            dynamic: Dynamic::Mf,
+            drum,
+            pitch: None,
+            location: ImpactLocation::PlayingSpot,
+            roll: None,
+        }
+    }
+
     /// The pitch sounded: the beat's own or the drum's kit tuning.
     pub fn sounding_pitch(&self, kit: &Kit) -> Pitch {
         self.pitch.unwrap_or(kit.drums[self.drum].tuning)
@@ -344,19 +358,12 @@ impl Score {
         let mut score: Score = match probe.version {
             1 => migrate::from_v1(ron_file::parse(path, text)?),
             2 => ron_file::parse(path, text)?,
-            0 => {
-                return Err(FileError::invalid(
-                    path,
-                    "version",
-                    "format version 0 does not exist",
-                ));
-            }
             found => {
-                return Err(FileError::TooNew {
-                    path: path.to_path_buf(),
+                return Err(ron_file::unsupported_version(
+                    path,
                     found,
-                    supported: SCORE_FORMAT_VERSION,
-                });
+                    SCORE_FORMAT_VERSION,
+                ));
             }
         };
         score.sort_beats();

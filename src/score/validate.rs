@@ -131,19 +131,10 @@ pub fn problems(score: &Score, kit: &Kit) -> Vec<Problem> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::score::{Beat, PlayingMode, Roll};
+    use crate::score::{Beat, Roll};
 
     fn beat(tick: u64, drum: usize) -> Beat {
-        Beat {
-            tick,
-            hand: Hand::Auto,
-            mode: PlayingMode::Legato,
-            dynamic: Dynamic::Mf,
-            drum,
-            pitch: None,
-            location: ImpactLocation::PlayingSpot,
-            roll: None,
-        }
+        Beat::plain(tick, drum)
     }
 
     fn first_problem(score: &Score) -> String {
