@@ -2,6 +2,7 @@
 //! forward kinematics, and inverse kinematics for the arm chains.
 
 pub mod ik;
+pub mod model;
 pub mod skeleton;
 
 pub use skeleton::{JOINT_COUNT, Joint, Pose, Skeleton};
