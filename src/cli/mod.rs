@@ -5,6 +5,7 @@
 mod args;
 mod check;
 mod compose;
+mod evaluate;
 mod midi;
 mod mocap;
 mod sticking;
@@ -96,6 +97,22 @@ pub enum Command {
         /// Seed of the choice among near-equal motion units.
         #[arg(long, default_value_t = 1)]
         seed: u64,
+    },
+    /// Compare the IK, ID and HIMC control pipelines on captured strokes of each playing
+    /// mode (seed 000 §3.3): tip RMS error per mode with its spread across trials.
+    Evaluate {
+        /// Trials per mode (randomised initial posture within 2° per joint, gains within ±10 %).
+        #[arg(long, default_value_t = 5)]
+        trials: usize,
+        /// Write the results as JSON.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Draw the Fig. 5 comparison per mode as PNGs into this folder.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// The motion database folder.
+        #[arg(long, default_value = "mocap")]
+        db: PathBuf,
     },
     /// Motion-capture database: build, inspect, import.
     #[command(subcommand)]
@@ -221,6 +238,14 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             db,
             seed,
         }) => compose::run(&score, &db, &output, plot.as_deref(), seed).map(|()| ExitCode::SUCCESS),
+        Some(Command::Evaluate {
+            trials,
+            json,
+            plot,
+            db,
+        }) => {
+            evaluate::run(&db, trials, json.as_deref(), plot.as_deref()).map(|()| ExitCode::SUCCESS)
+        }
         Some(Command::Mocap(MocapCommand::Synth { output, seed })) => {
             mocap::synth(&output, seed).map(|()| ExitCode::SUCCESS)
         }

@@ -1,0 +1,236 @@
+//! Joint-space control of the simulated body (seed 000 §3.2): PD torques
+//! τ = ks·e − kd·(ω − ω_t) (eq. 2) toward target joint rotations, with the rotation error
+//! e = log(q⁻¹·q_t) as a rotation vector in the joint's child frame, per-joint gains and
+//! torque limits; gains scaled to each joint's effective inertia; gravity compensation;
+//! and joint limits as ellipsoids in the quaternion tangent space (seed 000 Alg. 1),
+//! enforced by corrective torques.
+
+use super::dynamics::{Dynamics, State};
+use super::skeleton::{JOINT_COUNT, Pose};
+use crate::mocap::limits::{JointLimit, quat_log};
+use glam::{DMat3, DQuat, DVec3};
+
+/// PD gains and torque limits per joint.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Gains {
+    /// Stiffness ks, N·m/rad.
+    pub stiffness: [f64; JOINT_COUNT],
+    /// Damping kd, N·m·s/rad.
+    pub damping: [f64; JOINT_COUNT],
+    /// Largest torque a joint may apply, N·m.
+    pub max_torque: [f64; JOINT_COUNT],
+}
+
+/// Natural frequency of each joint's PD loop, Hz: the trunk, neck and head slow, the arms
+/// and sticks fast enough to follow a stroke.
+pub const DEFAULT_FREQUENCY_HZ: [f64; JOINT_COUNT] = [
+    4.0, 4.0, 4.0, 14.0, 16.0, 18.0, 20.0, 14.0, 16.0, 18.0, 20.0,
+];
+
+impl Gains {
+    /// Gains giving each joint the natural frequency `freq_hz` and damping ratio `zeta`
+    /// for its effective inertia at `state`: I_eff = 1/λ_max of the joint's 3×3 block of
+    /// M⁻¹ (the smallest inertia the joint can see, so explicit integration stays stable;
+    /// gains from diag(M) overestimate it and blow up, guide §5).
+    pub fn from_effective_inertia(
+        dynamics: &mut Dynamics,
+        state: &State,
+        freq_hz: &[f64; JOINT_COUNT],
+        zeta: f64,
+        max_torque: f64,
+    ) -> Gains {
+        let m = dynamics.mass_matrix(state);
+        let inv = invert(&m, 3 * JOINT_COUNT);
+        let mut stiffness = [0.0; JOINT_COUNT];
+        let mut damping = [0.0; JOINT_COUNT];
+        for j in 0..JOINT_COUNT {
+            let block = DMat3::from_cols_array_2d(&std::array::from_fn(|c| {
+                std::array::from_fn(|r| inv[(3 * j + r) * 3 * JOINT_COUNT + 3 * j + c])
+            }));
+            let (values, _) = crate::mocap::limits::symmetric_eigen(block);
+            let inertia = 1.0 / values[0].max(1e-12);
+            let w = std::f64::consts::TAU * freq_hz[j];
+            stiffness[j] = inertia * w * w;
+            damping[j] = 2.0 * zeta * inertia * w;
+        }
+        Gains {
+            stiffness,
+            damping,
+            max_torque: [max_torque; JOINT_COUNT],
+        }
+    }
+
+    /// The same gains with every stiffness and damping multiplied by `factor[j]`.
+    pub fn scaled(&self, factor: &[f64; JOINT_COUNT]) -> Gains {
+        Gains {
+            stiffness: std::array::from_fn(|j| self.stiffness[j] * factor[j]),
+            damping: std::array::from_fn(|j| self.damping[j] * factor[j]),
+            max_torque: self.max_torque,
+        }
+    }
+}
+
+/// Rotation error from `q` to `target` as a rotation vector in the child frame, rad.
+pub fn rotation_error(q: DQuat, target: DQuat) -> DVec3 {
+    let d = (q.inverse() * target).normalize();
+    let d = if d.w < 0.0 { -d } else { d };
+    d.to_scaled_axis()
+}
+
+/// PD torques toward `target` (with target angular velocities `target_w`, child frames),
+/// plus feed-forward `bias`, each clamped to its joint's torque limit.
+pub fn pd_torques(
+    gains: &Gains,
+    state: &State,
+    target: &Pose,
+    target_w: &[DVec3; JOINT_COUNT],
+    bias: &[DVec3; JOINT_COUNT],
+) -> [DVec3; JOINT_COUNT] {
+    std::array::from_fn(|j| {
+        let e = rotation_error(state.q[j], target[j]);
+        let tau = e * gains.stiffness[j] - (state.w[j] - target_w[j]) * gains.damping[j] + bias[j];
+        tau.clamp_length_max(gains.max_torque[j])
+    })
+}
+
+/// Torques that hold `pose` still against gravity: τ_g = −M·q̈₀ with q̈₀ the passive
+/// acceleration at rest.
+pub fn gravity_compensation(dynamics: &mut Dynamics, pose: &Pose) -> [DVec3; JOINT_COUNT] {
+    let state = State {
+        q: *pose,
+        w: [DVec3::ZERO; JOINT_COUNT],
+    };
+    let acc = dynamics.accelerations(&state, &[DVec3::ZERO; JOINT_COUNT], &[]);
+    let m = dynamics.mass_matrix(&state);
+    let n = 3 * JOINT_COUNT;
+    std::array::from_fn(|j| {
+        let row = |r: usize| {
+            -(0..n)
+                .map(|c| m[r * n + c] * acc[c / 3][c % 3])
+                .sum::<f64>()
+        };
+        DVec3::new(row(3 * j), row(3 * j + 1), row(3 * j + 2))
+    })
+}
+
+/// Corrective torques pushing joints back inside their limit ellipsoids: beyond the
+/// ellipsoid (radius r > 1) a spring of `stiffness` (N·m per unit of radius) toward the
+/// mean, damped by `damping` (N·m·s/rad) along that direction.
+pub fn limit_torques(
+    limits: &[Option<JointLimit>; JOINT_COUNT],
+    state: &State,
+    stiffness: f64,
+    damping: f64,
+) -> [DVec3; JOINT_COUNT] {
+    std::array::from_fn(|j| {
+        let Some(limit) = &limits[j] else {
+            return DVec3::ZERO;
+        };
+        let r = limit.radius(state.q[j]);
+        if r <= 1.0 {
+            return DVec3::ZERO;
+        }
+        let toward_mean = rotation_error(state.q[j], limit.mean).normalize_or_zero();
+        let closing = state.w[j].dot(toward_mean);
+        toward_mean * (stiffness * (r - 1.0) - damping * closing.min(0.0))
+    })
+}
+
+/// Half-angle log of each joint relative to `mean` (for checking limits).
+pub fn tangent(q: DQuat, mean: DQuat) -> DVec3 {
+    quat_log(mean.inverse() * q)
+}
+
+/// Invert a dense n×n matrix (row-major) by Gauss–Jordan elimination with partial
+/// pivoting.
+fn invert(m: &[f64], n: usize) -> Vec<f64> {
+    let mut a = m.to_vec();
+    let mut inv: Vec<f64> = (0..n * n)
+        .map(|k| f64::from(u8::from(k / n == k % n)))
+        .collect();
+    for col in 0..n {
+        let pivot = (col..n)
+            .max_by(|&x, &y| a[x * n + col].abs().total_cmp(&a[y * n + col].abs()))
+            .unwrap_or(col);
+        for k in 0..n {
+            a.swap(col * n + k, pivot * n + k);
+            inv.swap(col * n + k, pivot * n + k);
+        }
+        let d = a[col * n + col];
+        let d = if d.abs() < 1e-300 { 1e-300 } else { d };
+        for k in 0..n {
+            a[col * n + k] /= d;
+            inv[col * n + k] /= d;
+        }
+        for row in 0..n {
+            if row != col {
+                let f = a[row * n + col];
+                if f != 0.0 {
+                    for k in 0..n {
+                        a[row * n + k] -= f * a[col * n + k];
+                        inv[row * n + k] -= f * inv[col * n + k];
+                    }
+                }
+            }
+        }
+    }
+    inv
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::body::model::BodyModel;
+    use crate::body::skeleton::Joint;
+
+    /// Dense inversion: M·M⁻¹ = I on the body's mass matrix.
+    #[test]
+    fn inverse_of_mass_matrix() {
+        let mut dynamics = Dynamics::new(BodyModel::default());
+        let m = dynamics.mass_matrix(&State::rest());
+        let n = 33;
+        let inv = invert(&m, n);
+        for r in 0..n {
+            for c in 0..n {
+                let v: f64 = (0..n).map(|k| m[r * n + k] * inv[k * n + c]).sum();
+                assert!(
+                    (v - f64::from(u8::from(r == c))).abs() < 1e-8,
+                    "({r},{c}) = {v}"
+                );
+            }
+        }
+    }
+
+    /// PD with gravity compensation holds a bent-arm pose and settles onto a new target
+    /// within 1° in 1 s of simulation at 10 kHz.
+    #[test]
+    fn pd_settles_to_target() {
+        let mut dynamics = Dynamics::new(BodyModel::default());
+        let mut start = crate::body::skeleton::REST;
+        start[Joint::ShoulderR.index()] = DQuat::from_rotation_x(0.5);
+        start[Joint::ElbowR.index()] = DQuat::from_rotation_x(1.2);
+        let mut target = start;
+        target[Joint::ShoulderR.index()] = DQuat::from_rotation_x(0.8);
+        target[Joint::WristR.index()] = DQuat::from_rotation_x(-0.4);
+        let mut state = State {
+            q: start,
+            w: [DVec3::ZERO; JOINT_COUNT],
+        };
+        let gains =
+            Gains::from_effective_inertia(&mut dynamics, &state, &DEFAULT_FREQUENCY_HZ, 1.0, 200.0);
+        let bias = gravity_compensation(&mut dynamics, &target);
+        for _ in 0..10_000 {
+            let tau = pd_torques(&gains, &state, &target, &[DVec3::ZERO; JOINT_COUNT], &bias);
+            dynamics.step(&mut state, &tau, &[], 1e-4);
+        }
+        for j in 0..JOINT_COUNT {
+            let err = rotation_error(state.q[j], target[j]).length();
+            assert!(
+                err < 1f64.to_radians(),
+                "{:?}: {} deg",
+                Joint::ALL[j],
+                err.to_degrees()
+            );
+        }
+    }
+}

@@ -1,0 +1,247 @@
+//! Driving the simulated body along a reference motion with one of the three control
+//! pipelines of seed 000 (Fig. 1):
+//!
+//! * **IK** — kinematic only: each task step, inverse kinematics brings both tips to
+//!   their targets; no dynamics.
+//! * **ID** — PD inverse dynamics tracking the captured joint rotations (seed 000 eq. 2),
+//!   with gravity compensation.
+//! * **HIMC** — hybrid inverse motion control (seed 000 Alg. 2): each task step IK turns
+//!   the tip targets into joint targets; *every simulation step* a damped-least-squares
+//!   step from the simulated pose toward the tip targets corrects them (IK nested in PD),
+//!   and PD with gravity compensation tracks the result.
+//!
+//! Task rate 250 Hz and simulation rate 10 kHz by default (40 sub-steps). The run stops
+//! with an error naming the time if the state becomes non-finite or diverges.
+
+use super::control::{Gains, gravity_compensation, pd_torques, rotation_error};
+use super::dynamics::{Dynamics, State};
+use super::ik::{self, IkParams};
+use super::model::BodyModel;
+use super::skeleton::{JOINT_COUNT, Joint, Pose};
+use crate::kit::Side;
+use glam::{DQuat, DVec3};
+
+/// A control pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pipeline {
+    Ik,
+    Id,
+    Himc,
+}
+
+impl Pipeline {
+    /// Lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Pipeline::Ik => "ik",
+            Pipeline::Id => "id",
+            Pipeline::Himc => "himc",
+        }
+    }
+}
+
+/// Simulation settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimParams {
+    /// Physics rate, Hz.
+    pub sim_hz: f64,
+    /// Natural frequency of each joint's PD loop, Hz.
+    pub frequency_hz: [f64; JOINT_COUNT],
+    /// Damping ratio of the PD loops.
+    pub zeta: f64,
+    /// Torque limit of every joint, N·m.
+    pub max_torque: f64,
+    /// The IK solver (method, damping, weights).
+    pub ik: IkParams,
+    /// Fraction of the per-step Cartesian correction HIMC adds to its joint targets.
+    pub correction_gain: f64,
+    /// Angular speed beyond which the simulation counts as diverged, rad/s.
+    pub max_angular_speed: f64,
+}
+
+impl Default for SimParams {
+    fn default() -> Self {
+        SimParams {
+            sim_hz: 10_000.0,
+            frequency_hz: super::control::DEFAULT_FREQUENCY_HZ,
+            zeta: 1.0,
+            max_torque: 300.0,
+            ik: IkParams {
+                tolerance_m: 1e-5,
+                max_iterations: 30,
+                weights: [0.1, 0.5, 0.8, 1.0, 0.8],
+                use_trunk: true,
+                reference_gain: 0.2,
+                ..IkParams::default()
+            },
+            correction_gain: 1.0,
+            max_angular_speed: 500.0,
+        }
+    }
+}
+
+/// What to follow: task-rate samples of both tips, and the joint rotations if known.
+#[derive(Clone, Debug)]
+pub struct Reference {
+    /// Task rate, Hz.
+    pub rate_hz: f64,
+    /// Tip targets per sample, [left, right], m.
+    pub tips: [Vec<DVec3>; 2],
+    /// Joint rotations per sample (needed by ID; HIMC pulls its IK toward them).
+    pub poses: Option<Vec<Pose>>,
+}
+
+/// What the body did, at the task rate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Motion {
+    pub rate_hz: f64,
+    /// Tip positions per sample, [left, right], m.
+    pub tips: [Vec<DVec3>; 2],
+    /// Joint rotations per sample.
+    pub poses: Vec<Pose>,
+}
+
+/// The simulation stopped.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("the simulation {what} at {time_s:.4} s")]
+pub struct Diverged {
+    pub time_s: f64,
+    pub what: String,
+}
+
+/// Follow `reference` with `pipeline`, starting from `initial` at rest, with `gains_scale`
+/// multiplying each joint's PD gains (1 = nominal).
+pub fn simulate(
+    model: &BodyModel,
+    reference: &Reference,
+    pipeline: Pipeline,
+    params: &SimParams,
+    initial: &Pose,
+    gains_scale: &[f64; JOINT_COUNT],
+) -> Result<Motion, Diverged> {
+    let n = reference.tips[0].len();
+    let skeleton = &model.skeleton;
+    let ik_pose = |start: &Pose, k: usize, pull: Option<&Pose>| {
+        let mut pose = *start;
+        for side in [Side::Left, Side::Right] {
+            let target = reference.tips[crate::mocap::db::side_index(side)][k];
+            pose = ik::solve(
+                skeleton,
+                &pose,
+                side,
+                target,
+                pull.or(Some(start)),
+                &params.ik,
+            )
+            .pose;
+        }
+        pose
+    };
+    let mut motion = Motion {
+        rate_hz: reference.rate_hz,
+        tips: [Vec::with_capacity(n), Vec::with_capacity(n)],
+        poses: Vec::with_capacity(n),
+    };
+    let record = |motion: &mut Motion, pose: &Pose| {
+        let frames = skeleton.forward(pose);
+        motion.tips[0].push(frames.tip(Side::Left));
+        motion.tips[1].push(frames.tip(Side::Right));
+        motion.poses.push(*pose);
+    };
+    if pipeline == Pipeline::Ik {
+        let mut pose = *initial;
+        for k in 0..n {
+            pose = ik_pose(&pose, k, reference.poses.as_ref().map(|p| &p[k]));
+            record(&mut motion, &pose);
+        }
+        return Ok(motion);
+    }
+    let mut dynamics = Dynamics::new(model.clone());
+    let mut state = State {
+        q: *initial,
+        w: [DVec3::ZERO; JOINT_COUNT],
+    };
+    let gains = Gains::from_effective_inertia(
+        &mut dynamics,
+        &state,
+        &params.frequency_hz,
+        params.zeta,
+        params.max_torque,
+    )
+    .scaled(gains_scale);
+    let substeps = (params.sim_hz / reference.rate_hz).round().max(1.0) as usize;
+    let dt = 1.0 / (reference.rate_hz * substeps as f64);
+    // Joint targets at the task rate.
+    let targets: Vec<Pose> = match pipeline {
+        Pipeline::Id => reference.poses.clone().ok_or_else(|| Diverged {
+            time_s: 0.0,
+            what: "cannot run ID without captured joint rotations".into(),
+        })?,
+        _ => {
+            let mut pose = *initial;
+            (0..n)
+                .map(|k| {
+                    pose = ik_pose(&pose, k, reference.poses.as_ref().map(|p| &p[k]));
+                    pose
+                })
+                .collect()
+        }
+    };
+    let one_step = IkParams {
+        max_iterations: 1,
+        tolerance_m: 0.0,
+        reference_gain: 0.0,
+        ..params.ik.clone()
+    };
+    record(&mut motion, &state.q);
+    for k in 1..n {
+        let (from, to) = (&targets[k - 1], &targets[k]);
+        let target_w: [DVec3; JOINT_COUNT] =
+            std::array::from_fn(|j| rotation_error(from[j], to[j]) * reference.rate_hz);
+        let bias = gravity_compensation(&mut dynamics, to);
+        for s in 1..=substeps {
+            let u = s as f64 / substeps as f64;
+            let mut goal: Pose = std::array::from_fn(|j| from[j].slerp(to[j], u));
+            if pipeline == Pipeline::Himc {
+                // IK nested in PD: a DLS step from the simulated pose toward the tip targets.
+                let mut corrected = state.q;
+                for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
+                    let target = reference.tips[h][k - 1].lerp(reference.tips[h][k], u);
+                    corrected = ik::solve(skeleton, &corrected, side, target, None, &one_step).pose;
+                }
+                for j in 0..JOINT_COUNT {
+                    let delta = rotation_error(state.q[j], corrected[j]) * params.correction_gain;
+                    goal[j] = (goal[j] * DQuat::from_scaled_axis(delta)).normalize();
+                }
+            }
+            let tau = pd_torques(&gains, &state, &goal, &target_w, &bias);
+            dynamics.step(&mut state, &tau, &[], dt);
+            let speed = state.w.iter().map(|w| w.length()).fold(0.0, f64::max);
+            if !state.is_finite() || speed > params.max_angular_speed {
+                let time_s = (k - 1) as f64 / reference.rate_hz + s as f64 * dt;
+                let joint = state
+                    .w
+                    .iter()
+                    .position(|w| !w.is_finite() || w.length() > params.max_angular_speed)
+                    .map_or("?", |j| Joint::ALL[j].name());
+                return Err(Diverged {
+                    time_s,
+                    what: format!("diverged ({joint} spinning at {speed:.0} rad/s)"),
+                });
+            }
+        }
+        record(&mut motion, &state.q);
+    }
+    Ok(motion)
+}
+
+/// RMS distance between two equally long point sequences, m.
+pub fn rms_error(a: &[DVec3], b: &[DVec3]) -> f64 {
+    let n = a.len().min(b.len()).max(1);
+    (a.iter()
+        .zip(b)
+        .map(|(x, y)| x.distance_squared(*y))
+        .sum::<f64>()
+        / n as f64)
+        .sqrt()
+}

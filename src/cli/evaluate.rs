@@ -1,0 +1,155 @@
+//! `timpanist evaluate`: the seed 000 §3.3 comparison of the IK, ID and HIMC pipelines on
+//! captured strokes of each playing mode — a table, optional JSON, optional Fig. 5 plots.
+
+use crate::body::control::rotation_error;
+use crate::body::evaluate::{self, EvalParams, Report};
+use crate::body::model::BodyModel;
+use crate::body::sim::Motion;
+use crate::body::skeleton::{Joint, REST};
+use crate::io::plot::{Figure, Panel, Series};
+use crate::io::ron_file;
+use crate::mocap::db::MotionDb;
+use crate::rng::Rng;
+use crate::score::PlayingMode;
+use plotters::style::RGBColor;
+use std::path::Path;
+
+/// Run the evaluation and report it.
+pub fn run(
+    db_dir: &Path,
+    trials: usize,
+    json: Option<&Path>,
+    plot: Option<&Path>,
+) -> anyhow::Result<()> {
+    let db = MotionDb::load(db_dir)?;
+    let model = BodyModel::default();
+    let params = EvalParams {
+        trials: trials.max(1),
+        ..EvalParams::default()
+    };
+    let started = std::time::Instant::now();
+    let report = evaluate::evaluate(&db, &model, &params).map_err(anyhow::Error::msg)?;
+    let took = started.elapsed().as_secs_f64();
+    print_table(&report);
+    let simulated: f64 = PlayingMode::ALL
+        .iter()
+        .flat_map(|&m| evaluate::units_for(&db, m, params.strokes_per_mode))
+        .map(|u| (u.end - u.start) as f64 / db.takes[u.take].rate_hz)
+        .sum::<f64>()
+        * 2.0
+        * params.trials as f64;
+    println!(
+        "simulated {simulated:.1} s of ID and HIMC at {} Hz in {took:.1} s wall ({:.0}× real time, IK included)",
+        params.sim.sim_hz,
+        simulated / took
+    );
+    if let Some(path) = json {
+        let text = serde_json::to_string_pretty(&report)?;
+        ron_file::write_atomic(path, text.as_bytes())?;
+    }
+    if let Some(dir) = plot {
+        std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
+        for mode in PlayingMode::ALL {
+            let Some(unit) = evaluate::units_for(&db, mode, 1).into_iter().next() else {
+                continue;
+            };
+            let reference = evaluate::reference_of(&db, unit);
+            let motions = evaluate::trial(&model, &reference, &params, &mut Rng::new(params.seed))
+                .map_err(anyhow::Error::msg)?;
+            let captured = Motion {
+                rate_hz: reference.rate_hz,
+                tips: reference.tips.clone(),
+                poses: reference.poses.clone().unwrap_or_default(),
+            };
+            let path = dir.join(format!("fig5-{}.png", mode.name().replace(' ', "-")));
+            fig5(&model, mode, &captured, &motions)
+                .save_png(&path)
+                .map_err(anyhow::Error::msg)?;
+            println!("wrote {}", path.display());
+        }
+    }
+    Ok(())
+}
+
+fn print_table(report: &Report) {
+    println!(
+        "{:<16} {:>11} {:>16} {:>16} {:>16} {:>10}",
+        "mode", "amplitude m", "IK rms ± sd mm", "ID rms ± sd mm", "HIMC rms ± sd mm", "HIMC/ampl"
+    );
+    for m in &report.modes {
+        let s =
+            |e: &evaluate::ErrorStat| format!("{:.2} ± {:.2}", e.rms_e_m * 1e3, e.rms_sd_m * 1e3);
+        println!(
+            "{:<16} {:>11.3} {:>16} {:>16} {:>16} {:>9.2}%",
+            m.mode,
+            m.amplitude_m,
+            s(&m.ik),
+            s(&m.id),
+            s(&m.himc),
+            100.0 * m.himc.rms_e_m / m.amplitude_m
+        );
+    }
+}
+
+const CAPTURED: RGBColor = RGBColor(0, 0, 0);
+const COLOURS: [RGBColor; 3] = [
+    RGBColor(40, 160, 60),
+    RGBColor(40, 90, 220),
+    RGBColor(220, 40, 40),
+];
+
+/// Seed 000 Fig. 5 for one mode: right-arm flexion angles and heights, captured vs each pipeline.
+fn fig5(model: &BodyModel, mode: PlayingMode, captured: &Motion, motions: &[Motion; 3]) -> Figure {
+    let all: Vec<(&str, RGBColor, &Motion)> = std::iter::once(("captured", CAPTURED, captured))
+        .chain(
+            ["IK", "ID", "HIMC"]
+                .into_iter()
+                .zip(COLOURS)
+                .zip(motions)
+                .map(|((n, c), m)| (n, c, m)),
+        )
+        .collect();
+    let flexion = |joint: Joint| {
+        move |m: &Motion, k: usize| {
+            rotation_error(REST[joint.index()], m.poses[k][joint.index()])
+                .x
+                .to_degrees()
+        }
+    };
+    let height = |joint: Option<Joint>| {
+        move |m: &Motion, k: usize| match joint {
+            Some(j) => model.skeleton.forward(&m.poses[k]).position[j.index()].z,
+            None => m.tips[1][k].z,
+        }
+    };
+    let panel = |label: &str, f: &dyn Fn(&Motion, usize) -> f64| Panel {
+        y_label: label.into(),
+        series: all
+            .iter()
+            .map(|(name, colour, m)| Series {
+                label: (*name).into(),
+                colour: *colour,
+                points: (0..m.poses.len().min(m.tips[1].len()))
+                    .map(|k| (k as f64 / m.rate_hz, f(m, k)))
+                    .collect(),
+            })
+            .collect(),
+        markers: Vec::new(),
+    };
+    Figure {
+        title: format!(
+            "{}: captured vs IK / ID / HIMC (seed 000 Fig. 5)",
+            mode.name()
+        ),
+        panels: vec![
+            panel("wrist flexion (deg)", &flexion(Joint::WristR)),
+            panel("elbow flexion (deg)", &flexion(Joint::ElbowR)),
+            panel("shoulder flexion (deg)", &flexion(Joint::ShoulderR)),
+            panel("tip height (m)", &height(None)),
+            panel("wrist height (m)", &height(Some(Joint::WristR))),
+            panel("elbow height (m)", &height(Some(Joint::ElbowR))),
+        ],
+        guides: Vec::new(),
+        size: (1200, 1600),
+    }
+}
