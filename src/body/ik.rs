@@ -8,7 +8,7 @@
 //! A step ω (world frame) is applied to a joint's local rotation as
 //! q ← (R_parent⁻¹·exp(ω)·R_parent)·q.
 
-use super::skeleton::{Joint, Pose, Skeleton};
+use super::skeleton::{JOINT_COUNT, Joint, Pose, Skeleton};
 use crate::kit::Side;
 use glam::{DMat3, DQuat, DVec3};
 
@@ -79,12 +79,18 @@ pub fn solve(
     params: &IkParams,
 ) -> IkResult {
     let arm = Joint::arm(side);
-    let chain: Vec<(Joint, f64)> = params
-        .use_trunk
-        .then_some((Joint::Trunk, params.weights[0]))
-        .into_iter()
-        .chain(arm.iter().zip(&params.weights[1..]).map(|(&j, &w)| (j, w)))
-        .collect();
+    // Fixed-size buffers: the solver runs every simulation step and must not allocate.
+    let mut chain = [(Joint::Trunk, 0.0); 5];
+    let mut len = 0;
+    if params.use_trunk {
+        chain[0] = (Joint::Trunk, params.weights[0]);
+        len = 1;
+    }
+    for (&j, &w) in arm.iter().zip(&params.weights[1..]) {
+        chain[len] = (j, w);
+        len += 1;
+    }
+    let chain = &chain[..len];
     let mut pose = *start;
     let mut iterations = 0;
     let mut error = f64::INFINITY;
@@ -98,13 +104,14 @@ pub fn solve(
         }
         iterations += 1;
         // Columns: three world axes per joint.
-        let columns: Vec<(usize, DVec3, DVec3, f64)> = chain
-            .iter()
-            .flat_map(|&(j, w)| {
-                let r = tip - frames.position[j.index()];
-                [DVec3::X, DVec3::Y, DVec3::Z].map(move |a| (j.index(), a, a.cross(r), w))
-            })
-            .collect();
+        let mut buffer = [(0usize, DVec3::ZERO, DVec3::ZERO, 0.0); 15];
+        for (slot, &(j, w)) in buffer.chunks_mut(3).zip(chain) {
+            let r = tip - frames.position[j.index()];
+            for (column, a) in slot.iter_mut().zip([DVec3::X, DVec3::Y, DVec3::Z]) {
+                *column = (j.index(), a, a.cross(r), w);
+            }
+        }
+        let columns = &buffer[..3 * chain.len()];
         let jwjt = columns
             .iter()
             .fold(DMat3::ZERO, |m, &(_, _, c, w)| m + outer(c, c) * w);
@@ -118,14 +125,14 @@ pub fn solve(
                 safe_solve(jwjt + DMat3::IDENTITY * params.damping_m.powi(2), e, 0.0)
             }
         };
-        let mut step: Vec<DVec3> = vec![DVec3::ZERO; pose.len()];
-        for &(i, a, c, w) in &columns {
+        let mut step = [DVec3::ZERO; JOINT_COUNT];
+        for &(i, a, c, w) in columns {
             step[i] += a * (w * c.dot(y));
         }
         if let Some(reference) = reference {
-            add_null_space_pull(&mut step, &columns, &frames, &pose, reference, jwjt, params);
+            add_null_space_pull(&mut step, columns, &frames, &pose, reference, jwjt, params);
         }
-        for &(j, _) in &chain {
+        for &(j, _) in chain {
             let i = j.index();
             let mut w = step[i];
             if w.length() > params.max_step_rad {
@@ -157,7 +164,7 @@ fn add_null_space_pull(
     jwjt: DMat3,
     params: &IkParams,
 ) {
-    let mut z = vec![DVec3::ZERO; pose.len()];
+    let mut z = [DVec3::ZERO; JOINT_COUNT];
     for &(i, _, _, w) in columns.iter().step_by(3) {
         let joint = super::skeleton::Joint::ALL[i];
         let local = (reference[i] * pose[i].inverse()).normalize();
