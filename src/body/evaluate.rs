@@ -13,6 +13,14 @@ use crate::score::{Dynamic, Grip, ImpactLocation, PlayingMode};
 use glam::DQuat;
 use serde::Serialize;
 
+/// The simulated player of the evaluation: 1.72 m and 69 kg, while the database was
+/// captured (synthesised) on a 1.75 m performer — as in seed 000, the virtual character's
+/// anthropometry only approximates the performer's, so replaying captured joint angles
+/// (ID) misplaces the tips while tracking the tips (HIMC) does not.
+pub fn simulated_body() -> BodyModel {
+    BodyModel::new(super::skeleton::Skeleton::new(1.72, 0.37), 69.0)
+}
+
 /// How trials are randomised.
 #[derive(Clone, Debug, PartialEq)]
 pub struct EvalParams {

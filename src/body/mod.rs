@@ -2,6 +2,7 @@
 //! forward kinematics, and inverse kinematics for the arm chains.
 
 pub mod control;
+pub mod dynamics;
 pub mod evaluate;
 pub mod ik;
 pub mod model;

@@ -3,23 +3,25 @@
 //!
 //! * **IK** — kinematic only: each task step, inverse kinematics brings both tips to
 //!   their targets; no dynamics.
-//! * **ID** — PD inverse dynamics tracking the captured joint rotations (seed 000 eq. 2),
-//!   with gravity compensation.
+//! * **ID** — PD inverse dynamics tracking the captured joint rotations (seed 000 eq. 2):
+//!   PD on the joint error plus the feed-forward torques of the target motion (gravity,
+//!   velocity terms and M·q̈, once per task step).
 //! * **HIMC** — hybrid inverse motion control (seed 000 Alg. 2): each task step IK turns
-//!   the tip targets into joint targets; *every simulation step* a damped-least-squares
-//!   step from the simulated pose toward the tip targets corrects them (IK nested in PD),
-//!   and PD with gravity compensation tracks the result.
+//!   the tip targets into joint targets (its redundancy pulled toward the captured
+//!   posture where known); *every simulation step* damped least squares from the
+//!   simulated pose toward the tip targets, Δq = J⁺(X_t − X), gives the PD target (IK
+//!   nested in PD), tracked with the same PD and feed-forward as ID.
 //!
 //! Task rate 250 Hz and simulation rate 10 kHz by default (40 sub-steps). The run stops
 //! with an error naming the time if the state becomes non-finite or diverges.
 
-use super::control::{Gains, gravity_compensation, pd_torques, rotation_error};
+use super::control::{Gains, inverse_dynamics, pd_torques, rotation_error};
 use super::dynamics::{Dynamics, State};
 use super::ik::{self, IkParams};
 use super::model::BodyModel;
 use super::skeleton::{JOINT_COUNT, Joint, Pose};
 use crate::kit::Side;
-use glam::{DQuat, DVec3};
+use glam::DVec3;
 
 /// A control pipeline.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -53,8 +55,8 @@ pub struct SimParams {
     pub max_torque: f64,
     /// The IK solver (method, damping, weights).
     pub ik: IkParams,
-    /// Fraction of the per-step Cartesian correction HIMC adds to its joint targets.
-    pub correction_gain: f64,
+    /// DLS iterations HIMC runs every simulation step.
+    pub nested_iterations: usize,
     /// Angular speed beyond which the simulation counts as diverged, rad/s.
     pub max_angular_speed: f64,
 }
@@ -74,7 +76,7 @@ impl Default for SimParams {
                 reference_gain: 0.2,
                 ..IkParams::default()
             },
-            correction_gain: 1.0,
+            nested_iterations: 2,
             max_angular_speed: 500.0,
         }
     }
@@ -121,8 +123,10 @@ pub fn simulate(
 ) -> Result<Motion, Diverged> {
     let n = reference.tips[0].len();
     let skeleton = &model.skeleton;
+    // IK warm-starts from the captured posture when there is one (so it only corrects what
+    // the tips need), else from the previous solution.
     let ik_pose = |start: &Pose, k: usize, pull: Option<&Pose>| {
-        let mut pose = *start;
+        let mut pose = *pull.unwrap_or(start);
         for side in [Side::Left, Side::Right] {
             let target = reference.tips[crate::mocap::db::side_index(side)][k];
             pose = ik::solve(
@@ -187,31 +191,56 @@ pub fn simulate(
                 .collect()
         }
     };
-    let one_step = IkParams {
-        max_iterations: 1,
-        tolerance_m: 0.0,
-        reference_gain: 0.0,
+    let nested = IkParams {
+        max_iterations: params.nested_iterations,
+        tolerance_m: 1e-6,
+        reference_gain: 1.0,
         ..params.ik.clone()
     };
+    // Target joint velocities (over each task interval) and accelerations.
+    let velocity = |k: usize| -> [DVec3; JOINT_COUNT] {
+        let k = k.clamp(1, n.max(2) - 1);
+        std::array::from_fn(|j| {
+            rotation_error(targets[k - 1][j], targets[k][j]) * reference.rate_hz
+        })
+    };
+    state.w = velocity(1);
     record(&mut motion, &state.q);
     for k in 1..n {
         let (from, to) = (&targets[k - 1], &targets[k]);
-        let target_w: [DVec3; JOINT_COUNT] =
-            std::array::from_fn(|j| rotation_error(from[j], to[j]) * reference.rate_hz);
-        let bias = gravity_compensation(&mut dynamics, to);
+        let target_w = velocity(k);
+        let next_w = velocity(k + 1);
+        let qdd: [DVec3; JOINT_COUNT] =
+            std::array::from_fn(|j| (next_w[j] - target_w[j]) * reference.rate_hz);
+        // Feed-forward inverse dynamics of the target motion, once per task step.
+        let bias = inverse_dynamics(
+            &mut dynamics,
+            &State {
+                q: *from,
+                w: target_w,
+            },
+            &qdd,
+        );
         for s in 1..=substeps {
             let u = s as f64 / substeps as f64;
             let mut goal: Pose = std::array::from_fn(|j| from[j].slerp(to[j], u));
             if pipeline == Pipeline::Himc {
-                // IK nested in PD: a DLS step from the simulated pose toward the tip targets.
-                let mut corrected = state.q;
+                // IK nested in PD (seed 000 Alg. 2): every step, solve the tips' targets from
+                // the simulated pose, Δq = J⁺(X_t − X(q)), with the redundancy pulled toward
+                // the task-rate IK posture; PD then tracks that.
+                let reference_pose = goal;
+                goal = state.q;
                 for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
                     let target = reference.tips[h][k - 1].lerp(reference.tips[h][k], u);
-                    corrected = ik::solve(skeleton, &corrected, side, target, None, &one_step).pose;
-                }
-                for j in 0..JOINT_COUNT {
-                    let delta = rotation_error(state.q[j], corrected[j]) * params.correction_gain;
-                    goal[j] = (goal[j] * DQuat::from_scaled_axis(delta)).normalize();
+                    goal = ik::solve(
+                        skeleton,
+                        &goal,
+                        side,
+                        target,
+                        Some(&reference_pose),
+                        &nested,
+                    )
+                    .pose;
                 }
             }
             let tau = pd_torques(&gains, &state, &goal, &target_w, &bias);

@@ -22,7 +22,7 @@ pub fn run(
     plot: Option<&Path>,
 ) -> anyhow::Result<()> {
     let db = MotionDb::load(db_dir)?;
-    let model = BodyModel::default();
+    let model = evaluate::simulated_body();
     let params = EvalParams {
         trials: trials.max(1),
         ..EvalParams::default()
