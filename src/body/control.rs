@@ -237,7 +237,12 @@ mod tests {
         }
         for (j, (q, t)) in state.q.iter().zip(&target).enumerate() {
             let err = rotation_error(*q, *t).length();
-            assert!(err < 0.1f64.to_radians(), "{:?}: {} deg", Joint::ALL[j], err.to_degrees());
+            assert!(
+                err < 0.1f64.to_radians(),
+                "{:?}: {} deg",
+                Joint::ALL[j],
+                err.to_degrees()
+            );
         }
     }
 }

@@ -49,7 +49,7 @@ impl State {
 /// An external force applied at a point of a segment (e.g. the drum pushing a stick tip).
 #[derive(Clone, Copy, Debug)]
 pub struct ExternalForce {
-    /// The segment it acts on ([`Joint::index`]).
+    /// The segment it acts on ([`Joint::index`]; out of range panics).
     pub segment: usize,
     /// Point of application, performer frame, m.
     pub point_world: DVec3,
@@ -312,8 +312,8 @@ impl Dynamics {
     ) -> [DVec3; N] {
         self.kinematics(state);
         let s = &mut self.scratch;
+        s.ia = self.inertia;
         for i in 0..N {
-            s.ia[i] = self.inertia[i];
             s.pa[i] = s.v[i].cross_force(self.inertia[i].mul(s.v[i]));
         }
         for f in external {
@@ -369,9 +369,9 @@ impl Dynamics {
         dt: f64,
     ) {
         let qdd = self.accelerations(state, tau, external);
-        for i in 0..N {
-            state.w[i] += dt * qdd[i];
-            state.q[i] = (state.q[i] * DQuat::from_scaled_axis(state.w[i] * dt)).normalize();
+        for ((q, w), a) in state.q.iter_mut().zip(&mut state.w).zip(qdd) {
+            *w += dt * a;
+            *q = (*q * DQuat::from_scaled_axis(*w * dt)).normalize();
         }
     }
 
@@ -388,7 +388,8 @@ impl Dynamics {
         (kinetic, potential)
     }
 
-    /// World position (m) and velocity (m/s) of a point given in a segment's frame (m).
+    /// World position (m) and velocity (m/s) of a point given in a segment's frame (m);
+    /// `segment` is a [`Joint::index`].
     pub fn point_velocity(
         &mut self,
         state: &State,
@@ -435,10 +436,8 @@ impl Dynamics {
         };
         for i in 0..N {
             // Force on segment j's joint per unit acceleration of joint i: columns of F.
-            let mut f = [SpatialVec::ZERO; 3];
-            for (k, fk) in f.iter_mut().enumerate() {
-                *fk = SpatialVec::new(s.ia[i].a.col(k), s.ia[i].b.row(k));
-            }
+            let mut f: [SpatialVec; 3] =
+                std::array::from_fn(|k| SpatialVec::new(s.ia[i].a.col(k), s.ia[i].b.row(k)));
             set(i, i, s.ia[i].a);
             let mut j = i;
             while let Some(p) = self.parent[j] {
@@ -668,28 +667,19 @@ mod tests {
             force_world: force,
         }];
         let qdd = flatten(&dynamics.accelerations(&state, &[DVec3::ZERO; N], &external));
-        let jt = gradient(
+        let jacobian: Vec<DVec3> = gradient(
             &state,
             |s| dynamics.tip(s, Side::Right).0,
             |a, b| (a - b).to_array().to_vec(),
-        );
-        let accel = DVec3::from_slice(
-            &(0..3)
-                .map(|r| (0..DOF).map(|d| jt[d][r] * qdd[d]).sum())
-                .collect::<Vec<f64>>(),
-        );
+        )
+        .iter()
+        .map(|column| DVec3::from_slice(column))
+        .collect();
+        let j_times = |x: &[f64]| jacobian.iter().zip(x).map(|(c, x)| *c * *x).sum::<DVec3>();
+        let accel = j_times(&qdd);
         assert!(accel.dot(force) > 0.0);
-        let generalised: Vec<f64> = jt
-            .iter()
-            .map(|col| DVec3::from_slice(col).dot(force))
-            .collect();
-        let m = dynamics.mass_matrix(&state);
-        let y = solve(m, generalised);
-        let expected = DVec3::from_slice(
-            &(0..3)
-                .map(|r| (0..DOF).map(|d| jt[d][r] * y[d]).sum())
-                .collect::<Vec<f64>>(),
-        );
+        let generalised = jacobian.iter().map(|c| c.dot(force)).collect();
+        let expected = j_times(&solve(dynamics.mass_matrix(&state), generalised));
         assert!(
             (accel - expected).length() < 1e-6 * expected.length(),
             "{accel} vs {expected}"
@@ -715,11 +705,12 @@ mod tests {
         let qdd = dynamics.accelerations(&state, &tau, &external);
         let h = 1e-6;
         let mut total_energy = |sign: f64| {
-            let mut s = state.clone();
-            for i in 0..N {
-                s.q[i] = state.q[i] * DQuat::from_scaled_axis(sign * h * state.w[i]);
-                s.w[i] = state.w[i] + sign * h * qdd[i];
-            }
+            let s = State {
+                q: std::array::from_fn(|i| {
+                    state.q[i] * DQuat::from_scaled_axis(sign * h * state.w[i])
+                }),
+                w: std::array::from_fn(|i| state.w[i] + sign * h * qdd[i]),
+            };
             let (k, p) = dynamics.energy(&s);
             k + p
         };
