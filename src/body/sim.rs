@@ -91,6 +91,9 @@ pub struct Reference {
     pub tips: [Vec<DVec3>; 2],
     /// Joint rotations per sample (needed by ID; HIMC pulls its IK toward them).
     pub poses: Option<Vec<Pose>>,
+    /// Scored impact times (s, from the first sample) with their beat index, in time
+    /// order, so that a failure can name the beat it happened in.
+    pub beats: Vec<(f64, usize)>,
 }
 
 /// What the body did, at the task rate.
@@ -105,10 +108,23 @@ pub struct Motion {
 
 /// The simulation stopped.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("the simulation {what} at {time_s:.4} s")]
+#[error("the simulation {what} at {time_s:.4} s{}", beat.map_or(String::new(), |b| format!(", during beat {b}")))]
 pub struct Diverged {
     pub time_s: f64,
+    /// The beat being played (the next impact's), when the reference names beats.
+    pub beat: Option<usize>,
     pub what: String,
+}
+
+impl Reference {
+    /// The beat being played at `time_s`: the first whose impact is not yet past.
+    pub fn beat_at(&self, time_s: f64) -> Option<usize> {
+        self.beats
+            .iter()
+            .find(|(t, _)| *t >= time_s)
+            .or(self.beats.last())
+            .map(|&(_, b)| b)
+    }
 }
 
 /// Follow `reference` with `pipeline`, starting from `initial` at rest, with `gains_scale`
@@ -179,6 +195,7 @@ pub fn simulate(
     let targets: Vec<Pose> = match pipeline {
         Pipeline::Id => reference.poses.clone().ok_or_else(|| Diverged {
             time_s: 0.0,
+            beat: None,
             what: "cannot run ID without captured joint rotations".into(),
         })?,
         _ => {
@@ -255,6 +272,7 @@ pub fn simulate(
                     .map_or("?", |j| Joint::ALL[j].name());
                 return Err(Diverged {
                     time_s,
+                    beat: reference.beat_at(time_s),
                     what: format!("diverged ({joint} spinning at {speed:.0} rad/s)"),
                 });
             }
@@ -273,4 +291,52 @@ pub fn rms_error(a: &[DVec3], b: &[DVec3]) -> f64 {
         .sum::<f64>()
         / n as f64)
         .sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::body::skeleton::REST;
+
+    /// A target the body cannot follow without blowing up (a 2 m jump of the tip in one
+    /// 4 ms task step with absurd gains) stops with the time and the beat, never NaN.
+    #[test]
+    fn divergence_names_time_and_beat() {
+        let model = BodyModel::default();
+        let here = model.skeleton.forward(&REST);
+        let hold = |side: Side, far: bool| {
+            (0..20)
+                .map(|k| {
+                    here.tip(side)
+                        + if far && k >= 10 {
+                            DVec3::new(0.0, 2.0, 0.0)
+                        } else {
+                            DVec3::ZERO
+                        }
+                })
+                .collect()
+        };
+        let reference = Reference {
+            rate_hz: 250.0,
+            tips: [hold(Side::Left, false), hold(Side::Right, true)],
+            poses: None,
+            beats: vec![(0.02, 3), (0.06, 4)],
+        };
+        let params = SimParams {
+            frequency_hz: [2000.0; JOINT_COUNT],
+            max_torque: 1e9,
+            ..SimParams::default()
+        };
+        let err = simulate(
+            &model,
+            &reference,
+            Pipeline::Himc,
+            &params,
+            &REST,
+            &[1.0; JOINT_COUNT],
+        )
+        .unwrap_err();
+        assert!(err.time_s > 0.0 && err.beat.is_some(), "{err}");
+        assert!(err.to_string().contains("during beat"), "{err}");
+    }
 }
