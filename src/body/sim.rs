@@ -76,7 +76,7 @@ impl Default for SimParams {
                 reference_gain: 0.2,
                 ..IkParams::default()
             },
-            nested_iterations: 2,
+            nested_iterations: 1,
             max_angular_speed: 500.0,
         }
     }
