@@ -5,6 +5,9 @@
 //! upward acceleration of the pelvis. The joint-space mass matrix comes from the
 //! composite-rigid-body algorithm (CRBA, §6.2). [`Dynamics::step`] integrates with
 //! semi-implicit (symplectic) Euler on the rotation group: w += dt·ẇ, then q ← q·exp(w·dt).
+//! Its energy error is first order in dt: at dt = 1e-4 s a passive body swinging for 1 s
+//! drifts by 0.2 % of the energy it exchanges, a collapsing one that whips the sticks to
+//! some 260 rad/s by 1.9 % (see the `energy_is_conserved` test).
 //!
 //! Conventions. Segment frame i = parent frame · translation(offset_i) · rotation(q_i), so
 //! each segment's origin is its joint. Spatial vectors are Plücker coordinates
