@@ -1,5 +1,7 @@
 //! The simulated timpanist's upper body: the 11-segment skeleton with ball joints and its
-//! forward kinematics, and inverse kinematics for the arm chains.
+//! forward kinematics, its mass model, articulated-body dynamics, inverse kinematics for
+//! the arm chains, PD control with joint limits, the IK / ID / HIMC pipelines and their
+//! evaluation.
 
 pub mod control;
 pub mod dynamics;
