@@ -15,6 +15,17 @@ pub struct Track {
     pub rotations: Vec<Option<DQuat>>,
 }
 
+impl Track {
+    /// A track with no samples yet.
+    pub fn empty(label: impl Into<String>) -> Track {
+        Track {
+            label: label.into(),
+            positions: Vec::new(),
+            rotations: Vec::new(),
+        }
+    }
+}
+
 /// A whole capture.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Take {

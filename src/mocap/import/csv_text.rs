@@ -53,6 +53,29 @@ pub(super) fn rows(text: &str) -> impl Iterator<Item = Row<'_>> {
 
 /// Split one line at commas. A cell in double quotes may hold commas; `""` inside quotes
 /// is a quote. Cells are trimmed of spaces and tabs.
+/// The data rows of `rows`: blank lines at the end are skipped, a blank line followed by
+/// more data is an error naming its line.
+pub(super) fn data_rows<'a>(
+    path: &'a Path,
+    rows: impl Iterator<Item = Row<'a>> + 'a,
+) -> impl Iterator<Item = Result<Row<'a>, ImportError>> + 'a {
+    let mut blank_at: Option<usize> = None;
+    rows.filter_map(move |row| {
+        if row.is_blank() {
+            blank_at.get_or_insert(row.line);
+            return None;
+        }
+        Some(match blank_at {
+            Some(b) => Err(ImportError::format(
+                path,
+                format!("line {b}"),
+                "expected a data row, found a blank line inside the data",
+            )),
+            None => Ok(row),
+        })
+    })
+}
+
 pub(super) fn split_cells(line: &str) -> Vec<Cow<'_, str>> {
     let line = line.strip_suffix('\r').unwrap_or(line);
     if !line.contains('"') {

@@ -258,29 +258,15 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
     let mut tracks: Vec<Track> = entities
         .iter()
         .zip(labels)
-        .map(|(_, label)| Track {
-            label,
-            positions: Vec::new(),
-            rotations: Vec::new(),
-        })
+        .map(|(_, label)| Track::empty(label))
         .collect();
 
     // Data rows.
     let step = 1.0 / rate_hz;
     let mut prev_time: Option<f64> = None;
     let mut frames = 0usize;
-    let mut blank_at: Option<usize> = None;
-    for row in rows {
-        if row.is_blank() {
-            blank_at.get_or_insert(row.line);
-            continue;
-        }
-        if let Some(b) = blank_at {
-            return Err(err(
-                format!("line {b}"),
-                "expected a data row, found a blank line inside the data".into(),
-            ));
-        }
+    for row in csv_text::data_rows(path, rows) {
+        let row = row?;
         csv_text::check_width(path, &row, width)?;
         csv_text::required_number(path, &row, 0, "frame number")?;
         let t = csv_text::required_number(path, &row, 1, "time in seconds")?;

@@ -61,25 +61,10 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
     let mut times: Vec<(usize, f64)> = Vec::new();
     let mut tracks: Vec<Track> = labels
         .iter()
-        .map(|c| Track {
-            label: c.label.clone(),
-            positions: Vec::new(),
-            rotations: Vec::new(),
-        })
+        .map(|c| Track::empty(c.label.clone()))
         .collect();
-    let mut blank_at: Option<usize> = None;
-    for row in rows {
-        if row.is_blank() {
-            blank_at.get_or_insert(row.line);
-            continue;
-        }
-        if let Some(b) = blank_at {
-            return Err(ImportError::format(
-                path,
-                format!("line {b}"),
-                "expected a data row, found a blank line inside the data",
-            ));
-        }
+    for row in csv_text::data_rows(path, rows) {
+        let row = row?;
         csv_text::check_width(path, &row, width)?;
         let t = csv_text::required_number(path, &row, 0, "time in seconds")?;
         times.push((row.line, t));

@@ -169,11 +169,7 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
 
     let mut tracks: Vec<Track> = columns
         .iter()
-        .map(|c| Track {
-            label: c.label.clone(),
-            positions: Vec::new(),
-            rotations: Vec::new(),
-        })
+        .map(|c| Track::empty(c.label.clone()))
         .collect();
     let mut prev_frame: Option<f64> = None;
     let mut frames = 0usize;
