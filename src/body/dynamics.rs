@@ -199,6 +199,20 @@ impl Transform {
             c,
         }
     }
+
+    /// A purely translational inertia [0 0; 0 C] (what an articulated inertia is after a
+    /// ball joint) from child to parent coordinates, Xᵀ·I·X = [−r̃C′r̃ r̃C′; C′r̃ᵀ C′] with
+    /// C′ = EᵀCE.
+    fn translational_inertia_to_parent(&self, c: DMat3) -> SpatialInertia {
+        let rx = skew(self.r);
+        let c = self.e.transpose() * c * self.e;
+        let rxc = rx * c;
+        SpatialInertia {
+            a: -(rxc * rx),
+            b: rxc,
+            c,
+        }
+    }
 }
 
 /// Per-segment quantities of one pass over the tree, kept between calls so a step does not
@@ -332,17 +346,13 @@ impl Dynamics {
             let SpatialInertia { a, b, c } = s.ia[i];
             let d_inv = a.inverse();
             let u = tau[i] - s.pa[i].ang;
-            let ia = SpatialInertia {
-                a: DMat3::ZERO,
-                b: DMat3::ZERO,
-                c: c - b.transpose() * d_inv * b,
-            };
-            // pA + Ia·c + U·D⁻¹·u with U = [A; Bᵀ].
+            let ia_c = c - b.transpose() * d_inv * b;
+            // pA + Ia·c + U·D⁻¹·u with U = [A; Bᵀ] and Ia = [0 0; 0 Ia_c].
             let k = d_inv * u;
-            let pa = s.pa[i] + ia.mul(s.c[i]) + SpatialVec::new(a * k, b.transpose() * k);
+            let pa = s.pa[i] + SpatialVec::new(a * k, ia_c * s.c[i].lin + b.transpose() * k);
             (s.d_inv[i], s.u[i]) = (d_inv, u);
             if let Some(p) = self.parent[i] {
-                s.ia[p] += s.x[i].inertia_to_parent(&ia);
+                s.ia[p] += s.x[i].translational_inertia_to_parent(ia_c);
                 s.pa[p] = s.pa[p] + s.x[i].force_to_parent(pa);
             }
         }
@@ -413,6 +423,35 @@ impl Dynamics {
         let grip = Joint::arm(side)[3].index();
         let local = DVec3::new(0.0, 0.0, -self.model.skeleton.stick_length_m);
         self.point_velocity(state, grip, local)
+    }
+
+    /// Inverse dynamics by the recursive Newton–Euler algorithm, O(n): the joint torques
+    /// (N·m, child frames) that give `state` the joint accelerations `qdd` (rad/s², child
+    /// frames) under gravity, with no external force. With zero velocity and zero `qdd` it
+    /// is gravity compensation. Each of the 11 joints is one forward and one backward
+    /// visit (about a microsecond), so control can afford it every task step.
+    pub fn inverse_dynamics(&mut self, state: &State, qdd: &[DVec3; N]) -> [DVec3; N] {
+        self.kinematics(state);
+        let s = &self.scratch;
+        // Forward: spatial accelerations; the pelvis accelerates upward to model gravity.
+        let mut acc = [SpatialVec::ZERO; N];
+        let mut force = [SpatialVec::ZERO; N];
+        for i in 0..N {
+            let a_p =
+                self.parent[i].map_or(SpatialVec::new(DVec3::ZERO, -self.gravity), |p| acc[p]);
+            acc[i] = s.x[i].motion(a_p) + s.c[i] + SpatialVec::new(qdd[i], DVec3::ZERO);
+            let inertia = &self.inertia[i];
+            force[i] = inertia.mul(acc[i]) + s.v[i].cross_force(inertia.mul(s.v[i]));
+        }
+        // Backward: each joint carries its segment's force and everything beyond it.
+        let mut tau = [DVec3::ZERO; N];
+        for i in (0..N).rev() {
+            tau[i] = force[i].ang;
+            if let Some(p) = self.parent[i] {
+                force[p] = force[p] + s.x[i].force_to_parent(force[i]);
+            }
+        }
+        tau
     }
 
     /// Joint-space mass matrix (33×33, row-major, joint i's three coordinates at rows
@@ -540,6 +579,28 @@ mod tests {
                     .collect()
             })
             .collect()
+    }
+
+    /// Newton–Euler inverse dynamics inverts the articulated-body forward dynamics: the
+    /// torques it gives for random accelerations produce those accelerations (1e-9 rad/s²).
+    #[test]
+    fn newton_euler_inverts_forward_dynamics() {
+        let mut rng = Rng::new(11);
+        let mut d = dynamics();
+        for _ in 0..20 {
+            let state = random_state(&mut rng, 3.0);
+            let qdd: [DVec3; N] = std::array::from_fn(|_| random_vec(&mut rng, 20.0));
+            let tau = d.inverse_dynamics(&state, &qdd);
+            let back = d.accelerations(&state, &tau, &[]);
+            let err = max_abs(
+                &flatten(&back)
+                    .iter()
+                    .zip(flatten(&qdd))
+                    .map(|(a, b)| a - b)
+                    .collect::<Vec<_>>(),
+            );
+            assert!(err < 1e-9, "{err}");
+        }
     }
 
     /// A passive body swinging under gravity from a bent, moving pose (joints turned up to

@@ -8,7 +8,7 @@
 //! A step ω (world frame) is applied to a joint's local rotation as
 //! q ← (R_parent⁻¹·exp(ω)·R_parent)·q.
 
-use super::skeleton::{JOINT_COUNT, Joint, Pose, Skeleton};
+use super::skeleton::{Frames, JOINT_COUNT, Joint, Pose, Skeleton};
 use crate::kit::Side;
 use glam::{DMat3, DQuat, DVec3};
 
@@ -78,70 +78,17 @@ pub fn solve(
     reference: Option<&Pose>,
     params: &IkParams,
 ) -> IkResult {
-    let arm = Joint::arm(side);
-    // Fixed-size buffers: the solver runs every simulation step and must not allocate.
-    let mut chain = [(Joint::Trunk, 0.0); 5];
-    let mut len = 0;
-    if params.use_trunk {
-        chain[0] = (Joint::Trunk, params.weights[0]);
-        len = 1;
-    }
-    for (&j, &w) in arm.iter().zip(&params.weights[1..]) {
-        chain[len] = (j, w);
-        len += 1;
-    }
-    let chain = &chain[..len];
     let mut pose = *start;
     let mut iterations = 0;
     let mut error = f64::INFINITY;
     while iterations < params.max_iterations {
         let frames = skeleton.forward(&pose);
-        let tip = frames.tip(side);
-        let e = target - tip;
-        error = e.length();
+        error = (target - frames.tip(side)).length();
         if error <= params.tolerance_m {
             break;
         }
         iterations += 1;
-        // Columns: three world axes per joint.
-        let mut buffer = [(0usize, DVec3::ZERO, DVec3::ZERO, 0.0); 15];
-        for (slot, &(j, w)) in buffer.chunks_mut(3).zip(chain) {
-            let r = tip - frames.position[j.index()];
-            for (column, a) in slot.iter_mut().zip([DVec3::X, DVec3::Y, DVec3::Z]) {
-                *column = (j.index(), a, a.cross(r), w);
-            }
-        }
-        let columns = &buffer[..3 * chain.len()];
-        let jwjt = columns
-            .iter()
-            .fold(DMat3::ZERO, |m, &(_, _, c, w)| m + outer(c, c) * w);
-        let y = match params.method {
-            IkMethod::Transpose => {
-                let jjt_e = jwjt * e;
-                e * (e.dot(jjt_e) / jjt_e.length_squared().max(1e-12))
-            }
-            IkMethod::PseudoInverse => safe_solve(jwjt, e, 1e-9),
-            IkMethod::DampedLeastSquares => {
-                safe_solve(jwjt + DMat3::IDENTITY * params.damping_m.powi(2), e, 0.0)
-            }
-        };
-        let mut step = [DVec3::ZERO; JOINT_COUNT];
-        for &(i, a, c, w) in columns {
-            step[i] += a * (w * c.dot(y));
-        }
-        if let Some(reference) = reference {
-            add_null_space_pull(&mut step, columns, &frames, &pose, reference, jwjt, params);
-        }
-        for &(j, _) in chain {
-            let i = j.index();
-            let mut w = step[i];
-            if w.length() > params.max_step_rad {
-                w = w.normalize() * params.max_step_rad;
-            }
-            let parent = frames.parent_rotation(j);
-            pose[i] =
-                (parent.inverse() * DQuat::from_scaled_axis(w) * parent * pose[i]).normalize();
-        }
+        iterate(&frames, &mut pose, side, target, reference, params);
     }
     if iterations == params.max_iterations {
         error = (target - skeleton.tip(&pose, side)).length();
@@ -154,11 +101,77 @@ pub fn solve(
     }
 }
 
+/// One iteration of the solver: the joint steps that move the `side` tip toward `target`,
+/// computed from `frames` (the forward kinematics of the pose the steps are applied to) and
+/// applied to `pose`. HIMC runs exactly this once per arm every simulation step, both arms
+/// from one forward-kinematics pass (the arms' chains share at most the trunk).
+pub fn iterate(
+    frames: &Frames,
+    pose: &mut Pose,
+    side: Side,
+    target: DVec3,
+    reference: Option<&Pose>,
+    params: &IkParams,
+) {
+    // Fixed-size buffers: the solver runs every simulation step and must not allocate.
+    let mut chain = [(Joint::Trunk, 0.0); 5];
+    let mut len = 0;
+    if params.use_trunk {
+        chain[0] = (Joint::Trunk, params.weights[0]);
+        len = 1;
+    }
+    for (&j, &w) in Joint::arm(side).iter().zip(&params.weights[1..]) {
+        chain[len] = (j, w);
+        len += 1;
+    }
+    let chain = &chain[..len];
+    let tip = frames.tip(side);
+    let e = target - tip;
+    // Columns: three world axes per joint.
+    let mut buffer = [(0usize, DVec3::ZERO, DVec3::ZERO, 0.0); 15];
+    for (slot, &(j, w)) in buffer.chunks_mut(3).zip(chain) {
+        let r = tip - frames.position[j.index()];
+        for (column, a) in slot.iter_mut().zip([DVec3::X, DVec3::Y, DVec3::Z]) {
+            *column = (j.index(), a, a.cross(r), w);
+        }
+    }
+    let columns = &buffer[..3 * chain.len()];
+    let jwjt = columns
+        .iter()
+        .fold(DMat3::ZERO, |m, &(_, _, c, w)| m + outer(c, c) * w);
+    let y = match params.method {
+        IkMethod::Transpose => {
+            let jjt_e = jwjt * e;
+            e * (e.dot(jjt_e) / jjt_e.length_squared().max(1e-12))
+        }
+        IkMethod::PseudoInverse => safe_solve(jwjt, e, 1e-9),
+        IkMethod::DampedLeastSquares => {
+            safe_solve(jwjt + DMat3::IDENTITY * params.damping_m.powi(2), e, 0.0)
+        }
+    };
+    let mut step = [DVec3::ZERO; JOINT_COUNT];
+    for &(i, a, c, w) in columns {
+        step[i] += a * (w * c.dot(y));
+    }
+    if let Some(reference) = reference {
+        add_null_space_pull(&mut step, columns, frames, pose, reference, jwjt, params);
+    }
+    for &(j, _) in chain {
+        let i = j.index();
+        let mut w = step[i];
+        if w.length() > params.max_step_rad {
+            w = w.normalize() * params.max_step_rad;
+        }
+        let parent = frames.parent_rotation(j);
+        pose[i] = (parent.inverse() * DQuat::from_scaled_axis(w) * parent * pose[i]).normalize();
+    }
+}
+
 /// Add z − W·Jᵀ(JWJᵀ + λ²I)⁻¹·J·z, where z turns each chain joint toward `reference`.
 fn add_null_space_pull(
     step: &mut [DVec3],
     columns: &[(usize, DVec3, DVec3, f64)],
-    frames: &super::skeleton::Frames,
+    frames: &Frames,
     pose: &Pose,
     reference: &Pose,
     jwjt: DMat3,
@@ -167,9 +180,11 @@ fn add_null_space_pull(
     let mut z = [DVec3::ZERO; JOINT_COUNT];
     for &(i, _, _, w) in columns.iter().step_by(3) {
         let joint = super::skeleton::Joint::ALL[i];
-        let local = (reference[i] * pose[i].inverse()).normalize();
-        let local = if local.w < 0.0 { -local } else { local };
-        z[i] = frames.parent_rotation(joint) * local.to_scaled_axis() * (params.reference_gain * w);
+        // 2·vec(q) = 2·sin(θ/2)·axis: the rotation toward the reference, exact to second
+        // order in the angle and free of trigonometry (this runs every simulation step).
+        let local = reference[i] * pose[i].inverse();
+        let toward = 2.0 * local.xyz() * local.w.signum();
+        z[i] = frames.parent_rotation(joint) * toward * (params.reference_gain * w);
     }
     let jz = columns
         .iter()

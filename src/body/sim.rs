@@ -15,7 +15,7 @@
 //! Task rate 250 Hz and simulation rate 10 kHz by default (40 sub-steps). The run stops
 //! with an error naming the time if the state becomes non-finite or diverges.
 
-use super::control::{Gains, inverse_dynamics, pd_torques, rotation_error};
+use super::control::{Gains, pd_torques, rotation_error};
 use super::dynamics::{Dynamics, State};
 use super::ik::{self, IkParams};
 use super::model::BodyModel;
@@ -209,8 +209,6 @@ pub fn simulate(
         }
     };
     let nested = IkParams {
-        max_iterations: params.nested_iterations,
-        tolerance_m: 1e-6,
         reference_gain: 1.0,
         ..params.ik.clone()
     };
@@ -230,8 +228,7 @@ pub fn simulate(
         let qdd: [DVec3; JOINT_COUNT] =
             std::array::from_fn(|j| (next_w[j] - target_w[j]) * reference.rate_hz);
         // Feed-forward inverse dynamics of the target motion, once per task step.
-        let bias = inverse_dynamics(
-            &mut dynamics,
+        let bias = dynamics.inverse_dynamics(
             &State {
                 q: *from,
                 w: target_w,
@@ -240,24 +237,27 @@ pub fn simulate(
         );
         for s in 1..=substeps {
             let u = s as f64 / substeps as f64;
-            let mut goal: Pose = std::array::from_fn(|j| from[j].slerp(to[j], u));
+            // Normalised lerp: within one 4 ms task interval it matches slerp to ~1e-7 rad.
+            let mut goal: Pose = std::array::from_fn(|j| from[j].lerp(to[j], u));
             if pipeline == Pipeline::Himc {
                 // IK nested in PD (seed 000 Alg. 2): every step, solve the tips' targets from
                 // the simulated pose, Δq = J⁺(X_t − X(q)), with the redundancy pulled toward
                 // the task-rate IK posture; PD then tracks that.
                 let reference_pose = goal;
                 goal = state.q;
-                for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
-                    let target = reference.tips[h][k - 1].lerp(reference.tips[h][k], u);
-                    goal = ik::solve(
-                        skeleton,
-                        &goal,
-                        side,
-                        target,
-                        Some(&reference_pose),
-                        &nested,
-                    )
-                    .pose;
+                for _ in 0..params.nested_iterations {
+                    let frames = skeleton.forward(&goal);
+                    for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
+                        let target = reference.tips[h][k - 1].lerp(reference.tips[h][k], u);
+                        ik::iterate(
+                            &frames,
+                            &mut goal,
+                            side,
+                            target,
+                            Some(&reference_pose),
+                            &nested,
+                        );
+                    }
                 }
             }
             let tau = pd_torques(&gains, &state, &goal, &target_w, &bias);
