@@ -418,6 +418,22 @@ impl Dynamics {
         )
     }
 
+    /// Both stick tips, [left, right]: position (m) and velocity (m/s), performer frame,
+    /// from one kinematics pass.
+    pub fn tips(&mut self, state: &State) -> [(DVec3, DVec3); 2] {
+        self.kinematics(state);
+        let s = &self.scratch;
+        let local = DVec3::new(0.0, 0.0, -self.model.skeleton.stick_length_m);
+        [Side::Left, Side::Right].map(|side| {
+            let i = Joint::arm(side)[3].index();
+            let v = s.v[i];
+            (
+                s.pos[i] + s.rot[i] * local,
+                s.rot[i] * (v.lin + v.ang.cross(local)),
+            )
+        })
+    }
+
     /// Stick tip of a side: position (m) and velocity (m/s), performer frame.
     pub fn tip(&mut self, state: &State, side: Side) -> (DVec3, DVec3) {
         let grip = Joint::arm(side)[3].index();

@@ -16,7 +16,7 @@
 //! with an error naming the time if the state becomes non-finite or diverges.
 
 use super::control::{Gains, pd_torques, rotation_error};
-use super::dynamics::{Dynamics, State};
+use super::dynamics::{Dynamics, ExternalForce, State};
 use super::ik::{self, IkParams};
 use super::model::BodyModel;
 use super::skeleton::{JOINT_COUNT, Joint, Pose};
@@ -116,6 +116,41 @@ pub struct Diverged {
     pub what: String,
 }
 
+/// Why a simulation did not finish.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SimError {
+    #[error(transparent)]
+    Diverged(#[from] Diverged),
+    /// The environment asked to stop (e.g. the user edited the score meanwhile).
+    #[error("the simulation was cancelled")]
+    Cancelled,
+}
+
+/// What the simulated body meets, asked every simulation step: forces on the stick tips
+/// (the drum heads) and whether to go on.
+pub trait Environment {
+    /// Forces (N, performer frame) on the left and right stick tips at `time_s` (s from the
+    /// reference's first sample), given each tip's position (m) and velocity (m/s) at the
+    /// start of the step. The IK pipeline has no dynamics: its tips are interpolated
+    /// between task samples and the forces it gets back are ignored.
+    fn tip_forces(&mut self, time_s: f64, tips: [(DVec3, DVec3); 2]) -> [DVec3; 2];
+
+    /// Called once per task step with the samples done and the total; `false` cancels.
+    fn progress(&mut self, _done: usize, _total: usize) -> bool {
+        true
+    }
+}
+
+/// Empty space: no contact, never cancelled.
+pub struct FreeSpace;
+
+impl Environment for FreeSpace {
+    fn tip_forces(&mut self, _time_s: f64, _tips: [(DVec3, DVec3); 2]) -> [DVec3; 2] {
+        [DVec3::ZERO; 2]
+    }
+}
+
 impl Reference {
     /// The beat being played at `time_s`: the first whose impact is not yet past.
     pub fn beat_at(&self, time_s: f64) -> Option<usize> {
@@ -127,8 +162,8 @@ impl Reference {
     }
 }
 
-/// Follow `reference` with `pipeline`, starting from `initial` at rest, with `gains_scale`
-/// multiplying each joint's PD gains (1 = nominal).
+/// Follow `reference` with `pipeline` in free space, starting from `initial` at rest, with
+/// `gains_scale` multiplying each joint's PD gains (1 = nominal).
 pub fn simulate(
     model: &BodyModel,
     reference: &Reference,
@@ -136,27 +171,63 @@ pub fn simulate(
     params: &SimParams,
     initial: &Pose,
     gains_scale: &[f64; JOINT_COUNT],
-) -> Result<Motion, Diverged> {
+) -> Result<Motion, SimError> {
+    simulate_in(
+        &mut FreeSpace,
+        model,
+        reference,
+        pipeline,
+        params,
+        initial,
+        gains_scale,
+    )
+}
+
+/// Joint targets at the task rate: IK brings both tips to each reference sample, warm
+/// started from the captured posture when there is one (so it only corrects what the tips
+/// need), else from the previous solution.
+pub fn ik_targets(
+    model: &BodyModel,
+    reference: &Reference,
+    params: &SimParams,
+    initial: &Pose,
+) -> Vec<Pose> {
+    let mut pose = *initial;
+    (0..reference.tips[0].len())
+        .map(|k| {
+            let pull = reference.poses.as_ref().map(|p| &p[k]);
+            let start = pose;
+            pose = *pull.unwrap_or(&start);
+            for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
+                pose = ik::solve(
+                    &model.skeleton,
+                    &pose,
+                    side,
+                    reference.tips[h][k],
+                    pull.or(Some(&start)),
+                    &params.ik,
+                )
+                .pose;
+            }
+            pose
+        })
+        .collect()
+}
+
+/// [`simulate`] with the body meeting `environment` (e.g. the drums) every simulation step.
+pub fn simulate_in(
+    environment: &mut dyn Environment,
+    model: &BodyModel,
+    reference: &Reference,
+    pipeline: Pipeline,
+    params: &SimParams,
+    initial: &Pose,
+    gains_scale: &[f64; JOINT_COUNT],
+) -> Result<Motion, SimError> {
     let n = reference.tips[0].len();
     let skeleton = &model.skeleton;
-    // IK warm-starts from the captured posture when there is one (so it only corrects what
-    // the tips need), else from the previous solution.
-    let ik_pose = |start: &Pose, k: usize, pull: Option<&Pose>| {
-        let mut pose = *pull.unwrap_or(start);
-        for side in [Side::Left, Side::Right] {
-            let target = reference.tips[crate::mocap::db::side_index(side)][k];
-            pose = ik::solve(
-                skeleton,
-                &pose,
-                side,
-                target,
-                pull.or(Some(start)),
-                &params.ik,
-            )
-            .pose;
-        }
-        pose
-    };
+    let substeps = (params.sim_hz / reference.rate_hz).round().max(1.0) as usize;
+    let dt = 1.0 / (reference.rate_hz * substeps as f64);
     let mut motion = Motion {
         rate_hz: reference.rate_hz,
         tips: [Vec::with_capacity(n), Vec::with_capacity(n)],
@@ -168,11 +239,36 @@ pub fn simulate(
         motion.tips[1].push(frames.tip(Side::Right));
         motion.poses.push(*pose);
     };
+    // Joint targets at the task rate.
+    let targets: Vec<Pose> = match pipeline {
+        Pipeline::Id => reference.poses.clone().ok_or_else(|| Diverged {
+            time_s: 0.0,
+            beat: None,
+            what: "cannot run ID without captured joint rotations".into(),
+        })?,
+        _ => ik_targets(model, reference, params, initial),
+    };
     if pipeline == Pipeline::Ik {
-        let mut pose = *initial;
-        for k in 0..n {
-            pose = ik_pose(&pose, k, reference.poses.as_ref().map(|p| &p[k]));
-            record(&mut motion, &pose);
+        for (k, pose) in targets.iter().enumerate() {
+            record(&mut motion, pose);
+            if k == 0 {
+                continue;
+            }
+            if !environment.progress(k, n) {
+                return Err(SimError::Cancelled);
+            }
+            // The drums still hear the kinematic sticks, at the simulation rate.
+            let (a, b) = (k - 1, k);
+            let velocity: [DVec3; 2] = std::array::from_fn(|h| {
+                (motion.tips[h][b] - motion.tips[h][a]) * reference.rate_hz
+            });
+            for s in 0..substeps {
+                let u = s as f64 / substeps as f64;
+                let tips = std::array::from_fn(|h| {
+                    (motion.tips[h][a].lerp(motion.tips[h][b], u), velocity[h])
+                });
+                environment.tip_forces(a as f64 / reference.rate_hz + s as f64 * dt, tips);
+            }
         }
         return Ok(motion);
     }
@@ -189,29 +285,11 @@ pub fn simulate(
         params.max_torque,
     )
     .scaled(gains_scale);
-    let substeps = (params.sim_hz / reference.rate_hz).round().max(1.0) as usize;
-    let dt = 1.0 / (reference.rate_hz * substeps as f64);
-    // Joint targets at the task rate.
-    let targets: Vec<Pose> = match pipeline {
-        Pipeline::Id => reference.poses.clone().ok_or_else(|| Diverged {
-            time_s: 0.0,
-            beat: None,
-            what: "cannot run ID without captured joint rotations".into(),
-        })?,
-        _ => {
-            let mut pose = *initial;
-            (0..n)
-                .map(|k| {
-                    pose = ik_pose(&pose, k, reference.poses.as_ref().map(|p| &p[k]));
-                    pose
-                })
-                .collect()
-        }
-    };
     let nested = IkParams {
         reference_gain: 1.0,
         ..params.ik.clone()
     };
+    let grips = [Side::Left, Side::Right].map(|side| Joint::arm(side)[3].index());
     // Target joint velocities (over each task interval) and accelerations.
     let velocity = |k: usize| -> [DVec3; JOINT_COUNT] {
         let k = k.clamp(1, n.max(2) - 1);
@@ -222,6 +300,9 @@ pub fn simulate(
     state.w = velocity(1);
     record(&mut motion, &state.q);
     for k in 1..n {
+        if !environment.progress(k, n) {
+            return Err(SimError::Cancelled);
+        }
         let (from, to) = (&targets[k - 1], &targets[k]);
         let target_w = velocity(k);
         let next_w = velocity(k + 1);
@@ -237,6 +318,7 @@ pub fn simulate(
         );
         for s in 1..=substeps {
             let u = s as f64 / substeps as f64;
+            let time_s = (k - 1) as f64 / reference.rate_hz + (s - 1) as f64 * dt;
             // Normalised lerp: within one 4 ms task interval it matches slerp to ~1e-7 rad.
             let mut goal: Pose = std::array::from_fn(|j| from[j].lerp(to[j], u));
             if pipeline == Pipeline::Himc {
@@ -260,11 +342,25 @@ pub fn simulate(
                     }
                 }
             }
+            let tips = dynamics.tips(&state);
+            let forces = environment.tip_forces(time_s, tips);
+            let external = std::array::from_fn::<_, 2, _>(|h| ExternalForce {
+                segment: grips[h],
+                point_world: tips[h].0,
+                force_world: forces[h],
+            });
+            let touching = forces.map(|f| f != DVec3::ZERO);
+            let external: &[ExternalForce] = match touching {
+                [false, false] => &[],
+                [true, false] => &external[..1],
+                [false, true] => &external[1..],
+                [true, true] => &external,
+            };
             let tau = pd_torques(&gains, &state, &goal, &target_w, &bias);
-            dynamics.step(&mut state, &tau, &[], dt);
+            dynamics.step(&mut state, &tau, external, dt);
             let speed = state.w.iter().map(|w| w.length()).fold(0.0, f64::max);
             if !state.is_finite() || speed > params.max_angular_speed {
-                let time_s = (k - 1) as f64 / reference.rate_hz + s as f64 * dt;
+                let time_s = time_s + dt;
                 let joint = state
                     .w
                     .iter()
@@ -274,7 +370,8 @@ pub fn simulate(
                     time_s,
                     beat: reference.beat_at(time_s),
                     what: format!("diverged ({joint} spinning at {speed:.0} rad/s)"),
-                });
+                }
+                .into());
             }
         }
         record(&mut motion, &state.q);
@@ -336,6 +433,9 @@ mod tests {
             &[1.0; JOINT_COUNT],
         )
         .unwrap_err();
+        let SimError::Diverged(err) = err else {
+            panic!("{err}")
+        };
         assert!(err.time_s > 0.0 && err.beat.is_some(), "{err}");
         assert!(err.to_string().contains("during beat"), "{err}");
     }
