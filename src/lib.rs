@@ -8,6 +8,7 @@
 pub mod app;
 pub mod body;
 pub mod cli;
+pub mod drum;
 pub mod io;
 pub mod kit;
 pub mod mocap;
@@ -16,3 +17,4 @@ pub mod pitch;
 pub mod problem;
 pub mod rng;
 pub mod score;
+pub mod sound;

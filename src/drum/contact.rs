@@ -1,0 +1,65 @@
+//! The Hertz law of the felt mallet on the head (seed 000 eq. 6): F = k·c^α for a
+//! compression c > 0 between the felt ball and the (displaced) head surface, 0 otherwise.
+//! The compression is capped at the felt ball's radius (beyond it the stick's core would
+//! meet the head), so a tip driven far below the head gets a large but finite force.
+
+use super::DrumError;
+use crate::kit::Mallet;
+
+/// One mallet's contact law.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HertzContact {
+    /// k, N/m^α.
+    pub stiffness: f64,
+    /// α.
+    pub exponent: f64,
+    /// Felt ball radius, m (the stick tip is the ball's centre).
+    pub ball_radius_m: f64,
+}
+
+impl HertzContact {
+    /// The law of a kit mallet.
+    pub fn of(mallet: &Mallet) -> Result<HertzContact, DrumError> {
+        let ok = mallet.felt_stiffness.is_finite()
+            && mallet.felt_stiffness > 0.0
+            && mallet.head_radius_m > 0.0
+            && mallet.mass_kg > 0.0
+            && (1.0..=4.0).contains(&mallet.contact_exponent);
+        if !ok {
+            return Err(DrumError::InvalidMallet(mallet.name.clone()));
+        }
+        Ok(HertzContact {
+            stiffness: mallet.felt_stiffness,
+            exponent: mallet.contact_exponent,
+            ball_radius_m: mallet.head_radius_m,
+        })
+    }
+
+    /// Force for compression `c` (m; ≤ 0 or NaN means apart), N, ≥ 0.
+    pub fn force(&self, c: f64) -> f64 {
+        if c > 0.0 {
+            self.stiffness * c.min(self.ball_radius_m).powf(self.exponent)
+        } else {
+            0.0
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kit::Kit;
+
+    /// F = k·c^α for small c, zero when apart or NaN, finite and capped when driven deep.
+    #[test]
+    fn hertz_law() {
+        let law = HertzContact::of(&Kit::standard().mallets[0]).unwrap();
+        let c = 0.002;
+        assert!((law.force(c) - law.stiffness * c.powf(law.exponent)).abs() < 1e-9);
+        assert_eq!(law.force(0.0), 0.0);
+        assert_eq!(law.force(-0.01), 0.0);
+        assert_eq!(law.force(f64::NAN), 0.0);
+        assert_eq!(law.force(10.0), law.force(law.ball_radius_m));
+        assert!(law.force(2.0 * c) > law.force(c));
+    }
+}

@@ -1,0 +1,75 @@
+//! The timpani heads as modal membranes struck through a Hertz felt contact (issue 6
+//! §1–2; seed 000 §4, eqs. 4–6): mode tables per head ([`modes`]), the exact per-mode time
+//! step ([`oscillator`]), the contact law ([`contact`]), the whole kit stepped at the
+//! simulation rate with both stick tips ([`set`]), and a scripted stick for tests and
+//! benchmarks ([`strike`]).
+
+pub mod bessel;
+pub mod contact;
+pub mod modes;
+pub mod oscillator;
+pub mod set;
+pub mod strike;
+
+pub use contact::HertzContact;
+pub use modes::{HeadMode, HeadModes, Orientation};
+pub use set::{ContactEvent, DrumSet, Excitation};
+
+/// Default number of mode orientations per head.
+pub const DEFAULT_MODE_COUNT: usize = 24;
+/// Largest number of mode orientations per head.
+pub const MAX_MODE_COUNT: usize = 200;
+
+/// Where mode frequencies come from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FrequencySource {
+    /// The kit's measured ratios to the (1,1) for the modes it lists (kettledrum
+    /// 1.50, 1.98, 2.44, 2.94 by default), the in-vacuo membrane for the others.
+    #[default]
+    Measured,
+    /// The ideal membrane, f_mn = air_loading · j_mn/(2πa) · √(T/σ), for every mode.
+    Membrane,
+}
+
+/// How many modes each head has and where their frequencies come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ModeConfig {
+    /// Mode orientations per head (both orientations of a degenerate pair count), 1–200.
+    pub count: usize,
+    pub source: FrequencySource,
+}
+
+impl Default for ModeConfig {
+    fn default() -> Self {
+        ModeConfig {
+            count: DEFAULT_MODE_COUNT,
+            source: FrequencySource::Measured,
+        }
+    }
+}
+
+impl ModeConfig {
+    /// Whether the configuration is usable.
+    pub fn check(&self) -> Result<(), DrumError> {
+        if (1..=MAX_MODE_COUNT).contains(&self.count) {
+            Ok(())
+        } else {
+            Err(DrumError::ModeCount(self.count))
+        }
+    }
+}
+
+/// Why a drum could not be set up.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DrumError {
+    #[error("mode count {0} is outside 1–{MAX_MODE_COUNT}")]
+    ModeCount(usize),
+    #[error("drum `{0}` has a non-positive size, tension or density, or no modes")]
+    InvalidDrum(String),
+    #[error("mallet `{0}` needs positive stiffness, head radius and mass and an exponent 1–4")]
+    InvalidMallet(String),
+    #[error("simulation step {0} s is not a positive finite time")]
+    TimeStep(f64),
+    #[error("drum index {index} is out of range (the kit has {count})")]
+    NoSuchDrum { index: usize, count: usize },
+}

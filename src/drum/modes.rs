@@ -1,0 +1,332 @@
+//! The modes of one timpani head (issue 6 §1): circular-membrane modes (m, n) with shapes
+//! Φ = J_m(j_mn·r/a)·cos(mθ) or ·sin(mθ) (both orientations of each degenerate pair),
+//! frequencies from the kit's measured ratios or from tension and density, per-mode decay
+//! (T60), radiation weight and modal mass — the diagonal M_S, K_S of seed 000 eq. 5.
+//!
+//! Head-local coordinates: origin at the head centre, metres, +x pointing from the centre
+//! toward the player (horizontally), +y 90° counter-clockwise from it seen from above, so
+//! θ is the angle of [`Drum::point_on_head`].
+//!
+//! Modes the kit does not list (e.g. (0,1), (1,2), (6,1)) take the in-vacuo membrane
+//! frequency j_mn/(2πa)·√(T/σ) (air loading mostly lowers the lowest modes; this puts
+//! (0,2) and (1,2) within 3 % of Fletcher & Rossing's 65-cm kettledrum), a T60 and gain
+//! scaled from the kit's highest listed mode by f_last/f (higher modes die faster and
+//! radiate less), and axisymmetric (m = 0) modes a quarter of that T60 (they die fast, guide §5).
+
+use super::bessel::{RadialProfile, bessel_zeros_below, radial_profile};
+use super::{DrumError, FrequencySource, ModeConfig};
+use crate::kit::Drum;
+use glam::{DVec2, DVec3};
+use std::f64::consts::{PI, TAU};
+use std::sync::Arc;
+
+/// Which of a degenerate pair: the shape's angular factor cos(mθ) or sin(mθ) (m = 0 modes
+/// have only `Cos`, whose factor is 1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Orientation {
+    Cos,
+    Sin,
+}
+
+/// One mode orientation of a head.
+#[derive(Clone, Debug)]
+pub struct HeadMode {
+    /// Nodal diameters.
+    pub m: u32,
+    /// Nodal circles counting the rim (from 1).
+    pub n: u32,
+    pub orientation: Orientation,
+    /// Frequency, Hz.
+    pub freq_hz: f64,
+    /// Time to decay by 60 dB, s.
+    pub t60_s: f64,
+    /// Relative radiated amplitude per unit modal velocity (the (1,1) mode is 1).
+    pub gain: f64,
+    /// Modal mass M_k = σ_eff ∫ Φ_k² dA with σ_eff = σ/air_loading² (the air the head
+    /// carries along, which lowers f11 by the air-loading factor), kg.
+    pub modal_mass_kg: f64,
+    /// Whether the kit's mode table lists this (m, n).
+    pub listed: bool,
+    radial: Arc<RadialProfile>,
+}
+
+impl HeadMode {
+    /// The zero j_mn of this mode's radial profile.
+    pub fn bessel_zero(&self) -> f64 {
+        self.radial.zero
+    }
+
+    /// Mode shape Φ at head-local polar coordinates (s = r/a, θ rad); 0 outside the head.
+    pub fn shape_polar(&self, s: f64, theta: f64) -> f64 {
+        let radial = self.radial.at(s);
+        if self.m == 0 {
+            return radial;
+        }
+        let (sin, cos) = (f64::from(self.m) * theta).sin_cos();
+        match self.orientation {
+            Orientation::Cos => radial * cos,
+            Orientation::Sin => radial * sin,
+        }
+    }
+}
+
+/// The modes of one head and where it is.
+#[derive(Clone, Debug)]
+pub struct HeadModes {
+    radius_m: f64,
+    centre: DVec3,
+    /// Unit horizontal vector from the centre toward the player (head-local +x).
+    toward_player: DVec2,
+    modes: Vec<HeadMode>,
+}
+
+impl HeadModes {
+    /// The first `config.count` mode orientations of `drum`: the kit's listed modes first
+    /// (in kit order, cos then sin), then the others by rising frequency.
+    pub fn new(drum: &Drum, config: &ModeConfig) -> Result<HeadModes, DrumError> {
+        config.check()?;
+        let a = drum.radius_m();
+        let mem = &drum.membrane;
+        if !(a > 0.0 && mem.tension_n_per_m > 0.0 && mem.areal_density_kg_per_m2 > 0.0) {
+            return Err(DrumError::InvalidDrum(drum.name.clone()));
+        }
+        let f11 = drum.tuning.hz();
+        let wave_hz_per_zero = (mem.tension_n_per_m / mem.areal_density_kg_per_m2).sqrt() / (TAU * a);
+        let sigma_eff = mem.areal_density_kg_per_m2 / (mem.air_loading * mem.air_loading);
+        let last = drum
+            .modes
+            .last()
+            .ok_or_else(|| DrumError::InvalidDrum(drum.name.clone()))?;
+        let last_hz = last.ratio * f11;
+
+        // Candidate unlisted (m, n) pairs with their exact zeros, enough of them: the
+        // zeros below x_max, widening x_max until they hold the orientations needed.
+        let need = config.count;
+        let mut x_max = 12.0;
+        let unlisted = loop {
+            let mut found: Vec<(f64, u32, u32)> = Vec::new();
+            for m in (0..).take_while(|&m| f64::from(m) < x_max) {
+                for (i, z) in bessel_zeros_below(m, x_max).into_iter().enumerate() {
+                    let n = i as u32 + 1;
+                    if !drum.modes.iter().any(|k| (k.m, k.n) == (m, n)) {
+                        found.push((z, m, n));
+                    }
+                }
+            }
+            let orientations: usize = found.iter().map(|&(_, m, _)| if m == 0 { 1 } else { 2 }).sum();
+            if orientations >= need {
+                break found;
+            }
+            x_max *= 1.5;
+        };
+        let mut unlisted = unlisted;
+        unlisted.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+
+        let mut modes = Vec::with_capacity(config.count);
+        let orientations = |m: u32| {
+            if m == 0 {
+                &[Orientation::Cos][..]
+            } else {
+                &[Orientation::Cos, Orientation::Sin][..]
+            }
+        };
+        let push = |m: u32, n: u32, listed: Option<&crate::kit::Mode>, modes: &mut Vec<HeadMode>| {
+            let radial = radial_profile(m, n);
+            let membrane_hz = wave_hz_per_zero * radial.zero;
+            let (freq_hz, t60_s, gain) = match (listed, config.source) {
+                (Some(k), FrequencySource::Measured) => (k.ratio * f11, k.decay_s, k.gain),
+                (Some(k), FrequencySource::Membrane) => {
+                    (mem.air_loading * membrane_hz, k.decay_s, k.gain)
+                }
+                (None, source) => {
+                    let f = match source {
+                        FrequencySource::Measured => membrane_hz,
+                        FrequencySource::Membrane => mem.air_loading * membrane_hz,
+                    };
+                    let scale = last_hz / f;
+                    let t60 = last.decay_s * scale * if m == 0 { 0.25 } else { 1.0 };
+                    (f, t60, last.gain * scale.min(1.0))
+                }
+            };
+            // ∫ Φ² dA = π a² J1(j)² for m = 0, π a²/2 · J_{m+1}(j)² otherwise.
+            let angular = if m == 0 { PI } else { PI / 2.0 };
+            let norm = angular * a * a * radial.j_next_at_zero.powi(2);
+            for &orientation in orientations(m) {
+                if modes.len() == config.count {
+                    return;
+                }
+                modes.push(HeadMode {
+                    m,
+                    n,
+                    orientation,
+                    freq_hz,
+                    t60_s,
+                    gain,
+                    modal_mass_kg: sigma_eff * norm,
+                    listed: listed.is_some(),
+                    radial: Arc::clone(&radial),
+                });
+            }
+        };
+        for k in &drum.modes {
+            push(k.m, k.n, Some(k), &mut modes);
+        }
+        for &(_, m, n) in &unlisted {
+            if modes.len() >= config.count {
+                break;
+            }
+            push(m, n, None, &mut modes);
+        }
+        Ok(HeadModes {
+            radius_m: a,
+            centre: drum.centre(),
+            toward_player: (-drum.centre().truncate())
+                .try_normalize()
+                .unwrap_or(DVec2::NEG_Y),
+            modes,
+        })
+    }
+
+    /// The mode orientations, listed modes first.
+    pub fn modes(&self) -> &[HeadMode] {
+        &self.modes
+    }
+
+    /// Head radius, m.
+    pub fn radius_m(&self) -> f64 {
+        self.radius_m
+    }
+
+    /// Head centre in the performer frame (on the head surface at rest), m.
+    pub fn centre(&self) -> DVec3 {
+        self.centre
+    }
+
+    /// A performer-frame point's head-local horizontal coordinates, m.
+    pub fn local(&self, point: DVec3) -> DVec2 {
+        let d = point.truncate() - self.centre.truncate();
+        let u = self.toward_player;
+        DVec2::new(d.dot(u), d.dot(u.perp()))
+    }
+
+    /// Head-local coordinates back to a performer-frame point on the resting head, m.
+    pub fn world(&self, local: DVec2) -> DVec3 {
+        let u = self.toward_player;
+        self.centre + (u * local.x + u.perp() * local.y).extend(0.0)
+    }
+
+    /// Whether a head-local point lies on the head (r ≤ a).
+    pub fn contains(&self, local: DVec2) -> bool {
+        local.length_squared() <= self.radius_m * self.radius_m
+    }
+
+    /// Every mode's shape Φ_k at a head-local point, written to `out` (same order as
+    /// [`modes`](Self::modes); `out` must be at least as long).
+    pub fn shapes_at(&self, local: DVec2, out: &mut [f64]) {
+        let s = local.length() / self.radius_m;
+        let theta = local.y.atan2(local.x);
+        for (o, mode) in out.iter_mut().zip(&self.modes) {
+            *o = mode.shape_polar(s, theta);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kit::Kit;
+
+    fn standard_26() -> Drum {
+        Kit::standard().drums[2].clone()
+    }
+
+    /// The default 24 orientations start with the kit's five (m,1) modes at the kit
+    /// ratios (both orientations), and include the (0,1) and (1,2).
+    #[test]
+    fn default_modes_follow_the_kit() {
+        let d = standard_26();
+        let h = HeadModes::new(&d, &ModeConfig::default()).unwrap();
+        assert_eq!(h.modes().len(), 24);
+        let f11 = d.tuning.hz();
+        for (i, want) in [1.0, 1.5, 1.98, 2.44, 2.94].iter().enumerate() {
+            let (c, s) = (&h.modes()[2 * i], &h.modes()[2 * i + 1]);
+            assert_eq!((c.m, c.n, c.orientation), (i as u32 + 1, 1, Orientation::Cos));
+            assert_eq!(s.orientation, Orientation::Sin);
+            assert!((c.freq_hz / f11 - want).abs() < 1e-12);
+        }
+        let has = |m, n| h.modes().iter().any(|k| (k.m, k.n) == (m, n));
+        assert!(has(0, 1) && has(1, 2) && has(0, 2));
+        // (0,2) and (1,2) near Fletcher & Rossing's 1.68 and 2.09 (within 5 %).
+        let ratio = |m, n| h.modes().iter().find(|k| (k.m, k.n) == (m, n)).unwrap().freq_hz / f11;
+        assert!((ratio(0, 2) / 1.68 - 1.0).abs() < 0.05, "{}", ratio(0, 2));
+        assert!((ratio(1, 2) / 2.09 - 1.0).abs() < 0.05, "{}", ratio(1, 2));
+    }
+
+    /// With 200 modes the unlisted ones come in rising frequency, all finite and positive.
+    #[test]
+    fn two_hundred_modes_are_sorted_and_sane() {
+        let d = standard_26();
+        let cfg = ModeConfig { count: 200, ..ModeConfig::default() };
+        let h = HeadModes::new(&d, &cfg).unwrap();
+        assert_eq!(h.modes().len(), 200);
+        let unlisted: Vec<f64> = h.modes().iter().filter(|k| !k.listed).map(|k| k.freq_hz).collect();
+        assert!(unlisted.windows(2).all(|w| w[0] <= w[1]));
+        assert!(h.modes().iter().all(|k| k.freq_hz > 0.0 && k.t60_s > 0.0 && k.modal_mass_kg > 0.0 && k.gain.is_finite()));
+        assert!(ModeConfig { count: 0, ..cfg }.check().is_err());
+        assert!(ModeConfig { count: 201, ..cfg }.check().is_err());
+    }
+
+    /// The membrane source reproduces the ideal-membrane ratios j_mn/j_11 and the kit's
+    /// membrane f11.
+    #[test]
+    fn membrane_source_uses_bessel_ratios() {
+        let d = standard_26();
+        let cfg = ModeConfig { count: 24, source: FrequencySource::Membrane };
+        let h = HeadModes::new(&d, &cfg).unwrap();
+        let f11 = h.modes()[0].freq_hz;
+        assert!((f11 / d.membrane_f11_hz() - 1.0).abs() < 1e-9);
+        assert!((h.modes()[2].freq_hz / f11 - 5.135_622 / 3.831_706).abs() < 1e-5);
+    }
+
+    /// Modal mass equals σ_eff ∫Φ² dA by numerical quadrature (1e-3), and shapes are 0 at
+    /// the rim, J_m(0) at the centre, and cos/sin in angle.
+    #[test]
+    fn modal_mass_and_shapes() {
+        let d = standard_26();
+        let h = HeadModes::new(&d, &ModeConfig::default()).unwrap();
+        let a = h.radius_m();
+        let sigma_eff = d.membrane.areal_density_kg_per_m2 / d.membrane.air_loading.powi(2);
+        let mut shapes = vec![0.0; h.modes().len()];
+        let mut integral = vec![0.0; h.modes().len()];
+        let (nr, nt) = (200, 96);
+        for i in 0..nr {
+            let r = (i as f64 + 0.5) / nr as f64 * a;
+            for j in 0..nt {
+                let t = (j as f64 + 0.5) / nt as f64 * TAU;
+                h.shapes_at(DVec2::from_angle(t) * r, &mut shapes);
+                let da = r * (a / nr as f64) * (TAU / nt as f64);
+                for (acc, s) in integral.iter_mut().zip(&shapes) {
+                    *acc += s * s * da;
+                }
+            }
+        }
+        for (k, mode) in h.modes().iter().enumerate() {
+            let m = sigma_eff * integral[k];
+            assert!((m / mode.modal_mass_kg - 1.0).abs() < 1e-3, "mode {k}: {m} vs {}", mode.modal_mass_kg);
+        }
+        h.shapes_at(DVec2::ZERO, &mut shapes);
+        for (s, mode) in shapes.iter().zip(h.modes()) {
+            let want = if mode.m == 0 { 1.0 } else { 0.0 };
+            assert!((s - want).abs() < 1e-9);
+        }
+        h.shapes_at(DVec2::new(a, 0.0), &mut shapes);
+        assert!(shapes.iter().all(|s| s.abs() < 1e-6));
+        // Local frame: the point toward the player is local +x.
+        let p = d.point_on_head(0.5, 0.0);
+        let l = h.local(p);
+        assert!((l - DVec2::new(0.5 * a, 0.0)).length() < 1e-12);
+        let q = d.point_on_head(0.5, 90.0);
+        assert!((h.local(q) - DVec2::new(0.0, 0.5 * a)).length() < 1e-12);
+        assert!((h.world(h.local(q)) - q).length() < 1e-12);
+    }
+}

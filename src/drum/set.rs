@@ -1,0 +1,330 @@
+//! Every head of a kit stepped at the simulation rate with the two stick tips in contact
+//! (issue 6 §2; seed 000 eqs. 5–6), two-way: each tip's Hertz force F = k·c^α, with
+//! c = (head surface + d(x)) − (tip − felt radius) and d(x) = Σ q_k Φ_k(x), pushes the
+//! membrane modes down (generalised force −F·Φ_k(x)) and the stick up, so the stick
+//! rebounds physically and a strike on a ringing head feels its motion.
+//!
+//! Each mode is advanced by its exact (ZOH) step with the force held over the step, the
+//! force computed from the state at the start of the step (explicit coupling). Modes at or
+//! above the simulation's Nyquist frequency (f ≥ 1/(2·dt)) are left out of the mechanical
+//! coupling — they would alias — but still sound: the audio voices (48 kHz) take every
+//! mode below the audio Nyquist, driven by the recorded force.
+
+use super::contact::HertzContact;
+use super::modes::HeadModes;
+use super::oscillator::ModeStep;
+use super::{DrumError, ModeConfig};
+use crate::kit::{Kit, Mallet, Side};
+use glam::{DVec2, DVec3};
+
+/// One touch of a stick tip on a head, from the first step with force to the first
+/// step without.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactEvent {
+    pub side: Side,
+    /// Drum index in the kit.
+    pub drum: usize,
+    /// Time of the first step with force, s.
+    pub start_s: f64,
+    /// Time of the first step without force (for a contact still going on: the end of
+    /// the latest step), s.
+    pub end_s: f64,
+    /// Largest force during the contact, N.
+    pub peak_force_n: f64,
+    /// Downward tip speed at first touch, m/s (≥ 0).
+    pub impact_speed_mps: f64,
+    /// Where the tip first touched: the point on the resting head under the tip,
+    /// performer frame, m.
+    pub point: DVec3,
+}
+
+impl ContactEvent {
+    /// Contact duration, s.
+    pub fn duration_s(&self) -> f64 {
+        self.end_s - self.start_s
+    }
+}
+
+/// The force one tip put on one head during one step: what drives the sound.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Excitation {
+    /// Step index (0 = the first call of [`DrumSet::step`]).
+    pub step: u64,
+    /// Time of the step, s (force held from `time_s` to `time_s + dt`).
+    pub time_s: f64,
+    pub drum: usize,
+    pub side: Side,
+    /// Contact point in head-local coordinates (see [`HeadModes::local`]), m.
+    pub point: DVec2,
+    /// Force pressing the head down, N (> 0).
+    pub force_n: f64,
+}
+
+/// One head's mechanical state: the modes below the simulation Nyquist frequency.
+#[derive(Clone, Debug)]
+struct Head {
+    modes: HeadModes,
+    /// Indices (into `modes.modes()`) of the coupled modes.
+    coupled: Vec<usize>,
+    steps: Vec<ModeStep>,
+    inv_mass: Vec<f64>,
+    /// State per coupled mode: (ω₀·q, q̇), m/s.
+    x: Vec<[f64; 2]>,
+    /// Σ|q_k| ≥ |d(x)| anywhere on the head (|Φ| ≤ 1), m: a cheap "far above" test.
+    bound_m: f64,
+}
+
+impl Head {
+    fn displacement(&self, shapes: &[f64]) -> f64 {
+        self.coupled
+            .iter()
+            .zip(&self.x)
+            .zip(&self.steps)
+            .map(|((&k, x), s)| x[0] / s.omega0 * shapes[k])
+            .sum()
+    }
+}
+
+/// Every head of a kit with both stick tips; `Clone` is the snapshot for re-simulation.
+#[derive(Clone, Debug)]
+pub struct DrumSet {
+    dt_s: f64,
+    config: ModeConfig,
+    law: HertzContact,
+    heads: Vec<Head>,
+    step: u64,
+    contacts: Vec<ContactEvent>,
+    /// Index in `contacts` of each tip's ongoing contact.
+    open: [Option<usize>; 2],
+    excitation: Vec<Excitation>,
+    /// Scratch: mode shapes under each tip.
+    shapes: [Vec<f64>; 2],
+}
+
+const SIDES: [Side; 2] = [Side::Left, Side::Right];
+
+impl DrumSet {
+    /// Every drum of `kit` at rest, struck with `mallet`, stepped every `dt_s` seconds.
+    pub fn new(
+        kit: &Kit,
+        mallet: &Mallet,
+        config: &ModeConfig,
+        dt_s: f64,
+    ) -> Result<DrumSet, DrumError> {
+        if !(dt_s.is_finite() && dt_s > 0.0) {
+            return Err(DrumError::TimeStep(dt_s));
+        }
+        let law = HertzContact::of(mallet)?;
+        let nyquist = 0.5 / dt_s;
+        let heads = kit
+            .drums
+            .iter()
+            .map(|drum| {
+                let modes = HeadModes::new(drum, config)?;
+                let coupled: Vec<usize> = (0..modes.modes().len())
+                    .filter(|&k| modes.modes()[k].freq_hz < nyquist)
+                    .collect();
+                let steps = coupled
+                    .iter()
+                    .map(|&k| {
+                        let m = &modes.modes()[k];
+                        ModeStep::new(m.freq_hz, m.t60_s, dt_s)
+                    })
+                    .collect();
+                let inv_mass = coupled
+                    .iter()
+                    .map(|&k| 1.0 / modes.modes()[k].modal_mass_kg)
+                    .collect();
+                Ok(Head {
+                    x: vec![[0.0; 2]; coupled.len()],
+                    modes,
+                    coupled,
+                    steps,
+                    inv_mass,
+                    bound_m: 0.0,
+                })
+            })
+            .collect::<Result<Vec<_>, DrumError>>()?;
+        let most = heads.iter().map(|h| h.modes.modes().len()).max().unwrap_or(0);
+        Ok(DrumSet {
+            dt_s,
+            config: *config,
+            law,
+            heads,
+            step: 0,
+            contacts: Vec::new(),
+            open: [None, None],
+            excitation: Vec::new(),
+            shapes: [vec![0.0; most], vec![0.0; most]],
+        })
+    }
+
+    /// One simulation step at `time_s`: `tips[i]` = (position m, velocity m/s) of tip i
+    /// (0 left, 1 right), performer frame. Returns the force on each tip, N (+z pushes
+    /// the stick up). A tip outside every head (horizontally) never touches.
+    pub fn step(&mut self, time_s: f64, tips: [(DVec3, DVec3); 2]) -> [DVec3; 2] {
+        let mut force = [0.0f64; 2];
+        let mut touching: [Option<(usize, DVec2)>; 2] = [None, None];
+        for (i, &(p, _)) in tips.iter().enumerate() {
+            let Some((j, local)) = self.head_under(p) else {
+                continue;
+            };
+            let head = &self.heads[j];
+            let bottom = p.z - self.law.ball_radius_m;
+            let surface = head.modes.centre().z;
+            // NaN positions fail every comparison and never touch.
+            if !(bottom - surface <= head.bound_m) {
+                continue;
+            }
+            head.modes.shapes_at(local, &mut self.shapes[i]);
+            let d = head.displacement(&self.shapes[i]);
+            let f = self.law.force(surface + d - bottom);
+            if f > 0.0 {
+                force[i] = f;
+                touching[i] = Some((j, local));
+            }
+        }
+        for (j, head) in self.heads.iter_mut().enumerate() {
+            let mut bound = 0.0;
+            for (&k, (x, (s, inv_m))) in head
+                .coupled
+                .iter()
+                .zip(head.x.iter_mut().zip(head.steps.iter().zip(&head.inv_mass)))
+            {
+                let mut generalised = 0.0;
+                for i in 0..2 {
+                    if let Some((tj, _)) = touching[i]
+                        && tj == j
+                    {
+                        generalised -= force[i] * self.shapes[i][k];
+                    }
+                }
+                *x = s.advance(*x, generalised * inv_m);
+                bound += (x[0] / s.omega0).abs();
+            }
+            head.bound_m = bound;
+        }
+        for i in 0..2 {
+            self.record(i, time_s, tips[i], force[i], touching[i]);
+        }
+        self.step += 1;
+        [
+            DVec3::new(0.0, 0.0, force[0]),
+            DVec3::new(0.0, 0.0, force[1]),
+        ]
+    }
+
+    fn head_under(&self, p: DVec3) -> Option<(usize, DVec2)> {
+        self.heads.iter().enumerate().find_map(|(j, h)| {
+            let local = h.modes.local(p);
+            h.modes.contains(local).then_some((j, local))
+        })
+    }
+
+    fn record(
+        &mut self,
+        i: usize,
+        time_s: f64,
+        (p, v): (DVec3, DVec3),
+        force: f64,
+        touching: Option<(usize, DVec2)>,
+    ) {
+        let Some((drum, local)) = touching else {
+            self.open[i] = None;
+            return;
+        };
+        self.excitation.push(Excitation {
+            step: self.step,
+            time_s,
+            drum,
+            side: SIDES[i],
+            point: local,
+            force_n: force,
+        });
+        let end_s = time_s + self.dt_s;
+        if let Some(c) = self.open[i].map(|k| &mut self.contacts[k])
+            && c.drum == drum
+        {
+            c.end_s = end_s;
+            c.peak_force_n = c.peak_force_n.max(force);
+            return;
+        }
+        self.open[i] = Some(self.contacts.len());
+        let head = &self.heads[drum].modes;
+        self.contacts.push(ContactEvent {
+            side: SIDES[i],
+            drum,
+            start_s: time_s,
+            end_s,
+            peak_force_n: force,
+            impact_speed_mps: (-v.z).max(0.0),
+            point: head.world(head.local(p)),
+        });
+    }
+
+    /// Finished and ongoing contacts, in start order.
+    pub fn contacts(&self) -> &[ContactEvent] {
+        &self.contacts
+    }
+
+    /// The force record that drives the sound: one entry per step and touching tip.
+    pub fn excitation(&self) -> &[Excitation] {
+        &self.excitation
+    }
+
+    /// Membrane displacement (m, +up) of drum `drum` at the performer-frame point
+    /// `point` (its height is ignored); 0 off the head or for an unknown drum.
+    pub fn displacement_at(&self, drum: usize, point: DVec3) -> f64 {
+        let Some(head) = self.heads.get(drum) else {
+            return 0.0;
+        };
+        let local = head.modes.local(point);
+        if !head.modes.contains(local) {
+            return 0.0;
+        }
+        let mut shapes = vec![0.0; head.modes.modes().len()];
+        head.modes.shapes_at(local, &mut shapes);
+        head.displacement(&shapes)
+    }
+
+    /// The modes of drum `drum` (all of them, coupled or not).
+    pub fn head(&self, drum: usize) -> Option<&HeadModes> {
+        self.heads.get(drum).map(|h| &h.modes)
+    }
+
+    /// Number of heads.
+    pub fn len(&self) -> usize {
+        self.heads.len()
+    }
+
+    /// Whether the kit has no drums.
+    pub fn is_empty(&self) -> bool {
+        self.heads.is_empty()
+    }
+
+    /// How many modes of drum `drum` take part in the mechanical coupling (those below
+    /// the simulation's Nyquist frequency).
+    pub fn coupled_mode_count(&self, drum: usize) -> usize {
+        self.heads.get(drum).map_or(0, |h| h.coupled.len())
+    }
+
+    /// Simulation step, s.
+    pub fn dt_s(&self) -> f64 {
+        self.dt_s
+    }
+
+    /// Steps taken so far.
+    pub fn steps_taken(&self) -> u64 {
+        self.step
+    }
+
+    /// The mode configuration every head was built with.
+    pub fn config(&self) -> &ModeConfig {
+        &self.config
+    }
+
+    /// The mallet's contact law.
+    pub fn contact_law(&self) -> &HertzContact {
+        &self.law
+    }
+}

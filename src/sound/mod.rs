@@ -1,0 +1,213 @@
+//! Sound from the simulated strikes (issue 6 §3), 48 kHz stereo, the same code offline and
+//! live: three models — **modal** (a voice bank driven by the recorded contact force,
+//! seed 000 §4), **sample** replay and **signal**-based partials (seed 002) — each with a
+//! fixed calibration, mixed with a constant-power pan from each drum's placement x, then
+//! checked for NaN and held below −1 dBFS by scaling the whole render down if needed.
+
+pub mod modal;
+pub mod sample;
+pub mod signal;
+pub mod spectrum;
+pub mod voices;
+pub mod wav;
+
+pub use spectrum::spectrum;
+pub use wav::write_wav;
+
+use crate::drum::DrumSet;
+use crate::kit::Kit;
+use std::f64::consts::FRAC_PI_4;
+use std::fmt;
+use std::path::PathBuf;
+use std::str::FromStr;
+
+/// Audio sample rate, Hz.
+pub const SAMPLE_RATE_HZ: u32 = 48_000;
+/// Highest peak a render may reach, linear (−1 dBFS).
+pub const PEAK_LIMIT: f64 = 0.891_250_938_133_745_5;
+/// Placement x (m) that pans a drum fully to one side; nearer drums pan in proportion.
+pub const PAN_SPAN_M: f64 = 1.2;
+/// Impact speed of the reference strike every model calibrates to, m/s (ff, see
+/// [`crate::drum::strike::impact_speed_mps`]).
+pub const REFERENCE_SPEED_MPS: f64 = 3.5;
+/// Peak level the sample and signal models give the reference strike (−6 dBFS); the
+/// modal model's calibration puts a reference strike on the 26-inch drum there too.
+pub const REFERENCE_LEVEL: f64 = 0.5;
+
+/// Which sound model renders.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum SoundModel {
+    /// Modal voices driven by the simulated contact force.
+    #[default]
+    Modal,
+    /// A recorded note per drum, pitched and scaled by impact speed.
+    Sample,
+    /// Decaying partials at the kit's modes plus a noise burst.
+    Signal,
+}
+
+impl SoundModel {
+    /// Every model with its command-line name.
+    pub const ALL: [(SoundModel, &'static str); 3] = [
+        (SoundModel::Modal, "modal"),
+        (SoundModel::Sample, "sample"),
+        (SoundModel::Signal, "signal"),
+    ];
+}
+
+impl fmt::Display for SoundModel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let name = Self::ALL.iter().find(|(m, _)| m == self).map_or("?", |(_, n)| n);
+        f.write_str(name)
+    }
+}
+
+impl FromStr for SoundModel {
+    type Err = SoundError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .iter()
+            .find(|(_, n)| n.eq_ignore_ascii_case(s.trim()))
+            .map(|(m, _)| *m)
+            .ok_or_else(|| SoundError::UnknownModel(s.to_string()))
+    }
+}
+
+/// Rendered sound.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Audio {
+    /// Samples per second per channel, Hz.
+    pub rate_hz: u32,
+    /// Channels (2: left, right).
+    pub channels: u16,
+    /// Interleaved samples in [−1, 1].
+    pub samples: Vec<f32>,
+    /// Scale applied on top of the model's fixed calibration to keep the peak at or below
+    /// −1 dBFS (1 when none was needed).
+    pub gain: f64,
+}
+
+impl Audio {
+    /// Frames (samples per channel).
+    pub fn frames(&self) -> usize {
+        self.samples.len() / usize::from(self.channels.max(1))
+    }
+
+    /// One channel as its own signal.
+    pub fn channel(&self, c: usize) -> Vec<f32> {
+        self.samples
+            .iter()
+            .skip(c)
+            .step_by(usize::from(self.channels.max(1)))
+            .copied()
+            .collect()
+    }
+
+    /// The mean of the channels.
+    pub fn mono(&self) -> Vec<f32> {
+        let ch = usize::from(self.channels.max(1));
+        self.samples
+            .chunks_exact(ch)
+            .map(|f| f.iter().sum::<f32>() / ch as f32)
+            .collect()
+    }
+}
+
+/// Why sound could not be rendered or written.
+#[derive(Debug, thiserror::Error)]
+pub enum SoundError {
+    #[error("unknown sound model `{0}` (expected modal, sample or signal)")]
+    UnknownModel(String),
+    #[error("duration {0} s is not a finite time ≥ 0 of at most 24 hours")]
+    Duration(f64),
+    #[error("the {model} model produced a non-finite sample at frame {frame}")]
+    NonFinite { model: SoundModel, frame: usize },
+    #[error("the drum set has {drums} heads but the kit {kit}")]
+    KitMismatch { drums: usize, kit: usize },
+    #[error("embedded sample {name}: {message}")]
+    Sample { name: String, message: String },
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{}: {source}", path.display())]
+    Wav {
+        path: PathBuf,
+        #[source]
+        source: hound::Error,
+    },
+}
+
+/// Stereo gains (left, right) for a drum at placement x (m): constant power,
+/// pan = clamp(x / PAN_SPAN_M, −1, 1), angle (pan + 1)·π/4.
+pub fn pan_gains(x_m: f64) -> (f64, f64) {
+    let pan = (x_m / PAN_SPAN_M).clamp(-1.0, 1.0);
+    let angle = (pan + 1.0) * FRAC_PI_4;
+    (angle.cos(), angle.sin())
+}
+
+/// Render `duration_s` of sound from what `drums` recorded (excitation, contacts).
+pub fn render(
+    kit: &Kit,
+    drums: &DrumSet,
+    duration_s: f64,
+    model: SoundModel,
+) -> Result<Audio, SoundError> {
+    if !(duration_s.is_finite() && (0.0..=86_400.0).contains(&duration_s)) {
+        return Err(SoundError::Duration(duration_s));
+    }
+    if drums.len() != kit.drums.len() {
+        return Err(SoundError::KitMismatch {
+            drums: drums.len(),
+            kit: kit.drums.len(),
+        });
+    }
+    let frames = (duration_s * f64::from(SAMPLE_RATE_HZ)).round() as usize;
+    let mut samples = vec![0.0f32; 2 * frames];
+    let mut mono = vec![0.0f32; frames];
+    for (j, drum) in kit.drums.iter().enumerate() {
+        mono.fill(0.0);
+        let heard = match model {
+            SoundModel::Modal => modal::render_drum(drums, j, &mut mono),
+            SoundModel::Sample => sample::render_drum(drum, drums, j, &mut mono)?,
+            SoundModel::Signal => signal::render_drum(drums, j, &mut mono),
+        };
+        if !heard {
+            continue;
+        }
+        let (l, r) = pan_gains(drum.placement.x_m);
+        let (l, r) = (l as f32, r as f32);
+        for (frame, &s) in samples.chunks_exact_mut(2).zip(&mono) {
+            frame[0] += l * s;
+            frame[1] += r * s;
+        }
+    }
+    let mut peak = 0.0f32;
+    for (i, s) in samples.iter().enumerate() {
+        if !s.is_finite() {
+            return Err(SoundError::NonFinite {
+                model,
+                frame: i / 2,
+            });
+        }
+        peak = peak.max(s.abs());
+    }
+    let gain = if f64::from(peak) > PEAK_LIMIT {
+        PEAK_LIMIT / f64::from(peak)
+    } else {
+        1.0
+    };
+    if gain < 1.0 {
+        for s in &mut samples {
+            *s = (f64::from(*s) * gain) as f32;
+        }
+    }
+    Ok(Audio {
+        rate_hz: SAMPLE_RATE_HZ,
+        channels: 2,
+        samples,
+        gain,
+    })
+}

@@ -1,0 +1,66 @@
+//! The signal-based sound model (seed 002): each contact starts decaying sinusoidal
+//! partials at the head's mode frequencies, decays and gains (the voices of
+//! [`modal::voices_for`]), each weighted by its mode shape at the impact point, plus a
+//! short noise burst (deterministic, seeded by drum and contact), all in proportion to
+//! the impact speed: a strike at `REFERENCE_SPEED_MPS` gives partials of total amplitude
+//! ≈ `REFERENCE_LEVEL` at the playing spot.
+
+use super::modal::{FLUSH_FLOOR, voices_for};
+use super::voices::VoiceBank;
+use super::{REFERENCE_LEVEL, REFERENCE_SPEED_MPS, SAMPLE_RATE_HZ};
+use crate::drum::DrumSet;
+use crate::rng::Rng;
+
+/// Noise burst: amplitude relative to the partials' scale, decay time constant (s),
+/// length (s), and one-pole low-pass coefficient (≈ 3 kHz at 48 kHz).
+const NOISE_LEVEL: f64 = 0.15;
+const NOISE_TAU_S: f64 = 0.002;
+const NOISE_LEN_S: f64 = 0.012;
+const NOISE_POLE: f64 = 0.67;
+
+/// Render drum `j`'s contacts into `out`; returns whether any contact was on it.
+pub fn render_drum(drums: &DrumSet, j: usize, out: &mut [f32]) -> bool {
+    let Some(head) = drums.head(j) else {
+        return false;
+    };
+    let contacts: Vec<(usize, &crate::drum::ContactEvent)> = drums
+        .contacts()
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.drum == j)
+        .collect();
+    if contacts.is_empty() {
+        return false;
+    }
+    let fs = f64::from(SAMPLE_RATE_HZ);
+    let (index, voices) = voices_for(head, 1.0);
+    // Normalise so Σ gain·|amplitude| of the (1,1)…(5,1) partials is REFERENCE_LEVEL at
+    // the reference speed when the shapes are 1.
+    let total_gain: f64 = voices.iter().map(|v| v.gain).sum::<f64>().max(1e-12);
+    let mut bank = VoiceBank::new(&voices, fs);
+    let mut shapes = vec![0.0; head.modes().len()];
+    let mut kick = vec![0.0f32; index.len()];
+    let mut cursor = 0;
+    for (ci, c) in &contacts {
+        let start = ((c.start_s * fs).round().max(0.0) as usize).min(out.len());
+        bank.ring(&mut out[cursor..start], FLUSH_FLOOR);
+        cursor = start;
+        let amp = REFERENCE_LEVEL * c.impact_speed_mps / REFERENCE_SPEED_MPS;
+        head.shapes_at(head.local(c.point), &mut shapes);
+        for (d, &k) in kick.iter_mut().zip(&index) {
+            *d = (amp / total_gain * 2.0 * shapes[k]) as f32;
+        }
+        bank.kick(&kick);
+        // The noise burst, added directly.
+        let mut rng = Rng::new(0x5EED_0000 ^ ((j as u64) << 32) ^ *ci as u64);
+        let mut lp = 0.0;
+        let len = (NOISE_LEN_S * fs) as usize;
+        for (i, o) in out[start..].iter_mut().take(len).enumerate() {
+            lp = NOISE_POLE * lp + (1.0 - NOISE_POLE) * rng.uniform(-1.0, 1.0);
+            let env = (-(i as f64) / (NOISE_TAU_S * fs)).exp();
+            *o += (NOISE_LEVEL * amp * env * lp) as f32;
+        }
+    }
+    bank.ring(&mut out[cursor..], FLUSH_FLOOR);
+    true
+}
