@@ -15,6 +15,7 @@ pub mod mocap;
 pub mod motion;
 pub mod pitch;
 pub mod problem;
+pub mod render;
 pub mod rng;
 pub mod score;
 pub mod sound;

@@ -328,6 +328,11 @@ impl Dynamics {
         external: &[ExternalForce],
     ) -> [DVec3; N] {
         self.kinematics(state);
+        self.articulated(tau, external)
+    }
+
+    /// ABA passes two and three, after [`Self::kinematics`] of the state.
+    fn articulated(&mut self, tau: &[DVec3; N], external: &[ExternalForce]) -> [DVec3; N] {
         let s = &mut self.scratch;
         s.ia = self.inertia;
         for i in 0..N {
@@ -382,10 +387,37 @@ impl Dynamics {
         dt: f64,
     ) {
         let qdd = self.accelerations(state, tau, external);
-        for ((q, w), a) in state.q.iter_mut().zip(&mut state.w).zip(qdd) {
-            *w += dt * a;
-            *q = (*q * DQuat::from_scaled_axis(*w * dt)).normalize();
-        }
+        integrate(state, &qdd, dt);
+    }
+
+    /// One step like [`Self::step`] with forces on the stick tips: `contact` gets both tips'
+    /// position (m) and velocity (m/s) at the start of the step, performer frame, and
+    /// returns the force on each (N, performer frame), applied at the tip during the step.
+    /// One kinematics pass serves both.
+    pub fn step_with_tip_forces(
+        &mut self,
+        state: &mut State,
+        tau: &[DVec3; N],
+        contact: impl FnOnce([(DVec3, DVec3); 2]) -> [DVec3; 2],
+        dt: f64,
+    ) -> [(DVec3, DVec3); 2] {
+        self.kinematics(state);
+        let tips = self.tips_from_kinematics();
+        let forces = contact(tips);
+        let external: [ExternalForce; 2] = std::array::from_fn(|h| ExternalForce {
+            segment: Joint::arm([Side::Left, Side::Right][h])[3].index(),
+            point_world: tips[h].0,
+            force_world: forces[h],
+        });
+        let external: &[ExternalForce] = match forces.map(|f| f != DVec3::ZERO) {
+            [false, false] => &[],
+            [true, false] => &external[..1],
+            [false, true] => &external[1..],
+            [true, true] => &external,
+        };
+        let qdd = self.articulated(tau, external);
+        integrate(state, &qdd, dt);
+        tips
     }
 
     /// Kinetic and gravitational potential energy, J (potential zero at the performer
@@ -422,6 +454,10 @@ impl Dynamics {
     /// from one kinematics pass.
     pub fn tips(&mut self, state: &State) -> [(DVec3, DVec3); 2] {
         self.kinematics(state);
+        self.tips_from_kinematics()
+    }
+
+    fn tips_from_kinematics(&self) -> [(DVec3, DVec3); 2] {
         let s = &self.scratch;
         let local = DVec3::new(0.0, 0.0, -self.model.skeleton.stick_length_m);
         [Side::Left, Side::Right].map(|side| {
@@ -507,6 +543,14 @@ impl Dynamics {
             }
         }
         m
+    }
+}
+
+/// Semi-implicit Euler: w += dt·ẇ, then q ← q·exp(w·dt) normalised.
+fn integrate(state: &mut State, qdd: &[DVec3; N], dt: f64) {
+    for ((q, w), a) in state.q.iter_mut().zip(&mut state.w).zip(qdd) {
+        *w += dt * *a;
+        *q = (*q * DQuat::from_scaled_axis(*w * dt)).normalize();
     }
 }
 

@@ -16,7 +16,7 @@
 //! with an error naming the time if the state becomes non-finite or diverges.
 
 use super::control::{Gains, pd_torques, rotation_error};
-use super::dynamics::{Dynamics, ExternalForce, State};
+use super::dynamics::{Dynamics, State};
 use super::ik::{self, IkParams};
 use super::model::BodyModel;
 use super::skeleton::{JOINT_COUNT, Joint, Pose};
@@ -289,7 +289,6 @@ pub fn simulate_in(
         reference_gain: 1.0,
         ..params.ik.clone()
     };
-    let grips = [Side::Left, Side::Right].map(|side| Joint::arm(side)[3].index());
     // Target joint velocities (over each task interval) and accelerations.
     let velocity = |k: usize| -> [DVec3; JOINT_COUNT] {
         let k = k.clamp(1, n.max(2) - 1);
@@ -342,22 +341,13 @@ pub fn simulate_in(
                     }
                 }
             }
-            let tips = dynamics.tips(&state);
-            let forces = environment.tip_forces(time_s, tips);
-            let external = std::array::from_fn::<_, 2, _>(|h| ExternalForce {
-                segment: grips[h],
-                point_world: tips[h].0,
-                force_world: forces[h],
-            });
-            let touching = forces.map(|f| f != DVec3::ZERO);
-            let external: &[ExternalForce] = match touching {
-                [false, false] => &[],
-                [true, false] => &external[..1],
-                [false, true] => &external[1..],
-                [true, true] => &external,
-            };
             let tau = pd_torques(&gains, &state, &goal, &target_w, &bias);
-            dynamics.step(&mut state, &tau, external, dt);
+            dynamics.step_with_tip_forces(
+                &mut state,
+                &tau,
+                |tips| environment.tip_forces(time_s, tips),
+                dt,
+            );
             let speed = state.w.iter().map(|w| w.length()).fold(0.0, f64::max);
             if !state.is_finite() || speed > params.max_angular_speed {
                 let time_s = time_s + dt;

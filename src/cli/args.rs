@@ -71,3 +71,13 @@ pub fn parse_vec3(s: &str) -> Result<glam::DVec3, String> {
         _ => Err(format!("expected x,y,z in metres, found \"{s}\"")),
     }
 }
+arg_enum!(ControlArg => crate::body::sim::Pipeline {
+    Himc => crate::body::sim::Pipeline::Himc,
+    Id => crate::body::sim::Pipeline::Id,
+    Ik => crate::body::sim::Pipeline::Ik,
+});
+arg_enum!(SoundArg => crate::sound::SoundModel {
+    Modal => crate::sound::SoundModel::Modal,
+    Sample => crate::sound::SoundModel::Sample,
+    Signal => crate::sound::SoundModel::Signal,
+});

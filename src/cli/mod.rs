@@ -8,10 +8,12 @@ mod compose;
 mod evaluate;
 mod midi;
 mod mocap;
+mod render;
 mod sticking;
 
 use args::{
-    DynamicArg, GripArg, LocationArg, ModeArg, SideArg, UpArg, parse_format, parse_pair, parse_vec3,
+    ControlArg, DynamicArg, GripArg, LocationArg, ModeArg, SideArg, SoundArg, UpArg, parse_format,
+    parse_pair, parse_vec3,
 };
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -91,6 +93,36 @@ pub enum Command {
         /// Also draw tip height and depth against time, beats marked, as a PNG.
         #[arg(long)]
         plot: Option<PathBuf>,
+        /// The motion database folder.
+        #[arg(long, default_value = "mocap")]
+        db: PathBuf,
+        /// Seed of the choice among near-equal motion units.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
+    /// Render a score to sound (and motion): compose, simulate the body striking the modal
+    /// drums at 10 kHz with timing compensation, synthesise 48 kHz stereo.
+    Render {
+        /// The score (.ron).
+        score: PathBuf,
+        /// The WAV to write (48 kHz, stereo).
+        #[arg(long)]
+        wav: PathBuf,
+        /// Also write the simulated motion as CSV (tips, targets, joint rotations, 250 Hz).
+        #[arg(long)]
+        motion: Option<PathBuf>,
+        /// Also write one JSON object per stick-head contact.
+        #[arg(long)]
+        events: Option<PathBuf>,
+        /// The control pipeline driving the body.
+        #[arg(long, value_enum, default_value_t = ControlArg::Himc)]
+        control: ControlArg,
+        /// The sound model.
+        #[arg(long, value_enum, default_value_t = SoundArg::Modal)]
+        sound: SoundArg,
+        /// Print simulated seconds per wall second and where the time went.
+        #[arg(long)]
+        stats: bool,
         /// The motion database folder.
         #[arg(long, default_value = "mocap")]
         db: PathBuf,
@@ -238,6 +270,30 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             db,
             seed,
         }) => compose::run(&score, &db, &output, plot.as_deref(), seed).map(|()| ExitCode::SUCCESS),
+        Some(Command::Render {
+            score,
+            wav,
+            motion,
+            events,
+            control,
+            sound,
+            stats,
+            db,
+            seed,
+        }) => render::run(
+            &score,
+            &db,
+            &render::Outputs {
+                wav: &wav,
+                motion: motion.as_deref(),
+                events: events.as_deref(),
+            },
+            control.into(),
+            sound.into(),
+            seed,
+            stats,
+        )
+        .map(|()| ExitCode::SUCCESS),
         Some(Command::Evaluate {
             trials,
             json,

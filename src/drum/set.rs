@@ -145,7 +145,11 @@ impl DrumSet {
                 })
             })
             .collect::<Result<Vec<_>, DrumError>>()?;
-        let most = heads.iter().map(|h| h.modes.modes().len()).max().unwrap_or(0);
+        let most = heads
+            .iter()
+            .map(|h| h.modes.modes().len())
+            .max()
+            .unwrap_or(0);
         Ok(DrumSet {
             dt_s,
             config: *config,

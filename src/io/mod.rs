@@ -1,7 +1,9 @@
-//! File adapters: strict RON files with atomic saving, and Standard MIDI Files in and out.
+//! File adapters: strict RON files with atomic saving, Standard MIDI Files in and out,
+//! and CSV of composed and simulated motion.
 
 pub mod midi_export;
 pub mod midi_import;
+pub mod motion_csv;
 pub mod plot;
 pub mod ron_file;
 pub mod tips_csv;

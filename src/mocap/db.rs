@@ -99,6 +99,9 @@ impl TakeData {
     }
 }
 
+/// The sides in the order of `[left, right]` arrays.
+pub const SIDES: [Side; 2] = [Side::Left, Side::Right];
+
 /// Index of a side in `[left, right]` arrays.
 pub fn side_index(side: Side) -> usize {
     match side {

@@ -1,0 +1,175 @@
+//! `timpanist render`: a whole score to a WAV (and optionally the simulated motion as CSV
+//! and one JSON object per contact), through the same pipeline as the editor, with a
+//! progress bar on stderr and, with `--stats`, where the time went. Everything is computed
+//! before anything is written; each file is written atomically.
+
+use crate::body::sim::Pipeline;
+use crate::io::{motion_csv, ron_file};
+use crate::mocap::db::MotionDb;
+use crate::motion::plan::PlanParams;
+use crate::render::{Progress, RenderParams, Rendering, render};
+use crate::score::LoadedScore;
+use crate::sound::SoundModel;
+use std::io::{IsTerminal, Write};
+use std::path::Path;
+
+/// Where to write what.
+pub struct Outputs<'a> {
+    pub wav: &'a Path,
+    pub motion: Option<&'a Path>,
+    pub events: Option<&'a Path>,
+}
+
+/// Render `score` and write `outputs`.
+pub fn run(
+    score: &Path,
+    db_dir: &Path,
+    outputs: &Outputs,
+    control: Pipeline,
+    sound: SoundModel,
+    seed: u64,
+    stats: bool,
+) -> anyhow::Result<()> {
+    let loaded = LoadedScore::load(score)?;
+    for notice in &loaded.notices {
+        eprintln!("note: {notice}");
+    }
+    let db = MotionDb::load(db_dir)?;
+    let params = RenderParams {
+        control,
+        sound,
+        plan: PlanParams {
+            seed,
+            ..PlanParams::default()
+        },
+        ..RenderParams::default()
+    };
+    let started = std::time::Instant::now();
+    let mut bar = ProgressBar::new();
+    let rendering = render(&loaded, &db, &params, &mut |p| {
+        bar.show(p);
+        true
+    });
+    bar.finish();
+    let rendering = rendering.map_err(|e| anyhow::anyhow!("{}: {e}", score.display()))?;
+    let wall = started.elapsed();
+    let events = outputs
+        .events
+        .map(|_| serde_json::to_string_pretty(&rendering.events))
+        .transpose()?;
+    let motion = outputs
+        .motion
+        .map(|_| motion_csv::to_csv(&rendering.motion, &rendering.reference, rendering.start_s));
+    crate::sound::write_wav(outputs.wav, &rendering.audio)?;
+    if let (Some(path), Some(text)) = (outputs.motion, motion) {
+        ron_file::write_atomic(path, text.as_bytes())?;
+    }
+    if let (Some(path), Some(text)) = (outputs.events, events) {
+        ron_file::write_atomic(path, text.as_bytes())?;
+    }
+    let t = &rendering.timing;
+    println!(
+        "{} -> {}: {} strokes, {} contacts, {:.1} s of audio; timing median {:.2} ms, worst {:.2} ms{}; rendered in {:.1} s",
+        score.display(),
+        outputs.wav.display(),
+        t.strokes,
+        rendering.events.len(),
+        rendering.audio.frames() as f64 / f64::from(rendering.audio.rate_hz),
+        t.median_abs_s * 1e3,
+        t.worst_abs_s * 1e3,
+        if t.missed > 0 {
+            format!(", {} strokes missed the head", t.missed)
+        } else {
+            String::new()
+        },
+        wall.as_secs_f64()
+    );
+    if stats {
+        print_stats(&rendering);
+    }
+    Ok(())
+}
+
+fn print_stats(r: &Rendering) {
+    let s = &r.stats;
+    let simulate: std::time::Duration = s.passes.iter().sum();
+    println!(
+        "simulated {:.2} s of motion x {} pass(es) at {:.0} Hz",
+        s.simulated_s,
+        s.passes.len(),
+        1.0 / r.drums.dt_s()
+    );
+    println!(
+        "speed: {:.1} simulated s per wall s overall; body+drums {:.1}x real time per pass",
+        s.realtime_factor(),
+        s.simulated_s * s.passes.len() as f64 / simulate.as_secs_f64().max(1e-9)
+    );
+    println!("time: compose {:.3} s", s.compose.as_secs_f64());
+    for (i, (p, t)) in s.passes.iter().zip(&s.timing).enumerate() {
+        println!(
+            "      pass {}: {:.3} s (timing median {:.2} ms, worst {:.2} ms, missed {})",
+            i + 1,
+            p.as_secs_f64(),
+            t.median_abs_s * 1e3,
+            t.worst_abs_s * 1e3,
+            t.missed
+        );
+    }
+    println!(
+        "      of which drums and contact {:.3} s; sound {:.3} s; normalisation gain {:.3}",
+        s.drums.as_secs_f64(),
+        s.sound.as_secs_f64(),
+        r.audio.gain
+    );
+}
+
+/// A one-line progress bar on stderr, redrawn when the percentage changes (plain lines
+/// per stage when stderr is not a terminal).
+struct ProgressBar {
+    tty: bool,
+    last: Option<(&'static str, usize, u32)>,
+}
+
+impl ProgressBar {
+    fn new() -> ProgressBar {
+        ProgressBar {
+            tty: std::io::stderr().is_terminal(),
+            last: None,
+        }
+    }
+
+    fn show(&mut self, p: Progress) {
+        let percent = (p.fraction * 100.0).floor() as u32;
+        let key = (p.stage, p.pass, percent);
+        if self.last == Some(key)
+            || (!self.tty && self.last.is_some_and(|l| l.0 == p.stage && l.1 == p.pass))
+        {
+            return;
+        }
+        self.last = Some(key);
+        let stage = if p.pass > 0 {
+            format!("{} (pass {})", p.stage, p.pass)
+        } else {
+            p.stage.to_string()
+        };
+        let mut err = std::io::stderr();
+        if self.tty {
+            let filled = (percent as usize * 30) / 100;
+            let _ = write!(
+                err,
+                "\r[{}{}] {percent:3}% {stage:<24}",
+                "#".repeat(filled),
+                "-".repeat(30 - filled)
+            );
+        } else {
+            let _ = writeln!(err, "{stage}...");
+        }
+        let _ = err.flush();
+    }
+
+    fn finish(&mut self) {
+        if self.tty && self.last.is_some() {
+            eprintln!();
+        }
+    }
+}
