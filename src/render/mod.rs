@@ -76,7 +76,7 @@ impl Default for RenderParams {
             mallet: 0,
             height_m: 1.75,
             mass_kg: 70.0,
-            max_passes: 5,
+            max_passes: 3,
             timing_tolerance_s: 0.0015,
             strike_depth_m: 0.025,
             force_at_silence_n: 15.0,
@@ -301,10 +301,22 @@ pub fn render(
         }
         // Late contacts play their target earlier; weak strokes aim deeper (the felt's
         // Hertz force grows about as the square of how far the hand drives through).
+        // A deeper aim reaches the head earlier, by about the extra depth over the impact
+        // speed: the shift allows for that so the two corrections do not fight.
         for i in 0..adjust.shift_s.len() {
             adjust.shift_s[i] += errors[i].unwrap_or(0.0);
+            let in_tolerance =
+                forces[i].is_some_and(|f| (f / aims[i] - 1.0).abs() <= params.force_tolerance);
+            if in_tolerance {
+                continue;
+            }
             let ratio = forces[i].map_or(2.0, |f| (aims[i] / f.max(1e-3)).sqrt().clamp(0.6, 1.6));
-            adjust.depth_m[i] = (adjust.depth_m[i] * ratio).clamp(0.002, 0.06);
+            let depth = (adjust.depth_m[i] * ratio).clamp(0.002, 0.06);
+            if let Some(c) = matches[i] {
+                let speed = drums.contacts()[c].impact_speed_mps.max(0.5);
+                adjust.shift_s[i] -= (depth - adjust.depth_m[i]) / speed;
+            }
+            adjust.depth_m[i] = depth;
         }
     };
     if !progress(Progress {

@@ -12,9 +12,9 @@ use serde::Serialize;
 /// never more than half the gap to the hand's neighbouring strokes).
 pub const MATCH_WINDOW_S: f64 = 0.06;
 
-/// A touch counts as a stroke's main contact if its peak force is at least this fraction
-/// of the strongest touch in the stroke's window (weaker ones are bounces).
-const MAIN_FRACTION: f64 = 0.5;
+/// A stroke's contact is the first touch in its window whose peak force is at least this fraction
+/// of the strongest there (a weaker earlier one is a graze; later ones are bounces).
+const MAIN_FRACTION: f64 = 0.2;
 
 /// One contact of a stick with a head, as written by `--events` (times in score seconds).
 #[derive(Clone, Debug, PartialEq, Serialize)]
