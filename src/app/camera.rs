@@ -36,10 +36,10 @@ impl Default for Camera {
     /// Above and in front of the player, to the right, seeing body and drums.
     fn default() -> Self {
         Camera {
-            target: DVec3::new(0.0, 0.35, 0.85),
-            yaw: 0.7,
-            pitch: 0.45,
-            distance: 3.0,
+            target: DVec3::new(0.0, 0.35, 0.95),
+            yaw: 0.6,
+            pitch: 0.4,
+            distance: 2.6,
             fov_y: 0.8,
         }
     }

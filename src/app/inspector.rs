@@ -251,7 +251,14 @@ fn score_section(ui: &mut egui::Ui, doc: &LoadedScore, out: &mut Vec<Command>) {
 
 fn kit_section(ui: &mut egui::Ui, doc: &LoadedScore) {
     ui.strong(&doc.kit.name);
-    ui.label(format!("from {}", doc.kit_source));
+    // A kit file is named without its folder (the full path is in the tooltip).
+    let source = std::path::Path::new(&doc.kit_source);
+    let short = match source.file_name() {
+        Some(name) if doc.kit_source.ends_with(".ron") => name.to_string_lossy().into_owned(),
+        _ => doc.kit_source.clone(),
+    };
+    ui.label(format!("from {short}"))
+        .on_hover_text(&doc.kit_source);
     ui.collapsing("Drums and membranes", |ui| {
         egui::Grid::new("drums").striped(true).show(ui, |ui| {
             for h in ["#", "drum", "tuning", "diameter", "tension", "modes"] {

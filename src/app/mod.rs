@@ -226,6 +226,11 @@ impl EditorApp {
         self.composer.composition()
     }
 
+    /// How long the last composition took on the worker thread.
+    pub fn last_compose_time(&self) -> Option<std::time::Duration> {
+        self.composer.last_duration
+    }
+
     /// Wait for the composition in progress (for tests and batch use).
     pub fn wait_for_composition(&mut self) -> Option<&Composition> {
         if self.composer.is_busy() {

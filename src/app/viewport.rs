@@ -149,6 +149,7 @@ impl Viewport {
         let painter = ui.painter_at(rect);
         painter.rect_filled(rect, 4.0, Color32::from_rgb(28, 30, 36));
         draw_floor(&painter, rect, &proj);
+        // Drums first: the body and sticks are above the heads, which are translucent.
         for drum in &input.doc.kit.drums {
             draw_drum(&painter, rect, &proj, drum);
         }
