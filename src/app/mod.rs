@@ -763,6 +763,7 @@ impl EditorApp {
             } else if self.playhead_s > d.loaded.score.duration_s() + 1.0 {
                 self.playback.pause();
             }
+            self.timeline.follow(map.tick_at(self.playhead_s));
         }
         ctx.request_repaint();
     }

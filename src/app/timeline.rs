@@ -113,6 +113,17 @@ impl TimelineView {
         }
     }
 
+    /// Scroll so that `tick` (the playhead while playing) stays in view.
+    pub fn follow(&mut self, tick: f64) {
+        if let (Some(axis), Some(g)) = (&mut self.axis, &self.geometry) {
+            let width = f64::from(g.lanes.width());
+            let x = axis.x_of(tick) - axis.left_px;
+            if x < 0.0 || x > 0.95 * width {
+                axis.start_tick = tick - 0.05 * width * axis.ticks_per_px;
+            }
+        }
+    }
+
     /// The axis in use (after the first frame).
     pub fn axis(&self) -> Option<TimeAxis> {
         self.axis
