@@ -4,6 +4,7 @@
 
 use eframe::egui;
 use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
 use std::path::Path;
 use timpanist::app::{EditorApp, EditorOptions};
 use timpanist::score::Hand;
@@ -106,5 +107,60 @@ fn drag_beat_is_one_step() {
     let t = ticks(&h);
     assert!(t.contains(&1200), "{t:?}");
     assert!(!t.contains(&960));
+    assert_eq!(h.state().undo_steps(), 1);
+}
+
+/// Dragging the tempo point up raises the tempo, as one undo step.
+#[test]
+fn drag_tempo_point() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(dir.path());
+    let lane = h.get_by_label("Tempo lane").rect();
+    let point = egui::pos2(lane.left() + 1.0, lane.center().y);
+    h.hover_at(point);
+    settle(&mut h);
+    h.drag_at(point);
+    settle(&mut h);
+    for k in 1..=4 {
+        h.hover_at(point + egui::vec2(0.0, -4.0 * k as f32));
+        settle(&mut h);
+    }
+    h.drop_at(point + egui::vec2(0.0, -16.0));
+    settle(&mut h);
+    let tempo = &h.state().loaded().unwrap().score.tempo;
+    assert_eq!(tempo.len(), 1);
+    assert_eq!(tempo[0].tick, 0);
+    assert!(tempo[0].bpm > 90.0, "{}", tempo[0].bpm);
+    assert_eq!(h.state().undo_steps(), 1);
+}
+
+/// Dragging a stroke's impact marker in the 3D view pins it on the head plane, as one
+/// undo step; the pinned point keeps the impact's height.
+#[test]
+fn drag_impact_pins_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(dir.path());
+    let comp = h.state().composition().unwrap().clone();
+    let s = 5;
+    let side = comp.strokes[s].hand;
+    let impact = comp.tip(side)[comp.impact_samples[s]];
+    h.state_mut().seek(comp.strokes[s].time_s);
+    settle(&mut h);
+    let at = h.state().viewport_point(impact).unwrap();
+    h.hover_at(at);
+    settle(&mut h);
+    h.drag_at(at);
+    settle(&mut h);
+    for k in 1..=4 {
+        h.hover_at(at + egui::vec2(5.0 * k as f32, 0.0));
+        settle(&mut h);
+    }
+    h.drop_at(at + egui::vec2(20.0, 0.0));
+    settle(&mut h);
+    let pins = &h.state().loaded().unwrap().score.pins;
+    assert_eq!(pins.len(), 1, "{}", h.state().status());
+    assert_eq!(pins[0].tick, comp.strokes[s].tick);
+    assert!((pins[0].point_m[2] - impact.z).abs() < 1e-9);
+    assert!((pins[0].point_m[0] - impact.x).abs() > 0.005);
     assert_eq!(h.state().undo_steps(), 1);
 }

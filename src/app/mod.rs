@@ -27,6 +27,7 @@ mod viewport;
 pub use camera::Camera;
 pub use files::{FileKind, kind_of};
 pub use keys::Action;
+pub use pose::Simulated;
 pub use recent::RecentFiles;
 pub use selection::Selection;
 pub use time_axis::{TimeAxis, snap};
@@ -110,6 +111,8 @@ pub struct EditorApp {
     tempo_lane: tempo_lane::TempoLane,
     viewport: viewport::Viewport,
     ik: pose::IkPose,
+    /// The simulated performance, once the render pipeline provides one.
+    simulated: Option<Simulated>,
     plot: tips_plot::TipsPlot,
     recent: RecentFiles,
     show_help: bool,
@@ -151,6 +154,7 @@ impl EditorApp {
             tempo_lane: tempo_lane::TempoLane::default(),
             viewport: viewport::Viewport::default(),
             ik: pose::IkPose::default(),
+            simulated: None,
             plot: tips_plot::TipsPlot::default(),
             recent: RecentFiles::load(options.recent_store),
             show_help: false,
@@ -255,6 +259,18 @@ impl EditorApp {
     /// render pipeline.
     pub fn set_audio(&mut self, interleaved: &[f32]) -> Result<(), playback::PlaybackError> {
         self.playback.set_audio(interleaved)
+    }
+
+    /// Move the playhead to `t_s` seconds.
+    pub fn seek(&mut self, t_s: f64) {
+        self.pending.push(Command::Seek(t_s));
+        self.drain();
+    }
+
+    /// Show a simulated performance (poses and tips) instead of the IK pose: the seam for
+    /// the render pipeline. `None` goes back to the IK pose of the composed targets.
+    pub fn set_simulation(&mut self, simulated: Option<Simulated>) {
+        self.simulated = simulated;
     }
 
     fn open_demo(&mut self) {
@@ -828,13 +844,20 @@ impl EditorApp {
         let view_h = (ui.available_height() - lanes_h - plot_h).max(220.0);
         let (rect, _) = ui.allocate_exact_size(egui::vec2(width, view_h), egui::Sense::hover());
         let comp = self.composer.composition();
-        let pose = comp.map(|c| {
-            *self.ik.pose(
-                &self.viewport.body().skeleton,
-                c,
-                self.generation,
-                self.playhead_s,
-            )
+        let simulated_pose = self
+            .simulated
+            .as_ref()
+            .and_then(|s| s.pose_at(self.playhead_s))
+            .copied();
+        let pose = simulated_pose.or_else(|| {
+            comp.map(|c| {
+                *self.ik.pose(
+                    &self.viewport.body().skeleton,
+                    c,
+                    self.generation,
+                    self.playhead_s,
+                )
+            })
         });
         self.viewport.show(
             ui,
@@ -844,7 +867,7 @@ impl EditorApp {
                 composition: comp,
                 generation: self.generation,
                 pose: pose.as_ref(),
-                simulated: None,
+                simulated: self.simulated.as_ref().map(|s| &s.tips),
                 selection: &self.selection,
                 time_s: self.playhead_s,
             },

@@ -9,6 +9,29 @@ use crate::kit::Side;
 use crate::motion::compose::Composition;
 use glam::{DQuat, DVec3};
 
+/// A simulated performance for the viewport: body poses and stick tips sampled at a fixed
+/// rate (the render pipeline's output, handed to [`super::EditorApp::set_simulation`]).
+#[derive(Clone, Debug, Default)]
+pub struct Simulated {
+    /// Time of sample 0, s.
+    pub start_s: f64,
+    /// Sample rate, Hz.
+    pub rate_hz: f64,
+    /// Body pose per sample.
+    pub poses: Vec<Pose>,
+    /// Simulated stick tips per sample, [left, right], m (performer frame).
+    pub tips: [Vec<DVec3>; 2],
+}
+
+impl Simulated {
+    /// The pose at `t_s` (nearest sample, clamped), if there are any.
+    pub fn pose_at(&self, t_s: f64) -> Option<&Pose> {
+        let last = self.poses.len().checked_sub(1)?;
+        let k = ((t_s - self.start_s) * self.rate_hz).round().max(0.0) as usize;
+        self.poses.get(k.min(last))
+    }
+}
+
 /// A playing posture: upper arms forward, elbows bent, sticks pointing forward and down.
 pub fn ready_pose() -> Pose {
     let mut p = REST;
@@ -89,6 +112,23 @@ impl IkPose {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A simulated pose is looked up by time, clamped to the take.
+    #[test]
+    fn simulated_pose_lookup() {
+        let mut second = REST;
+        second[0] = DQuat::from_rotation_z(0.1);
+        let sim = Simulated {
+            start_s: 1.0,
+            rate_hz: 10.0,
+            poses: vec![REST, second],
+            tips: Default::default(),
+        };
+        assert_eq!(sim.pose_at(0.0), Some(&REST));
+        assert_eq!(sim.pose_at(1.08), Some(&second));
+        assert_eq!(sim.pose_at(50.0), Some(&second));
+        assert!(Simulated::default().pose_at(1.0).is_none());
+    }
 
     /// In the ready pose the sticks are in front of the body, below the shoulders.
     #[test]

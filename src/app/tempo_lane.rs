@@ -66,6 +66,9 @@ pub fn with_point(points: &[TempoPoint], tick: u64, bpm: f64) -> Option<Vec<Temp
 #[derive(Default)]
 pub struct TempoLane {
     dragging: Option<usize>,
+    /// The tempo range shown when the drag began (held so the scale does not move
+    /// under the pointer).
+    range: Option<(f64, f64)>,
 }
 
 impl TempoLane {
@@ -91,7 +94,10 @@ impl TempoLane {
             egui::FontId::proportional(12.0),
             ui.visuals().text_color(),
         );
-        let (lo, hi) = bpm_range(points);
+        let (lo, hi) = match (self.dragging, self.range) {
+            (Some(_), Some(r)) => r,
+            _ => bpm_range(points),
+        };
         let y_of = |bpm: f64| {
             rect.bottom() - 4.0 - ((bpm - lo) / (hi - lo)) as f32 * (rect.height() - 8.0)
         };
@@ -121,6 +127,9 @@ impl TempoLane {
                 );
             }
         }
+        // The lane first, so the points drawn on it are on top for the pointer.
+        let lane = ui.interact(rect, ui.make_persistent_id("tempo-lane"), Sense::click());
+        lane.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "Tempo lane"));
         let mut hovered_point = None;
         let pointer = ui.input(|i| i.pointer.hover_pos());
         for (i, p) in points.iter().enumerate() {
@@ -147,6 +156,7 @@ impl TempoLane {
             );
             if resp.drag_started() {
                 self.dragging = Some(i);
+                self.range = Some((lo, hi));
                 out.push(Command::Gesture);
             }
             if self.dragging == Some(i)
@@ -187,8 +197,6 @@ impl TempoLane {
                 }
             });
         }
-        let lane = ui.interact(rect, ui.make_persistent_id("tempo-lane"), Sense::click());
-        lane.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "Tempo lane"));
         if hovered_point.is_none()
             && lane.double_clicked()
             && let Some(p) = pointer

@@ -462,7 +462,7 @@ impl Viewport {
                     removed: None,
                 }));
                 out.push(Command::Select(Selection::default()));
-            } else if let Some(s) = pick_impact(comp, &proj, p) {
+            } else if let Some(s) = pick_impact(comp, &proj, p, input.time_s) {
                 let stroke = &comp.strokes[s];
                 if score
                     .pins
@@ -510,7 +510,7 @@ impl Viewport {
                 current: h,
             });
         }
-        if let Some(s) = pick_impact(comp, &proj, p) {
+        if let Some(s) = pick_impact(comp, &proj, p, input.time_s) {
             let stroke = &comp.strokes[s];
             let anchor = comp.tips[side_index(stroke.hand)][comp.impact_samples[s]];
             out.push(Command::Gesture);
@@ -549,7 +549,8 @@ impl Viewport {
     }
 }
 
-/// The handle whose marker is within 9 px of `p`.
+/// The handle whose marker is within 9 px of `p` (of several, the nearest in time to
+/// the playhead).
 fn pick_handle(
     comp: &Composition,
     input: &ViewportInput,
@@ -569,12 +570,18 @@ fn pick_handle(
             proj.project(world).map(|(q, _)| (i, q.distance(p)))
         })
         .filter(|(_, d)| *d <= 9.0)
-        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .min_by(|a, b| {
+            let dt = |i: usize| {
+                (map.seconds_at(input.doc.score.handles[i].tick as f64) - input.time_s).abs()
+            };
+            dt(a.0).total_cmp(&dt(b.0))
+        })
         .map(|(i, _)| i)
 }
 
-/// The stroke whose impact marker is within 7 px of `p`.
-fn pick_impact(comp: &Composition, proj: &Projector, p: DVec2) -> Option<usize> {
+/// The stroke whose impact marker is within 7 px of `p` (of several, the nearest in time
+/// to the playhead at `time_s`: strokes on one spot share a marker).
+fn pick_impact(comp: &Composition, proj: &Projector, p: DVec2, time_s: f64) -> Option<usize> {
     comp.strokes
         .iter()
         .zip(&comp.impact_samples)
@@ -584,7 +591,10 @@ fn pick_impact(comp: &Composition, proj: &Projector, p: DVec2) -> Option<usize> 
                 .map(|(q, _)| (s, q.distance(p)))
         })
         .filter(|(_, d)| *d <= 7.0)
-        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .min_by(|a, b| {
+            let dt = |s: usize| (comp.strokes[s].time_s - time_s).abs();
+            dt(a.0).total_cmp(&dt(b.0))
+        })
         .map(|(s, _)| s)
 }
 
