@@ -74,7 +74,11 @@ fn opens_demo_score_with_every_panel() {
     ] {
         h.get_by_label(panel);
     }
-    h.get_by_label("Right tip");
+    assert_eq!(
+        h.get_all_by_label("Right tip").count(),
+        2,
+        "height and depth plots"
+    );
     h.get_by_label_contains("No sound device: silent playback");
 }
 

@@ -904,7 +904,19 @@ impl EditorApp {
             (_, Some(e)) => {
                 ui.label(format!("Composed stick tips unavailable: {e}"));
             }
-            (Some(c), None) => self.plot.show(ui, c, self.generation, self.playhead_s),
+            (Some(c), None) => {
+                let map = loaded.score.tempo_map();
+                let window = self.timeline.geometry.map(|g| {
+                    let t = |x: f32| map.seconds_at(g.axis.tick_of(f64::from(x)).max(0.0));
+                    (t(g.lanes.left()), t(g.lanes.right()))
+                });
+                if let Some(t) = self
+                    .plot
+                    .show(ui, c, self.generation, self.playhead_s, window)
+                {
+                    self.pending.push(Command::Seek(t));
+                }
+            }
             (None, None) => {
                 ui.horizontal(|ui| {
                     ui.spinner();
