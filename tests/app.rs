@@ -1,53 +1,304 @@
-//! The editor driven headless through egui_kittest: it opens the demo score and shows it.
+//! The editor driven headless through egui_kittest: it opens scores, adds beats by
+//! clicking, sets modes by key and inspector, undoes and redoes, drags a 3D handle, saves
+//! and reopens, asks before losing changes, reports bad files in the window, handles
+//! dropped files and keeps a recent-files list — all in temp dirs, never the real home.
 
+use eframe::egui;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
-use std::path::Path;
-use timpanist::app::EditorApp;
+use std::path::{Path, PathBuf};
+use timpanist::app::{EditorApp, EditorOptions};
+use timpanist::score::{Hand, PlayingMode};
 
-/// The editor opens the bundled demo score, shows its title and the kit, and no error.
-#[test]
-fn opens_demo_score() {
-    let demo = Path::new(env!("CARGO_MANIFEST_DIR")).join("scores/etude-modes.ron");
-    let mut harness = Harness::new_eframe(|_cc| EditorApp::new(Some(&demo)));
-    harness.state_mut().wait_for_composition();
-    harness.run();
-    let app = harness.state();
-    assert!(app.error().is_none(), "{:?}", app.error());
-    assert_eq!(app.loaded().unwrap().score.beats.len(), 16);
-    harness.get_by_label("Etude in five modes and three spots");
-    harness.get_by_label("Standard set (32/29/26/23 inch)");
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// The editor composes the open score's stick-tip trajectories in the background and
-/// shows them once they arrive.
+/// An editor on `score` with its recent list in `dir` and the silent clock, in a window
+/// large enough for every panel.
+fn harness(score: Option<PathBuf>, dir: &Path) -> Harness<'static, EditorApp> {
+    std::env::set_current_dir(root()).unwrap();
+    let options = EditorOptions {
+        score,
+        recent_store: Some(dir.join("recent.txt")),
+        audio_device: false,
+    };
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1400.0, 900.0))
+        .with_max_steps(64)
+        .build_eframe(move |_cc| EditorApp::with_options(options));
+    settle(&mut h);
+    h
+}
+
+/// Let the composing worker finish, then run the UI until it is idle.
+fn settle(h: &mut Harness<'static, EditorApp>) {
+    h.step();
+    h.state_mut().wait_for_composition();
+    h.run();
+}
+
+fn demo() -> PathBuf {
+    root().join("scores/etude-modes.ron")
+}
+
+/// Click at `pos` (press and release without moving).
+fn click(h: &mut Harness<'static, EditorApp>, pos: egui::Pos2) {
+    h.hover_at(pos);
+    settle(h);
+    h.drag_at(pos);
+    settle(h);
+    h.drop_at(pos);
+    settle(h);
+}
+
+/// The editor opens the bundled demo score, shows its title, the kit and every panel.
+#[test]
+fn opens_demo_score_with_every_panel() {
+    let dir = tempfile::tempdir().unwrap();
+    let h = harness(Some(demo()), dir.path());
+    let app = h.state();
+    assert!(app.error().is_none(), "{:?}", app.error());
+    assert_eq!(app.loaded().unwrap().score.beats.len(), 16);
+    h.get_by_label("Etude in five modes and three spots");
+    h.get_by_label("Standard set (32/29/26/23 inch)");
+    for panel in [
+        "3D view",
+        "Timeline",
+        "Ruler",
+        "Tempo lane",
+        "Inspector",
+        "File",
+        "Edit",
+        "Play",
+    ] {
+        h.get_by_label(panel);
+    }
+    assert_eq!(
+        h.get_all_by_label("Right tip").count(),
+        2,
+        "height and depth plots"
+    );
+    h.get_by_label_contains("No sound device: silent playback");
+}
+
+/// The editor composes the open score's stick-tip trajectories in the background.
 #[test]
 fn composes_in_the_background() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    std::env::set_current_dir(root).unwrap();
-    let demo = root.join("scores/improvisation.ron");
-    let mut harness = Harness::new_eframe(|_cc| EditorApp::new(Some(&demo)));
-    let strokes = harness
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(Some(root().join("scores/improvisation.ron")), dir.path());
+    let strokes = h
         .state_mut()
         .wait_for_composition()
         .map(|c| c.strokes.len());
     assert_eq!(strokes, Some(5));
-    harness.run();
-    harness.get_by_label("Right tip");
 }
 
 /// A score that fails to load is reported in the window instead of crashing.
 #[test]
 fn load_error_is_shown() {
-    let mut harness =
-        Harness::new_eframe(|_cc| EditorApp::new(Some(Path::new("/no/such/score.ron"))));
-    harness.run();
-    assert!(
-        harness
-            .state()
-            .error()
-            .unwrap()
-            .contains("/no/such/score.ron")
+    let dir = tempfile::tempdir().unwrap();
+    let h = harness(Some(PathBuf::from("/no/such/score.ron")), dir.path());
+    assert!(h.state().error().unwrap().contains("/no/such/score.ron"));
+    h.get_by_label_contains("Error: ");
+}
+
+/// Clicking an empty spot of a lane adds a beat there (snapped, in that hand's lane) and
+/// selects it; keys 1-5 set its mode; Ctrl+Z and Ctrl+Shift+Z undo and redo each step.
+#[test]
+fn add_beat_set_mode_undo_redo() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(Some(demo()), dir.path());
+    let before = h.state().loaded().unwrap().score.beats.clone();
+    // Half-way between two beats of the demo, in the Left lane.
+    let tick = 960 * 4 * 2 + 480;
+    assert!(before.iter().all(|b| b.tick != tick));
+    let at = h.state().timeline_point(tick, Hand::Left).unwrap();
+    click(&mut h, at);
+    let app = h.state();
+    let beats = &app.loaded().unwrap().score.beats;
+    assert_eq!(beats.len(), before.len() + 1, "{}", app.status());
+    let added: Vec<_> = beats.iter().filter(|b| !before.contains(b)).collect();
+    assert_eq!(added.len(), 1);
+    assert_eq!((added[0].tick, added[0].hand), (tick, Hand::Left));
+    assert!(app.is_dirty());
+    let sel: Vec<usize> = app.selection().beats.iter().copied().collect();
+    assert_eq!(beats[sel[0]].tick, tick);
+
+    h.key_press(egui::Key::Num5);
+    settle(&mut h);
+    let mode_of_added = |h: &Harness<'static, EditorApp>| {
+        let s = &h.state().loaded().unwrap().score;
+        s.beats
+            .iter()
+            .find(|b| b.tick == tick && b.hand == Hand::Left)
+            .map(|b| b.mode)
+    };
+    assert_eq!(mode_of_added(&h), Some(PlayingMode::Staccato));
+    assert_eq!(h.state().undo_steps(), 2);
+
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut h);
+    assert_eq!(mode_of_added(&h), Some(before_mode(&h, tick)));
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut h);
+    assert_eq!(h.state().loaded().unwrap().score.beats, before);
+    assert!(!h.state().is_dirty());
+    h.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::Z,
     );
-    harness.get_by_label_contains("Error: ");
+    settle(&mut h);
+    h.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::Z,
+    );
+    settle(&mut h);
+    assert_eq!(mode_of_added(&h), Some(PlayingMode::Staccato));
+}
+
+/// The mode a new beat takes from the template (the demo's plain beat): legato.
+fn before_mode(_h: &Harness<'static, EditorApp>, _tick: u64) -> PlayingMode {
+    PlayingMode::Legato
+}
+
+/// The inspector sets the mode of all selected beats at once, as one undo step.
+#[test]
+fn inspector_sets_mode_of_selection() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(Some(demo()), dir.path());
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    settle(&mut h);
+    h.get_by_label("16 beat(s) selected");
+    h.get_by_label("Mode").click();
+    settle(&mut h);
+    h.get_by_label("4 vertical accent").click();
+    settle(&mut h);
+    let s = &h.state().loaded().unwrap().score;
+    assert!(
+        s.beats
+            .iter()
+            .all(|b| b.mode == PlayingMode::VerticalAccent)
+    );
+    assert_eq!(h.state().undo_steps(), 1);
+}
+
+/// Dragging on a composed trajectory in the 3D view adds a handle and moves it: one undo
+/// step; undo removes it.
+#[test]
+fn drag_handle_in_3d_is_one_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(Some(demo()), dir.path());
+    let comp = h.state().composition().unwrap().clone();
+    // A point of the right tip mid-way between two impacts, high above the head.
+    let k = comp.impact_samples[2] + (comp.impact_samples[3] - comp.impact_samples[2]) / 2;
+    let side = comp.strokes[2].hand;
+    let world = comp.tip(side)[k];
+    let start = h.state().viewport_point(world).expect("visible");
+    h.hover_at(start);
+    settle(&mut h);
+    h.drag_at(start);
+    settle(&mut h);
+    for step in 1..=6 {
+        h.hover_at(start + egui::vec2(0.0, -8.0 * step as f32));
+        settle(&mut h);
+    }
+    h.drop_at(start + egui::vec2(0.0, -48.0));
+    settle(&mut h);
+    h.state_mut().wait_for_composition();
+    let s = &h.state().loaded().unwrap().score;
+    assert_eq!(s.handles.len(), 1, "{}", h.state().status());
+    let offset = s.handles[0].offset_m;
+    assert!(offset[2] > 0.01, "the handle moved up: {offset:?}");
+    assert_eq!(h.state().undo_steps(), 1);
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut h);
+    assert!(h.state().loaded().unwrap().score.handles.is_empty());
+}
+
+/// Save As into a temp dir, reopen: the same score, recorded in the recent list (kept in
+/// the injected location, which persists it).
+#[test]
+fn save_and_reopen() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(Some(demo()), dir.path());
+    let at = h.state().timeline_point(960 * 3, Hand::Right).unwrap();
+    click(&mut h, at);
+    let edited = h.state().loaded().unwrap().score.clone();
+    let target = dir.path().join("saved.ron");
+    h.state_mut().save_to(&target);
+    assert!(h.state().error().is_none(), "{:?}", h.state().error());
+    assert!(!h.state().is_dirty());
+    let again = harness(Some(target.clone()), dir.path());
+    assert_eq!(again.state().loaded().unwrap().score, edited);
+    assert_eq!(again.state().recent_files()[0], target);
+    let listed = std::fs::read_to_string(dir.path().join("recent.txt")).unwrap();
+    assert!(listed.contains("saved.ron"));
+}
+
+/// Quitting with unsaved changes asks first; Cancel keeps the editor and the changes.
+#[test]
+fn quit_with_unsaved_changes_asks() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(Some(demo()), dir.path());
+    assert!(h.state_mut().request_quit(), "nothing to lose yet");
+    let at = h.state().timeline_point(960 * 3, Hand::Right).unwrap();
+    click(&mut h, at);
+    assert!(!h.state_mut().request_quit());
+    settle(&mut h);
+    h.get_by_label("Unsaved changes");
+    h.get_by_label("Cancel").click();
+    settle(&mut h);
+    assert!(!h.state().is_asking_to_discard());
+    assert!(h.state().is_dirty());
+}
+
+/// Dropped files: a MIDI file imports as a new unsaved score, a broken score shows an
+/// error in the window, another kind of file is refused with a message.
+#[test]
+fn dropped_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(Some(demo()), dir.path());
+    let bad = dir.path().join("broken.ron");
+    std::fs::write(&bad, "Score(version: 2, title: ").unwrap();
+    h.state_mut().handle_dropped(&bad);
+    settle(&mut h);
+    assert!(h.state().error().unwrap().contains("broken.ron"));
+    h.get_by_label_contains("Error: ");
+    h.state_mut().handle_dropped(Path::new("notes.txt"));
+    assert!(h.state().error().unwrap().contains("notes.txt"));
+
+    let mid = dir.path().join("export.mid");
+    let loaded = timpanist::score::LoadedScore::load(&demo()).unwrap();
+    std::fs::write(
+        &mid,
+        timpanist::io::midi_export::export(&loaded.score, &loaded.kit),
+    )
+    .unwrap();
+    h.state_mut().handle_dropped(&mid);
+    h.state_mut().wait_for_composition();
+    settle(&mut h);
+    let app = h.state();
+    assert!(app.error().is_none(), "{:?}", app.error());
+    assert_eq!(app.loaded().unwrap().score.beats.len(), 16);
+    assert!(app.path().is_none(), "an import is not saved yet");
+}
+
+/// Space plays from the playhead on the silent clock and pauses again; F1 shows help.
+#[test]
+fn space_plays_on_the_silent_clock() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(Some(demo()), dir.path());
+    h.key_press(egui::Key::Space);
+    h.step();
+    assert!(h.state().playback().is_playing());
+    std::thread::sleep(std::time::Duration::from_millis(50));
+    h.step();
+    h.key_press(egui::Key::Space);
+    h.step();
+    assert!(!h.state().playback().is_playing());
+    assert!(h.state().playhead_s() > 0.04, "{}", h.state().playhead_s());
+    h.key_press(egui::Key::F1);
+    settle(&mut h);
+    h.get_by_label("Keyboard and mouse");
 }

@@ -43,6 +43,9 @@ pub enum ScoreEdit {
         before: Vec<TempoPoint>,
         after: Vec<TempoPoint>,
     },
+    /// Replace all beats at once (`after` in time order): a change of several beats
+    /// (move, delete, paste, set mode of a selection) as one step.
+    SetBeats { before: Vec<Beat>, after: Vec<Beat> },
 }
 
 impl ScoreEdit {
@@ -57,6 +60,7 @@ impl ScoreEdit {
             ScoreEdit::RemoveHandle { .. } => "remove handle",
             ScoreEdit::SetPin { .. } => "pin impact",
             ScoreEdit::SetTempo { .. } => "change tempo",
+            ScoreEdit::SetBeats { .. } => "change beats",
         }
     }
 }
@@ -109,6 +113,7 @@ impl undo::Edit for ScoreEdit {
                 score.pins.extend(*pin);
             }
             ScoreEdit::SetTempo { after, .. } => score.tempo = after.clone(),
+            ScoreEdit::SetBeats { after, .. } => score.beats = after.clone(),
         }
     }
 
@@ -153,11 +158,14 @@ impl undo::Edit for ScoreEdit {
                 }
             }
             ScoreEdit::SetTempo { before, .. } => score.tempo = before.clone(),
+            ScoreEdit::SetBeats { before, .. } => score.beats = before.clone(),
         }
     }
 
-    /// Consecutive moves of one handle, or changes of one beat that stays in place,
-    /// become one step.
+    /// Consecutive moves of one handle, or changes of one beat that stays in place, or
+    /// successive replacements of the beats or the tempo map (each starting where the last
+    /// ended), become one step.
+    /// (The editor groups edits by gesture on top of this, so two drags stay two steps.)
     fn merge(&mut self, other: Self) -> undo::Merged<Self> {
         match (self, other) {
             (
@@ -183,6 +191,26 @@ impl undo::Edit for ScoreEdit {
                     ..
                 },
             ) if *at == index && after.tick == new_after.tick => {
+                *after = new_after;
+                undo::Merged::Yes
+            }
+            (
+                ScoreEdit::SetTempo { after, .. },
+                ScoreEdit::SetTempo {
+                    before: new_before,
+                    after: new_after,
+                },
+            ) if *after == new_before => {
+                *after = new_after;
+                undo::Merged::Yes
+            }
+            (
+                ScoreEdit::SetBeats { after, .. },
+                ScoreEdit::SetBeats {
+                    before: new_before,
+                    after: new_after,
+                },
+            ) if *after == new_before => {
                 *after = new_after;
                 undo::Merged::Yes
             }
@@ -306,6 +334,33 @@ mod tests {
             record.undo(&mut score);
         }
         assert_eq!(score, original);
+    }
+
+    /// Replacing all beats is one step however often it is repeated in a row, and undo
+    /// restores the beats from before the first replacement.
+    #[test]
+    fn set_beats_merge_and_undo() {
+        let mut score = Score::new("t");
+        score.beats = vec![beat(0), beat(960)];
+        let original = score.beats.clone();
+        let mut record = Record::new();
+        for shift in [10u64, 20, 30] {
+            let after: Vec<Beat> = original
+                .iter()
+                .map(|b| Beat {
+                    tick: b.tick + shift,
+                    ..*b
+                })
+                .collect();
+            let before = score.beats.clone();
+            record.edit(&mut score, ScoreEdit::SetBeats { before, after });
+        }
+        assert_eq!(score.beats[1].tick, 990);
+        assert_eq!(record.len(), 1);
+        record.undo(&mut score);
+        assert_eq!(score.beats, original);
+        record.redo(&mut score);
+        assert_eq!(score.beats[0].tick, 30);
     }
 
     /// Pinning replaces an earlier pin of the same stroke, and undo brings it back.

@@ -1,0 +1,212 @@
+//! The 3D viewport's orbit camera: a pinhole camera looking at a target point from a
+//! yaw/pitch/distance orbit (performer frame, z up), with projection of points to the
+//! viewport's pixels and the inverse (a pixel's viewing ray) — pure math, no egui.
+
+use glam::{DVec2, DVec3};
+
+/// An orbit camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// The point orbited and looked at, m (performer frame).
+    pub target: DVec3,
+    /// Angle of the camera about the vertical through the target, rad (0: on +y, in
+    /// front of the player looking back at them).
+    pub yaw: f64,
+    /// Elevation above the horizontal, rad.
+    pub pitch: f64,
+    /// Distance from the target, m.
+    pub distance: f64,
+    /// Vertical field of view, rad.
+    pub fov_y: f64,
+}
+
+/// The viewing basis of a camera.
+#[derive(Clone, Copy, Debug)]
+pub struct Basis {
+    pub eye: DVec3,
+    pub forward: DVec3,
+    pub right: DVec3,
+    pub up: DVec3,
+}
+
+/// Points closer to the eye than this are not drawn, m.
+pub const NEAR_M: f64 = 0.05;
+
+impl Default for Camera {
+    /// Above and in front of the player, to the right, seeing body and drums.
+    fn default() -> Self {
+        Camera {
+            target: DVec3::new(0.0, 0.35, 0.95),
+            yaw: 0.6,
+            pitch: 0.4,
+            distance: 2.6,
+            fov_y: 0.8,
+        }
+    }
+}
+
+impl Camera {
+    /// The eye position and viewing axes.
+    pub fn basis(&self) -> Basis {
+        let (sy, cy) = self.yaw.sin_cos();
+        let (sp, cp) = self.pitch.sin_cos();
+        let eye = self.target + self.distance * DVec3::new(cp * sy, cp * cy, sp);
+        let forward = (self.target - eye).normalize();
+        let right = forward.cross(DVec3::Z).normalize();
+        let up = right.cross(forward);
+        Basis {
+            eye,
+            forward,
+            right,
+            up,
+        }
+    }
+
+    /// Focal length in pixels for a viewport `height` pixels high.
+    pub fn focal_px(&self, height: f64) -> f64 {
+        0.5 * height / (0.5 * self.fov_y).tan()
+    }
+
+    /// Pixel position (from the viewport's top-left) of `p` in a `size` viewport, and its
+    /// depth along the view axis (m); `None` behind or too near the eye.
+    pub fn project(&self, p: DVec3, size: DVec2) -> Option<(DVec2, f64)> {
+        self.projector(size).project(p)
+    }
+
+    /// A projector with the basis computed once (for many points per frame).
+    pub fn projector(&self, size: DVec2) -> Projector {
+        Projector {
+            basis: self.basis(),
+            focal: self.focal_px(size.y),
+            centre: 0.5 * size,
+        }
+    }
+
+    /// The viewing ray through pixel `px`: origin (the eye) and unit direction.
+    pub fn ray(&self, px: DVec2, size: DVec2) -> (DVec3, DVec3) {
+        let b = self.basis();
+        let f = self.focal_px(size.y);
+        let d = b.forward + b.right * (px.x - 0.5 * size.x) / f + b.up * (0.5 * size.y - px.y) / f;
+        (b.eye, d.normalize())
+    }
+
+    /// Orbit by a pointer movement of `delta` pixels.
+    pub fn orbit(&mut self, delta: DVec2) {
+        self.yaw -= 0.008 * delta.x;
+        self.pitch = (self.pitch + 0.008 * delta.y).clamp(-1.45, 1.45);
+    }
+
+    /// Move the target with the pointer by `delta` pixels in a viewport `height` high, so
+    /// the point under the pointer at the target's depth follows it.
+    pub fn pan(&mut self, delta: DVec2, height: f64) {
+        let b = self.basis();
+        let scale = self.distance / self.focal_px(height);
+        self.target += (-b.right * delta.x + b.up * delta.y) * scale;
+    }
+
+    /// Zoom by `factor` (> 1 moves away).
+    pub fn zoom(&mut self, factor: f64) {
+        self.distance = (self.distance * factor).clamp(0.3, 30.0);
+    }
+}
+
+/// Projection with a precomputed basis.
+#[derive(Clone, Copy, Debug)]
+pub struct Projector {
+    pub basis: Basis,
+    focal: f64,
+    centre: DVec2,
+}
+
+impl Projector {
+    /// Pixel position and depth of `p`, as [`Camera::project`].
+    pub fn project(&self, p: DVec3) -> Option<(DVec2, f64)> {
+        let rel = p - self.basis.eye;
+        let z = rel.dot(self.basis.forward);
+        if z < NEAR_M {
+            return None;
+        }
+        let x = rel.dot(self.basis.right);
+        let y = rel.dot(self.basis.up);
+        Some((
+            self.centre + DVec2::new(self.focal * x / z, -self.focal * y / z),
+            z,
+        ))
+    }
+
+    /// Pixels per metre at depth `z`.
+    pub fn scale_at(&self, z: f64) -> f64 {
+        self.focal / z.max(NEAR_M)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SIZE: DVec2 = DVec2::new(800.0, 600.0);
+
+    /// The target projects to the viewport centre at the orbit distance.
+    #[test]
+    fn target_is_centred() {
+        let cam = Camera::default();
+        let (px, depth) = cam.project(cam.target, SIZE).unwrap();
+        assert!((px - SIZE * 0.5).length() < 1e-9, "{px}");
+        assert!((depth - cam.distance).abs() < 1e-12);
+    }
+
+    /// A pixel's ray passes through every point that projects to that pixel.
+    #[test]
+    fn ray_inverts_projection() {
+        let cam = Camera {
+            yaw: -1.1,
+            pitch: 0.3,
+            ..Camera::default()
+        };
+        for p in [
+            DVec3::new(0.3, 0.5, 0.8),
+            DVec3::new(-0.4, 0.1, 1.5),
+            DVec3::new(0.0, 0.9, 0.2),
+        ] {
+            let (px, depth) = cam.project(p, SIZE).unwrap();
+            let (o, d) = cam.ray(px, SIZE);
+            let along = (p - o).dot(d);
+            assert!((o + d * along - p).length() < 1e-9);
+            assert!(along >= depth - 1e-9);
+        }
+    }
+
+    /// Up in the world is up on screen; points behind the eye are not projected.
+    #[test]
+    fn orientation_and_clipping() {
+        let cam = Camera::default();
+        let (low, _) = cam.project(cam.target, SIZE).unwrap();
+        let (high, _) = cam.project(cam.target + DVec3::Z * 0.1, SIZE).unwrap();
+        assert!(high.y < low.y);
+        let behind = cam.basis().eye - cam.basis().forward;
+        assert!(cam.project(behind, SIZE).is_none());
+    }
+
+    /// Panning by some pixels moves a point at the target's depth by the same pixels
+    /// (it stays under the pointer).
+    #[test]
+    fn pan_follows_pointer() {
+        let mut cam = Camera::default();
+        let p = cam.target;
+        let (before, _) = cam.project(p, SIZE).unwrap();
+        cam.pan(DVec2::new(40.0, -25.0), SIZE.y);
+        let (after, _) = cam.project(p, SIZE).unwrap();
+        assert!((after - before - DVec2::new(40.0, -25.0)).length() < 1e-6);
+    }
+
+    /// Orbit keeps the distance to the target; zoom is clamped.
+    #[test]
+    fn orbit_and_zoom() {
+        let mut cam = Camera::default();
+        cam.orbit(DVec2::new(120.0, 500.0));
+        assert!((cam.basis().eye.distance(cam.target) - cam.distance).abs() < 1e-9);
+        assert!(cam.pitch <= 1.45);
+        cam.zoom(1e-6);
+        assert_eq!(cam.distance, 0.3);
+    }
+}

@@ -1,0 +1,144 @@
+//! The body pose the 3D view shows: until simulated poses arrive from the render
+//! pipeline, the pose inverse kinematics gives for the composed target tips at the
+//! playhead (damped least squares, seed 000 eq. 3), warm-started from the last pose shown
+//! and pulled toward a ready posture, recomputed only when the time or composition changes.
+
+use crate::body::ik::{IkParams, solve};
+use crate::body::skeleton::{Joint, Pose, REST, Skeleton};
+use crate::kit::Side;
+use crate::motion::compose::Composition;
+use glam::{DQuat, DVec3};
+
+/// A simulated performance for the viewport: body poses and stick tips sampled at a fixed
+/// rate (the render pipeline's output, handed to [`super::EditorApp::set_simulation`]).
+#[derive(Clone, Debug, Default)]
+pub struct Simulated {
+    /// Time of sample 0, s.
+    pub start_s: f64,
+    /// Sample rate, Hz.
+    pub rate_hz: f64,
+    /// Body pose per sample.
+    pub poses: Vec<Pose>,
+    /// Simulated stick tips per sample, [left, right], m (performer frame).
+    pub tips: [Vec<DVec3>; 2],
+}
+
+impl Simulated {
+    /// The pose at `t_s` (nearest sample, clamped), if there are any.
+    pub fn pose_at(&self, t_s: f64) -> Option<&Pose> {
+        let last = self.poses.len().checked_sub(1)?;
+        let k = ((t_s - self.start_s) * self.rate_hz).round().max(0.0) as usize;
+        self.poses.get(k.min(last))
+    }
+}
+
+/// A playing posture: upper arms forward, elbows bent, sticks pointing forward and down.
+pub fn ready_pose() -> Pose {
+    let mut p = REST;
+    for side in [Side::Left, Side::Right] {
+        let [shoulder, elbow, wrist, _] = Joint::arm(side);
+        p[shoulder.index()] = DQuat::from_rotation_x(0.45);
+        p[elbow.index()] = DQuat::from_rotation_x(1.1);
+        p[wrist.index()] = DQuat::from_rotation_x(0.2);
+    }
+    p
+}
+
+/// Both tips of `comp` at time `t_s` (linear between samples, clamped to its ends), m.
+pub fn tips_at(comp: &Composition, t_s: f64) -> Option<[DVec3; 2]> {
+    if comp.is_empty() {
+        return None;
+    }
+    let f = ((t_s - comp.start_s) * comp.rate_hz).clamp(0.0, (comp.len() - 1) as f64);
+    let k = f.floor() as usize;
+    let k1 = (k + 1).min(comp.len() - 1);
+    let x = f - k as f64;
+    Some([0, 1].map(|h| comp.tips[h][k].lerp(comp.tips[h][k1], x)))
+}
+
+/// The IK pose cache.
+pub struct IkPose {
+    key: Option<(u64, u64)>,
+    pose: Pose,
+    params: IkParams,
+}
+
+impl Default for IkPose {
+    fn default() -> Self {
+        IkPose {
+            key: None,
+            pose: ready_pose(),
+            params: IkParams {
+                max_iterations: 60,
+                tolerance_m: 1e-4,
+                ..IkParams::default()
+            },
+        }
+    }
+}
+
+impl IkPose {
+    /// The pose reaching `comp`'s tips at `t_s` (composition `generation` identifies it).
+    pub fn pose(
+        &mut self,
+        skeleton: &Skeleton,
+        comp: &Composition,
+        generation: u64,
+        t_s: f64,
+    ) -> &Pose {
+        let key = (generation, t_s.to_bits());
+        if self.key == Some(key) {
+            return &self.pose;
+        }
+        self.key = Some(key);
+        if let Some(tips) = tips_at(comp, t_s) {
+            let ready = ready_pose();
+            for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
+                let r = solve(
+                    skeleton,
+                    &self.pose,
+                    side,
+                    tips[h],
+                    Some(&ready),
+                    &self.params,
+                );
+                self.pose = r.pose;
+            }
+        }
+        &self.pose
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A simulated pose is looked up by time, clamped to the take.
+    #[test]
+    fn simulated_pose_lookup() {
+        let mut second = REST;
+        second[0] = DQuat::from_rotation_z(0.1);
+        let sim = Simulated {
+            start_s: 1.0,
+            rate_hz: 10.0,
+            poses: vec![REST, second],
+            tips: Default::default(),
+        };
+        assert_eq!(sim.pose_at(0.0), Some(&REST));
+        assert_eq!(sim.pose_at(1.08), Some(&second));
+        assert_eq!(sim.pose_at(50.0), Some(&second));
+        assert!(Simulated::default().pose_at(1.0).is_none());
+    }
+
+    /// In the ready pose the sticks are in front of the body, below the shoulders.
+    #[test]
+    fn ready_pose_reaches_forward() {
+        let s = Skeleton::default();
+        let f = s.forward(&ready_pose());
+        for side in [Side::Left, Side::Right] {
+            let tip = f.tip(side);
+            assert!(tip.y > 0.3, "{tip}");
+            assert!(tip.z < f.position[Joint::arm(side)[0].index()].z);
+        }
+    }
+}

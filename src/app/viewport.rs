@@ -1,0 +1,667 @@
+//! The 3D viewport: orbit/pan/zoom camera, the floor, the drums with their heads (through
+//! [`head_displacement`], so membrane vibration can be drawn once the drum model provides
+//! it), the body as capsules with sticks, the composed target tip trajectories (one
+//! colour per hand) with impacts, pins and handles marked, and room for simulated
+//! trajectories in other colours. Handles: drag on a trajectory to add one and move it,
+//! drag a handle to move it (in the view plane, or along x/y/z while X/Y/Z is held),
+//! right-click removes it; drag an impact to pin it on the head (right-click unpins).
+
+use super::camera::{Camera, Projector};
+use super::command::Command;
+use super::picking::{drag_along_axis, drag_in_plane, pick_polyline};
+use super::selection::Selection;
+use crate::body::model::BodyModel;
+use crate::body::skeleton::{JOINT_COUNT, Joint, Pose};
+use crate::kit::{Drum, Side};
+use crate::mocap::db::side_index;
+use crate::motion::compose::Composition;
+use crate::score::edit::ScoreEdit;
+use crate::score::{Handle, ImpactPin, LoadedScore};
+use eframe::egui::{self, Color32, Pos2, Rect, Sense, Shape, Stroke, Vec2};
+use glam::{DVec2, DVec3};
+
+/// Colour of each hand's composed (target) trajectory, [left, right].
+pub const TARGET_COLOURS: [Color32; 2] = [
+    Color32::from_rgb(60, 150, 230),
+    Color32::from_rgb(240, 140, 40),
+];
+/// Colour of each hand's simulated trajectory, [left, right].
+pub const SIMULATED_COLOURS: [Color32; 2] = [
+    Color32::from_rgb(120, 230, 230),
+    Color32::from_rgb(250, 220, 90),
+];
+
+/// Vertical displacement of `drum`'s head at `point` (performer frame), m. Zero until
+/// the drum model's membrane state is connected.
+pub fn head_displacement(_drum: &Drum, _point: DVec3) -> f64 {
+    0.0
+}
+
+/// What the viewport draws.
+pub struct ViewportInput<'a> {
+    pub doc: &'a LoadedScore,
+    pub composition: Option<&'a Composition>,
+    /// Changes whenever `composition` is replaced (for caches).
+    pub generation: u64,
+    /// The body pose to draw (IK now, simulated later).
+    pub pose: Option<&'a Pose>,
+    /// Simulated tip trajectories on the composition's time grid, [left, right].
+    pub simulated: Option<&'a [Vec<DVec3>; 2]>,
+    pub selection: &'a Selection,
+    /// The playhead, s.
+    pub time_s: f64,
+}
+
+enum Drag {
+    Orbit,
+    Pan,
+    Handle {
+        index: usize,
+        anchor: DVec3,
+        start_offset: DVec3,
+        current: Handle,
+    },
+    Pin {
+        hand: Side,
+        tick: u64,
+        anchor: DVec3,
+        current: DVec3,
+    },
+}
+
+struct Projected {
+    key: (u64, [u64; 8], [u32; 2]),
+    tips: [Vec<Option<DVec2>>; 2],
+}
+
+/// The viewport's state: camera, drag in progress, projection cache.
+#[derive(Default)]
+pub struct Viewport {
+    pub camera: Camera,
+    body: BodyModel,
+    drag: Option<Drag>,
+    cache: Option<Projected>,
+    /// Where the viewport was drawn last frame.
+    pub rect: Option<Rect>,
+}
+
+fn to_pos(rect: Rect, p: DVec2) -> Pos2 {
+    Pos2::new(rect.left() + p.x as f32, rect.top() + p.y as f32)
+}
+
+fn camera_key(c: &Camera) -> [u64; 8] {
+    [
+        c.target.x.to_bits(),
+        c.target.y.to_bits(),
+        c.target.z.to_bits(),
+        c.yaw.to_bits(),
+        c.pitch.to_bits(),
+        c.distance.to_bits(),
+        c.fov_y.to_bits(),
+        0,
+    ]
+}
+
+/// Sample index of time `t` in `comp`, clamped.
+fn sample_of(comp: &Composition, t: f64) -> usize {
+    (((t - comp.start_s) * comp.rate_hz).round().max(0.0) as usize)
+        .min(comp.len().saturating_sub(1))
+}
+
+impl Viewport {
+    /// The body model drawn.
+    pub fn body(&self) -> &BodyModel {
+        &self.body
+    }
+
+    /// Screen position of world point `p` in last frame's viewport.
+    pub fn screen_of(&self, p: DVec3) -> Option<Pos2> {
+        let rect = self.rect?;
+        let size = DVec2::new(f64::from(rect.width()), f64::from(rect.height()));
+        self.camera.project(p, size).map(|(q, _)| to_pos(rect, q))
+    }
+
+    /// Draw into `rect` and handle the pointer; edits go to `out`.
+    pub fn show(
+        &mut self,
+        ui: &mut egui::Ui,
+        rect: Rect,
+        input: &ViewportInput,
+        out: &mut Vec<Command>,
+    ) {
+        self.rect = Some(rect);
+        let resp = ui.interact(
+            rect,
+            ui.make_persistent_id("viewport-3d"),
+            Sense::click_and_drag(),
+        );
+        resp.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "3D view"));
+        if resp.hovered() {
+            let scroll = ui.input(|i| i.smooth_scroll_delta.y + (i.zoom_delta() - 1.0) * 200.0);
+            if scroll != 0.0 {
+                self.camera.zoom((-f64::from(scroll) * 0.002).exp());
+            }
+        }
+        let size = DVec2::new(f64::from(rect.width()), f64::from(rect.height()));
+        self.handle_input(ui, &resp, rect, size, input, out);
+
+        let proj = self.camera.projector(size);
+        let painter = ui.painter_at(rect);
+        painter.rect_filled(rect, 4.0, Color32::from_rgb(28, 30, 36));
+        draw_floor(&painter, rect, &proj);
+        // Drums first: the body and sticks are above the heads, which are translucent.
+        for drum in &input.doc.kit.drums {
+            draw_drum(&painter, rect, &proj, drum);
+        }
+        if let Some(pose) = input.pose {
+            self.draw_body(&painter, rect, &proj, pose);
+        }
+        if let Some(comp) = input.composition {
+            self.update_cache(comp, input.generation, size, &proj);
+            self.draw_trajectories(&painter, rect, &proj, comp, input);
+        }
+        if let Some(sim) = input.simulated {
+            for h in 0..2 {
+                let pts: Vec<Pos2> = sim[h]
+                    .iter()
+                    .filter_map(|p| proj.project(*p).map(|(q, _)| to_pos(rect, q)))
+                    .collect();
+                painter.add(Shape::line(pts, Stroke::new(1.5, SIMULATED_COLOURS[h])));
+            }
+        }
+        let mode = if ui.input(|i| i.key_down(egui::Key::X)) {
+            "drag along x"
+        } else if ui.input(|i| i.key_down(egui::Key::Y)) {
+            "drag along y"
+        } else if ui.input(|i| i.key_down(egui::Key::Z)) {
+            "drag along z"
+        } else {
+            "drag in the view plane (hold X, Y or Z for an axis)"
+        };
+        painter.text(
+            rect.left_bottom() + Vec2::new(6.0, -4.0),
+            egui::Align2::LEFT_BOTTOM,
+            format!("Handles: {mode}. Left drag: orbit, Shift: pan, wheel: zoom"),
+            egui::FontId::proportional(11.0),
+            Color32::from_gray(170),
+        );
+        for (h, name) in [(0, "left target"), (1, "right target")] {
+            painter.text(
+                rect.right_top() + Vec2::new(-8.0, 8.0 + 14.0 * h as f32),
+                egui::Align2::RIGHT_TOP,
+                name,
+                egui::FontId::proportional(11.0),
+                TARGET_COLOURS[h],
+            );
+        }
+    }
+
+    fn update_cache(&mut self, comp: &Composition, generation: u64, size: DVec2, proj: &Projector) {
+        let key = (
+            generation,
+            camera_key(&self.camera),
+            [size.x as u32, size.y as u32],
+        );
+        if self.cache.as_ref().is_some_and(|c| c.key == key) {
+            return;
+        }
+        let tips = [0, 1].map(|h| {
+            comp.tips[h]
+                .iter()
+                .map(|p| proj.project(*p).map(|(q, _)| q))
+                .collect()
+        });
+        self.cache = Some(Projected { key, tips });
+    }
+
+    fn draw_trajectories(
+        &self,
+        painter: &egui::Painter,
+        rect: Rect,
+        proj: &Projector,
+        comp: &Composition,
+        input: &ViewportInput,
+    ) {
+        let Some(cache) = &self.cache else { return };
+        for (h, tips) in cache.tips.iter().enumerate() {
+            let mut run: Vec<Pos2> = Vec::new();
+            for q in tips {
+                match q {
+                    Some(q) => run.push(to_pos(rect, *q)),
+                    None if !run.is_empty() => {
+                        painter.add(Shape::line(
+                            std::mem::take(&mut run),
+                            Stroke::new(1.5, TARGET_COLOURS[h]),
+                        ));
+                    }
+                    None => {}
+                }
+            }
+            painter.add(Shape::line(run, Stroke::new(1.5, TARGET_COLOURS[h])));
+        }
+        let score = &input.doc.score;
+        for (stroke, &k) in comp.strokes.iter().zip(&comp.impact_samples) {
+            let h = side_index(stroke.hand);
+            if let Some(q) = cache.tips[h].get(k).copied().flatten() {
+                let pinned = score
+                    .pins
+                    .iter()
+                    .any(|p| p.hand == stroke.hand && p.tick == stroke.tick);
+                let c = to_pos(rect, q);
+                if pinned {
+                    painter.add(Shape::convex_polygon(
+                        vec![
+                            c + Vec2::new(0.0, -6.0),
+                            c + Vec2::new(6.0, 0.0),
+                            c + Vec2::new(0.0, 6.0),
+                            c + Vec2::new(-6.0, 0.0),
+                        ],
+                        Color32::WHITE,
+                        Stroke::new(1.0, TARGET_COLOURS[h]),
+                    ));
+                } else {
+                    painter.circle(c, 3.5, TARGET_COLOURS[h], Stroke::new(1.0, Color32::WHITE));
+                }
+            }
+        }
+        let map = score.tempo_map();
+        for (i, handle) in score.handles.iter().enumerate() {
+            let world = match &self.drag {
+                Some(Drag::Handle {
+                    index,
+                    anchor,
+                    start_offset,
+                    current,
+                }) if *index == i => *anchor + DVec3::from_array(current.offset_m) - *start_offset,
+                _ => {
+                    comp.tips[side_index(handle.hand)]
+                        [sample_of(comp, map.seconds_at(handle.tick as f64))]
+                }
+            };
+            if let Some((q, _)) = proj.project(world) {
+                let c = to_pos(rect, q);
+                let selected = input.selection.handle == Some(i);
+                painter.rect(
+                    Rect::from_center_size(c, Vec2::splat(if selected { 11.0 } else { 9.0 })),
+                    1.0,
+                    if selected {
+                        Color32::YELLOW
+                    } else {
+                        Color32::from_gray(230)
+                    },
+                    Stroke::new(1.0, TARGET_COLOURS[side_index(handle.hand)]),
+                    egui::StrokeKind::Middle,
+                );
+            }
+        }
+        if let Some(Drag::Pin { current, .. }) = &self.drag
+            && let Some((q, _)) = proj.project(*current)
+        {
+            painter.circle_stroke(to_pos(rect, q), 7.0, Stroke::new(2.0, Color32::WHITE));
+        }
+        if let Some(tips) = super::pose::tips_at(comp, input.time_s) {
+            for h in 0..2 {
+                if let Some((q, _)) = proj.project(tips[h]) {
+                    painter.circle_filled(to_pos(rect, q), 5.0, TARGET_COLOURS[h]);
+                }
+            }
+        }
+    }
+
+    fn draw_body(&self, painter: &egui::Painter, rect: Rect, proj: &Projector, pose: &Pose) {
+        let frames = self.body.skeleton.forward(pose);
+        let mut capsules: Vec<(f64, Pos2, Pos2, f32, Color32)> = Vec::with_capacity(JOINT_COUNT);
+        for j in Joint::ALL {
+            let seg = &self.body.segments[j.index()];
+            let a = frames.position[j.index()];
+            let b = a + frames.rotation[j.index()] * seg.axis_m;
+            let (Some((pa, za)), Some((pb, zb))) = (proj.project(a), proj.project(b)) else {
+                continue;
+            };
+            let depth = 0.5 * (za + zb);
+            let width = (2.0 * seg.radius_m * proj.scale_at(depth)) as f32;
+            let stick = matches!(j, Joint::GripL | Joint::GripR);
+            let colour = if stick {
+                Color32::from_rgb(190, 150, 100)
+            } else {
+                let shade = (215.0 - 25.0 * depth).clamp(120.0, 210.0) as u8;
+                Color32::from_rgb(shade, shade.saturating_sub(20), shade.saturating_sub(35))
+            };
+            capsules.push((
+                depth,
+                to_pos(rect, pa),
+                to_pos(rect, pb),
+                width.max(1.5),
+                colour,
+            ));
+        }
+        capsules.sort_by(|a, b| b.0.total_cmp(&a.0));
+        for (_, a, b, w, colour) in capsules {
+            painter.line_segment([a, b], Stroke::new(w, colour));
+            painter.circle_filled(a, 0.5 * w, colour);
+            painter.circle_filled(b, 0.5 * w, colour);
+        }
+    }
+
+    fn handle_input(
+        &mut self,
+        ui: &egui::Ui,
+        resp: &egui::Response,
+        rect: Rect,
+        size: DVec2,
+        input: &ViewportInput,
+        out: &mut Vec<Command>,
+    ) {
+        let local = |p: Pos2| DVec2::new(f64::from(p.x - rect.left()), f64::from(p.y - rect.top()));
+        let score = &input.doc.score;
+        let map = score.tempo_map();
+        if resp.drag_started() {
+            let origin = ui
+                .input(|i| i.pointer.press_origin())
+                .unwrap_or(rect.center());
+            let middle = resp.dragged_by(egui::PointerButton::Middle)
+                || resp.dragged_by(egui::PointerButton::Secondary)
+                || ui.input(|i| i.modifiers.shift);
+            self.drag = if middle {
+                Some(Drag::Pan)
+            } else {
+                input
+                    .composition
+                    .and_then(|comp| self.pick(comp, input, local(origin), out, &map))
+                    .or(Some(Drag::Orbit))
+            };
+        }
+        if resp.dragged() {
+            let delta = resp.drag_delta();
+            let d = DVec2::new(f64::from(delta.x), f64::from(delta.y));
+            let pointer = resp.interact_pointer_pos().map(local);
+            let axis = ui.input(|i| {
+                if i.key_down(egui::Key::X) {
+                    Some(DVec3::X)
+                } else if i.key_down(egui::Key::Y) {
+                    Some(DVec3::Y)
+                } else if i.key_down(egui::Key::Z) {
+                    Some(DVec3::Z)
+                } else {
+                    None
+                }
+            });
+            let camera = self.camera;
+            match &mut self.drag {
+                Some(Drag::Orbit) => self.camera.orbit(d),
+                Some(Drag::Pan) => self.camera.pan(d, size.y),
+                Some(Drag::Handle {
+                    index,
+                    anchor,
+                    start_offset,
+                    current,
+                }) => {
+                    if let Some(px) = pointer {
+                        let (o, dir) = camera.ray(px, size);
+                        let target = match axis {
+                            Some(a) => drag_along_axis(o, dir, *anchor, a).map(|u| *anchor + a * u),
+                            None => drag_in_plane(o, dir, *anchor, camera.basis().forward),
+                        };
+                        if let Some(p) = target {
+                            let offset = *start_offset + (p - *anchor);
+                            let to = Handle {
+                                offset_m: offset.to_array().map(|v| (v * 1e4).round() / 1e4),
+                                ..*current
+                            };
+                            if to != *current {
+                                out.push(Command::Edit(ScoreEdit::MoveHandle {
+                                    index: *index,
+                                    from: *current,
+                                    to,
+                                }));
+                                *current = to;
+                            }
+                        }
+                    }
+                }
+                Some(Drag::Pin {
+                    hand,
+                    tick,
+                    anchor,
+                    current,
+                }) => {
+                    if let Some(px) = pointer {
+                        let (o, dir) = camera.ray(px, size);
+                        if let Some(p) = drag_in_plane(o, dir, *anchor, DVec3::Z)
+                            && p.distance(*current) > 1e-4
+                        {
+                            *current = p;
+                            out.push(Command::Edit(ScoreEdit::SetPin {
+                                hand: *hand,
+                                tick: *tick,
+                                pin: Some(ImpactPin {
+                                    hand: *hand,
+                                    tick: *tick,
+                                    point_m: p.to_array(),
+                                }),
+                                before: None,
+                            }));
+                        }
+                    }
+                }
+                None => {}
+            }
+        }
+        if resp.drag_stopped() {
+            self.drag = None;
+        }
+        if resp.secondary_clicked()
+            && let (Some(comp), Some(p)) = (input.composition, resp.interact_pointer_pos())
+        {
+            let p = local(p);
+            let proj = self.camera.projector(size);
+            if let Some(i) = pick_handle(comp, input, &proj, p, &map) {
+                out.push(Command::Gesture);
+                out.push(Command::Edit(ScoreEdit::RemoveHandle {
+                    index: i,
+                    removed: None,
+                }));
+                out.push(Command::Select(Selection::default()));
+            } else if let Some(s) = pick_impact(comp, &proj, p, input.time_s) {
+                let stroke = &comp.strokes[s];
+                if score
+                    .pins
+                    .iter()
+                    .any(|q| q.hand == stroke.hand && q.tick == stroke.tick)
+                {
+                    out.push(Command::Gesture);
+                    out.push(Command::Edit(ScoreEdit::SetPin {
+                        hand: stroke.hand,
+                        tick: stroke.tick,
+                        pin: None,
+                        before: None,
+                    }));
+                }
+            }
+        }
+    }
+
+    /// What a press at `p` grabs: a handle, an impact, or a new handle on a trajectory.
+    fn pick(
+        &mut self,
+        comp: &Composition,
+        input: &ViewportInput,
+        p: DVec2,
+        out: &mut Vec<Command>,
+        map: &crate::score::TempoMap,
+    ) -> Option<Drag> {
+        let size = self
+            .rect
+            .map(|r| DVec2::new(f64::from(r.width()), f64::from(r.height())))?;
+        let proj = self.camera.projector(size);
+        let score = &input.doc.score;
+        if let Some(i) = pick_handle(comp, input, &proj, p, map) {
+            let h = score.handles[i];
+            out.push(Command::Gesture);
+            out.push(Command::Select(Selection {
+                beats: Default::default(),
+                handle: Some(i),
+            }));
+            return Some(Drag::Handle {
+                index: i,
+                anchor: comp.tips[side_index(h.hand)]
+                    [sample_of(comp, map.seconds_at(h.tick as f64))],
+                start_offset: DVec3::from_array(h.offset_m),
+                current: h,
+            });
+        }
+        if let Some(s) = pick_impact(comp, &proj, p, input.time_s) {
+            let stroke = &comp.strokes[s];
+            let anchor = comp.tips[side_index(stroke.hand)][comp.impact_samples[s]];
+            out.push(Command::Gesture);
+            return Some(Drag::Pin {
+                hand: stroke.hand,
+                tick: stroke.tick,
+                anchor,
+                current: anchor,
+            });
+        }
+        let cache = self.cache.as_ref()?;
+        let best = (0..2)
+            .filter_map(|h| pick_polyline(&cache.tips[h], p, 6.0).map(|(k, d)| (h, k, d)))
+            .min_by(|a, b| a.2.total_cmp(&b.2))?;
+        let (h, k, _) = best;
+        let hand = if h == 0 { Side::Left } else { Side::Right };
+        let tick = map.tick_at(comp.time(k)).round().max(0.0) as u64;
+        let handle = Handle {
+            hand,
+            tick,
+            reach_ticks: u64::from(score.ticks_per_quarter) / 2,
+            offset_m: [0.0; 3],
+        };
+        out.push(Command::Gesture);
+        out.push(Command::Edit(ScoreEdit::AddHandle(handle)));
+        out.push(Command::Select(Selection {
+            beats: Default::default(),
+            handle: Some(score.handles.len()),
+        }));
+        Some(Drag::Handle {
+            index: score.handles.len(),
+            anchor: comp.tips[h][k],
+            start_offset: DVec3::ZERO,
+            current: handle,
+        })
+    }
+}
+
+/// The handle whose marker is within 9 px of `p` (of several, the nearest in time to
+/// the playhead).
+fn pick_handle(
+    comp: &Composition,
+    input: &ViewportInput,
+    proj: &Projector,
+    p: DVec2,
+    map: &crate::score::TempoMap,
+) -> Option<usize> {
+    input
+        .doc
+        .score
+        .handles
+        .iter()
+        .enumerate()
+        .filter_map(|(i, h)| {
+            let world =
+                comp.tips[side_index(h.hand)][sample_of(comp, map.seconds_at(h.tick as f64))];
+            proj.project(world).map(|(q, _)| (i, q.distance(p)))
+        })
+        .filter(|(_, d)| *d <= 9.0)
+        .min_by(|a, b| {
+            let dt = |i: usize| {
+                (map.seconds_at(input.doc.score.handles[i].tick as f64) - input.time_s).abs()
+            };
+            dt(a.0).total_cmp(&dt(b.0))
+        })
+        .map(|(i, _)| i)
+}
+
+/// The stroke whose impact marker is within 7 px of `p` (of several, the nearest in time
+/// to the playhead at `time_s`: strokes on one spot share a marker).
+fn pick_impact(comp: &Composition, proj: &Projector, p: DVec2, time_s: f64) -> Option<usize> {
+    comp.strokes
+        .iter()
+        .zip(&comp.impact_samples)
+        .enumerate()
+        .filter_map(|(s, (stroke, &k))| {
+            proj.project(comp.tips[side_index(stroke.hand)][k])
+                .map(|(q, _)| (s, q.distance(p)))
+        })
+        .filter(|(_, d)| *d <= 7.0)
+        .min_by(|a, b| {
+            let dt = |s: usize| (comp.strokes[s].time_s - time_s).abs();
+            dt(a.0).total_cmp(&dt(b.0))
+        })
+        .map(|(s, _)| s)
+}
+
+fn draw_floor(painter: &egui::Painter, rect: Rect, proj: &Projector) {
+    let stroke = Stroke::new(0.6, Color32::from_gray(60));
+    let line = |a: DVec3, b: DVec3| {
+        if let (Some((pa, _)), Some((pb, _))) = (proj.project(a), proj.project(b)) {
+            painter.line_segment([to_pos(rect, pa), to_pos(rect, pb)], stroke);
+        }
+    };
+    for k in 0..=12 {
+        let x = -1.5 + 0.25 * f64::from(k);
+        line(DVec3::new(x, -0.75, 0.0), DVec3::new(x, 1.75, 0.0));
+    }
+    for k in 0..=10 {
+        let y = -0.75 + 0.25 * f64::from(k);
+        line(DVec3::new(-1.5, y, 0.0), DVec3::new(1.5, y, 0.0));
+    }
+}
+
+fn draw_drum(painter: &egui::Painter, rect: Rect, proj: &Projector, drum: &Drum) {
+    const N: usize = 48;
+    let centre = DVec3::new(
+        drum.placement.x_m,
+        drum.placement.y_m,
+        drum.placement.head_height_m,
+    );
+    let r = 0.5 * drum.diameter_m;
+    let ring = |z_drop: f64, scale: f64| -> Option<Vec<Pos2>> {
+        (0..N)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / N as f64;
+                let mut p = centre + DVec3::new(a.cos(), a.sin(), 0.0) * r * scale;
+                p.z -= z_drop;
+                if z_drop == 0.0 {
+                    p.z += head_displacement(drum, p);
+                }
+                proj.project(p).map(|(q, _)| to_pos(rect, q))
+            })
+            .collect()
+    };
+    let kettle = Color32::from_rgb(150, 110, 60);
+    if let Some(bowl) = ring(0.55 * drum.diameter_m, 0.45) {
+        painter.add(Shape::closed_line(bowl.clone(), Stroke::new(1.0, kettle)));
+        if let Some(head) = ring(0.0, 1.0) {
+            for k in (0..N).step_by(6) {
+                painter.line_segment(
+                    [head[k], bowl[k]],
+                    Stroke::new(1.0, kettle.gamma_multiply(0.7)),
+                );
+            }
+        }
+    }
+    if let Some(head) = ring(0.0, 1.0) {
+        painter.add(Shape::convex_polygon(
+            head,
+            Color32::from_rgba_unmultiplied(225, 215, 190, 170),
+            Stroke::new(1.5, kettle),
+        ));
+    }
+    if let Some((q, _)) = proj.project(centre) {
+        painter.text(
+            to_pos(rect, q),
+            egui::Align2::CENTER_CENTER,
+            &drum.name,
+            egui::FontId::proportional(10.0),
+            Color32::from_gray(60),
+        );
+    }
+}
