@@ -185,14 +185,14 @@ mod tests {
         let mut twin = bank.clone();
         bank.kick(&[1.0, 1.0]);
         twin.kick(&[1.0, 1.0]);
-        let n = 24_000;
+        let n = 30_000;
         let mut out = vec![0.0f32; n];
         bank.render_free(&mut out);
         let mut out2 = vec![0.0f32; n];
         twin.render_driven(&vec![0.0; n * 8], &mut out2);
         assert_eq!(out, out2);
         let crossings = out.windows(2).filter(|w| w[0] < 0.0 && w[1] >= 0.0).count();
-        assert!((crossings as f64 - 110.0).abs() <= 1.0, "{crossings}");
+        assert!((crossings as f64 - 220.0 * n as f64 / rate).abs() <= 1.0, "{crossings}");
         let env = |t: f64| {
             let i = (t * rate) as usize;
             out[i..i + 220].iter().fold(0.0f32, |m, v| m.max(v.abs()))
