@@ -2,7 +2,7 @@
 //! end with a scripted stick (issue 6 §1–3 acceptance checks).
 
 use glam::DVec3;
-use timpanist::drum::strike::{self, PLAYING_SPOT_FRACTION, ScriptedStick, SIM_RATE_HZ};
+use timpanist::drum::strike::{self, PLAYING_SPOT_FRACTION, SIM_RATE_HZ, ScriptedStick};
 use timpanist::drum::{DrumSet, ModeConfig};
 use timpanist::kit::{Kit, Side};
 use timpanist::score::Dynamic;
@@ -44,7 +44,10 @@ fn one_stroke_partials_and_decay() {
     let spec = sound::spectrum(&x, SAMPLE_RATE_HZ);
     let f0 = kit.drums[D26].tuning.hz();
     let (f11, a11) = peak_in(&spec, f0 * 0.95, f0 * 1.05).unwrap();
-    assert!((f11 / f0 - 1.0).abs() < 0.02, "(1,1) at {f11} Hz, tuning {f0}");
+    assert!(
+        (f11 / f0 - 1.0).abs() < 0.02,
+        "(1,1) at {f11} Hz, tuning {f0}"
+    );
     let found = peaks(&spec, 50.0, 2000.0, 0.01);
     for r in [1.50, 1.98, 2.44, 2.94] {
         let hit = found
@@ -56,12 +59,17 @@ fn one_stroke_partials_and_decay() {
     let drop_db = |ratio: f64| {
         let level = |w: &[f32]| {
             let s = sound::spectrum(w, SAMPLE_RATE_HZ);
-            peak_in(&s, f11 * ratio * 0.98, f11 * ratio * 1.02).unwrap().1
+            peak_in(&s, f11 * ratio * 0.98, f11 * ratio * 1.02)
+                .unwrap()
+                .1
         };
         20.0 * (level(window(&x, 1.1, 1.6)) / level(window(&x, 0.1, 0.6))).log10()
     };
     let (d11, d21, d31) = (drop_db(1.0), drop_db(1.5), drop_db(1.98));
-    assert!(d11 < d21 - 3.0 && d11 < d31 - 3.0, "drops {d11} {d21} {d31} dB");
+    assert!(
+        d11 < d21 - 3.0 && d11 < d31 - 3.0,
+        "drops {d11} {d21} {d31} dB"
+    );
 }
 
 /// A centre strike hardly excites the m ≥ 1 modes (the (1,1) and (2,1) at least 30 dB
@@ -80,7 +88,10 @@ fn centre_and_playing_spot_differ() {
     let (spot11, spot21) = rel(PLAYING_SPOT_FRACTION);
     let (mid11, mid21) = rel(0.0);
     let db = |x: f64| 20.0 * x.log10();
-    assert!(db(spot11) > -20.0 && db(spot21) > -20.0, "{spot11} {spot21}");
+    assert!(
+        db(spot11) > -20.0 && db(spot21) > -20.0,
+        "{spot11} {spot21}"
+    );
     assert!(db(mid11) < db(spot11) - 30.0, "{mid11} vs {spot11}");
     assert!(db(mid21) < db(spot21) - 30.0, "{mid21} vs {spot21}");
 }
@@ -120,17 +131,27 @@ fn strike_on_a_vibrating_head_interacts() {
         let mut drums = DrumSet::new(&kit, mallet, &cfg, DT).unwrap();
         let mut sticks = [ScriptedStick::parked(mallet), ScriptedStick::parked(mallet)];
         if ring_first {
-            sticks[1] = ScriptedStick::above(drum, mallet, drum.point_on_head(0.6, 0.0), 3.0, 0.001);
+            sticks[1] =
+                ScriptedStick::above(drum, mallet, drum.point_on_head(0.6, 0.0), 3.0, 0.001);
         }
         strike::run(&mut drums, &mut sticks, 0.0, 200);
         sticks[0] = ScriptedStick::above(drum, mallet, drum.point_on_head(0.6, 40.0), 1.5, 0.001);
         let hist = strike::run(&mut drums, &mut sticks, 0.02, 400);
-        let left: Vec<_> = drums.contacts().iter().filter(|c| c.side == Side::Left).cloned().collect();
+        let left: Vec<_> = drums
+            .contacts()
+            .iter()
+            .filter(|c| c.side == Side::Left)
+            .cloned()
+            .collect();
         (hist[0].clone(), left)
     };
     let (still, c_still) = drop(false);
     let (moving, c_moving) = drop(true);
-    let diff = still.iter().zip(&moving).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    let diff = still
+        .iter()
+        .zip(&moving)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
     let peak = still.iter().copied().fold(0.0, f64::max);
     assert!(diff > 0.05 * peak, "max difference {diff} N of {peak} N");
     assert!(!c_still.is_empty() && !c_moving.is_empty());
@@ -163,7 +184,7 @@ fn pushing_stick_is_finite() {
 }
 
 /// Both sticks on the same head at once (a roll) give two overlapping contacts; a tip
-/// outside every head's radius never touches.
+/// outside every head's radius, or arriving under a head from the side, never touches.
 #[test]
 fn rolls_and_misses() {
     let kit = Kit::standard();
@@ -176,18 +197,35 @@ fn rolls_and_misses() {
     ];
     strike::run(&mut drums, &mut sticks, 0.0, 300);
     let c = drums.contacts();
-    let left = c.iter().find(|c| c.side == Side::Left).expect("left touches");
-    let right = c.iter().find(|c| c.side == Side::Right).expect("right touches");
-    assert!(right.start_s < left.end_s && left.start_s < right.end_s, "overlap: {c:?}");
+    let left = c
+        .iter()
+        .find(|c| c.side == Side::Left)
+        .expect("left touches");
+    let right = c
+        .iter()
+        .find(|c| c.side == Side::Right)
+        .expect("right touches");
+    assert!(
+        right.start_s < left.end_s && left.start_s < right.end_s,
+        "overlap: {c:?}"
+    );
 
     let mut drums = DrumSet::new(&kit, mallet, &ModeConfig::default(), DT).unwrap();
-    let outside = drum.point_on_head(1.02, 0.0) + DVec3::new(0.0, 0.0, 0.0);
+    let outside = drum.point_on_head(1.02, 0.0);
     let mut sticks = [
         ScriptedStick::parked(mallet),
         ScriptedStick::above(drum, mallet, outside, 2.0, 0.001),
     ];
     let hist = strike::run(&mut drums, &mut sticks, 0.0, 300);
     assert!(drums.contacts().is_empty() && hist[1].iter().all(|&f| f == 0.0));
+    // A tip arriving under the head from the side (5 cm below the surface) does not touch.
+    let mut drums = DrumSet::new(&kit, mallet, &ModeConfig::default(), DT).unwrap();
+    let below = drum.point_on_head(0.5, 0.0) - DVec3::new(0.0, 0.0, 0.05);
+    let f = drums.step(
+        0.0,
+        [(below, DVec3::ZERO), (below, DVec3::new(0.0, 0.0, -1.0))],
+    );
+    assert_eq!(f, [DVec3::ZERO; 2]);
 }
 
 /// A DrumSet snapshot (clone) re-simulated from the same state gives identical results,
@@ -199,9 +237,16 @@ fn snapshot_and_displacement() {
     let drum = &kit.drums[D26];
     let mut drums = DrumSet::new(&kit, mallet, &ModeConfig::default(), DT).unwrap();
     let p = drum.point_on_head(0.6, 0.0);
-    let mut sticks = [ScriptedStick::parked(mallet), ScriptedStick::above(drum, mallet, p, 2.5, 0.001)];
+    let mut sticks = [
+        ScriptedStick::parked(mallet),
+        ScriptedStick::above(drum, mallet, p, 2.5, 0.001),
+    ];
     strike::run(&mut drums, &mut sticks, 0.0, 20);
-    assert!(drums.displacement_at(D26, p) < -1e-4, "{}", drums.displacement_at(D26, p));
+    assert!(
+        drums.displacement_at(D26, p) < -1e-4,
+        "{}",
+        drums.displacement_at(D26, p)
+    );
     assert_eq!(drums.displacement_at(0, p), 0.0);
     let (mut a, mut sa) = (drums.clone(), sticks);
     let (mut b, mut sb) = (drums, sticks);
@@ -223,8 +268,14 @@ fn renders_are_deterministic_and_clean() {
         let b = sound::render(&kit, &drums, 1.5, model).unwrap();
         assert_eq!(a.samples, b.samples, "{model}");
         assert_eq!((a.channels, a.rate_hz, a.frames()), (2, 48_000, 72_000));
-        assert!(a.samples.iter().all(|s| s.is_finite() && s.abs() <= 1.0), "{model}");
-        assert!(a.samples.iter().any(|s| s.abs() > 0.01), "{model} is silent");
+        assert!(
+            a.samples.iter().all(|s| s.is_finite() && s.abs() <= 1.0),
+            "{model}"
+        );
+        assert!(
+            a.samples.iter().any(|s| s.abs() > 0.01),
+            "{model} is silent"
+        );
         // A local spectral maximum within 2 % of the tuning, at most 20 dB below the
         // strongest peak.
         let spec = sound::spectrum(&a.mono(), SAMPLE_RATE_HZ);
@@ -241,8 +292,14 @@ fn renders_are_deterministic_and_clean() {
     for k in 0..8 {
         for (d, drum) in kit.drums.iter().enumerate() {
             let mut sticks = [ScriptedStick::parked(mallet), ScriptedStick::parked(mallet)];
-            sticks[d % 2] = ScriptedStick::above(drum, mallet, drum.point_on_head(0.6, 0.0), 5.0, 0.001);
-            strike::run(&mut loud, &mut sticks, 0.01 * f64::from(k * 4 + d as u32), 100);
+            sticks[d % 2] =
+                ScriptedStick::above(drum, mallet, drum.point_on_head(0.6, 0.0), 5.0, 0.001);
+            strike::run(
+                &mut loud,
+                &mut sticks,
+                0.01 * f64::from(k * 4 + d as u32),
+                100,
+            );
         }
     }
     let a = sound::render(&kit, &loud, 1.0, SoundModel::Modal).unwrap();

@@ -49,12 +49,12 @@ impl HertzContact {
     /// The force F ≥ 0 that satisfies F = k·c^α with c = c0 − compliance·F (m, m/N): the
     /// contact force when the compression itself yields under it. 0 when c0 ≤ 0.
     pub fn solve(&self, c0: f64, compliance: f64) -> f64 {
-        if !(c0 > 0.0) {
+        if c0.is_nan() || c0 <= 0.0 {
             return 0.0;
         }
         let residual = |f: f64| f - self.force(c0 - compliance * f);
         let (mut lo, mut hi) = (0.0, self.force(c0));
-        if !(compliance > 0.0) || hi <= 0.0 {
+        if compliance.is_nan() || compliance <= 0.0 || hi <= 0.0 {
             return hi.max(0.0);
         }
         // residual is increasing: bisect to a relative 1e-10.

@@ -91,7 +91,8 @@ impl HeadModes {
             return Err(DrumError::InvalidDrum(drum.name.clone()));
         }
         let f11 = drum.tuning.hz();
-        let wave_hz_per_zero = (mem.tension_n_per_m / mem.areal_density_kg_per_m2).sqrt() / (TAU * a);
+        let wave_hz_per_zero =
+            (mem.tension_n_per_m / mem.areal_density_kg_per_m2).sqrt() / (TAU * a);
         let sigma_eff = mem.areal_density_kg_per_m2 / (mem.air_loading * mem.air_loading);
         let last = drum
             .modes
@@ -113,7 +114,10 @@ impl HeadModes {
                     }
                 }
             }
-            let orientations: usize = found.iter().map(|&(_, m, _)| if m == 0 { 1 } else { 2 }).sum();
+            let orientations: usize = found
+                .iter()
+                .map(|&(_, m, _)| if m == 0 { 1 } else { 2 })
+                .sum();
             if orientations >= need {
                 break found;
             }
@@ -130,44 +134,45 @@ impl HeadModes {
                 &[Orientation::Cos, Orientation::Sin][..]
             }
         };
-        let push = |m: u32, n: u32, listed: Option<&crate::kit::Mode>, modes: &mut Vec<HeadMode>| {
-            let radial = radial_profile(m, n);
-            let membrane_hz = wave_hz_per_zero * radial.zero;
-            let (freq_hz, t60_s, gain) = match (listed, config.source) {
-                (Some(k), FrequencySource::Measured) => (k.ratio * f11, k.decay_s, k.gain),
-                (Some(k), FrequencySource::Membrane) => {
-                    (mem.air_loading * membrane_hz, k.decay_s, k.gain)
-                }
-                (None, source) => {
-                    let f = match source {
-                        FrequencySource::Measured => membrane_hz,
-                        FrequencySource::Membrane => mem.air_loading * membrane_hz,
-                    };
-                    let scale = last_hz / f;
-                    let t60 = last.decay_s * scale * if m == 0 { 0.25 } else { 1.0 };
-                    (f, t60, last.gain * scale.min(1.0))
+        let push =
+            |m: u32, n: u32, listed: Option<&crate::kit::Mode>, modes: &mut Vec<HeadMode>| {
+                let radial = radial_profile(m, n);
+                let membrane_hz = wave_hz_per_zero * radial.zero;
+                let (freq_hz, t60_s, gain) = match (listed, config.source) {
+                    (Some(k), FrequencySource::Measured) => (k.ratio * f11, k.decay_s, k.gain),
+                    (Some(k), FrequencySource::Membrane) => {
+                        (mem.air_loading * membrane_hz, k.decay_s, k.gain)
+                    }
+                    (None, source) => {
+                        let f = match source {
+                            FrequencySource::Measured => membrane_hz,
+                            FrequencySource::Membrane => mem.air_loading * membrane_hz,
+                        };
+                        let scale = last_hz / f;
+                        let t60 = last.decay_s * scale * if m == 0 { 0.25 } else { 1.0 };
+                        (f, t60, last.gain * scale.min(1.0))
+                    }
+                };
+                // ∫ Φ² dA = π a² J1(j)² for m = 0, π a²/2 · J_{m+1}(j)² otherwise.
+                let angular = if m == 0 { PI } else { PI / 2.0 };
+                let norm = angular * a * a * radial.j_next_at_zero.powi(2);
+                for &orientation in orientations(m) {
+                    if modes.len() == config.count {
+                        return;
+                    }
+                    modes.push(HeadMode {
+                        m,
+                        n,
+                        orientation,
+                        freq_hz,
+                        t60_s,
+                        gain,
+                        modal_mass_kg: sigma_eff * norm,
+                        listed: listed.is_some(),
+                        radial: Arc::clone(&radial),
+                    });
                 }
             };
-            // ∫ Φ² dA = π a² J1(j)² for m = 0, π a²/2 · J_{m+1}(j)² otherwise.
-            let angular = if m == 0 { PI } else { PI / 2.0 };
-            let norm = angular * a * a * radial.j_next_at_zero.powi(2);
-            for &orientation in orientations(m) {
-                if modes.len() == config.count {
-                    return;
-                }
-                modes.push(HeadMode {
-                    m,
-                    n,
-                    orientation,
-                    freq_hz,
-                    t60_s,
-                    gain,
-                    modal_mass_kg: sigma_eff * norm,
-                    listed: listed.is_some(),
-                    radial: Arc::clone(&radial),
-                });
-            }
-        };
         for k in &drum.modes {
             push(k.m, k.n, Some(k), &mut modes);
         }
@@ -250,14 +255,24 @@ mod tests {
         let f11 = d.tuning.hz();
         for (i, want) in [1.0, 1.5, 1.98, 2.44, 2.94].iter().enumerate() {
             let (c, s) = (&h.modes()[2 * i], &h.modes()[2 * i + 1]);
-            assert_eq!((c.m, c.n, c.orientation), (i as u32 + 1, 1, Orientation::Cos));
+            assert_eq!(
+                (c.m, c.n, c.orientation),
+                (i as u32 + 1, 1, Orientation::Cos)
+            );
             assert_eq!(s.orientation, Orientation::Sin);
             assert!((c.freq_hz / f11 - want).abs() < 1e-12);
         }
         let has = |m, n| h.modes().iter().any(|k| (k.m, k.n) == (m, n));
         assert!(has(0, 1) && has(1, 2) && has(0, 2));
         // (0,2) and (1,2) near Fletcher & Rossing's 1.68 and 2.09 (within 5 %).
-        let ratio = |m, n| h.modes().iter().find(|k| (k.m, k.n) == (m, n)).unwrap().freq_hz / f11;
+        let ratio = |m, n| {
+            h.modes()
+                .iter()
+                .find(|k| (k.m, k.n) == (m, n))
+                .unwrap()
+                .freq_hz
+                / f11
+        };
         assert!((ratio(0, 2) / 1.68 - 1.0).abs() < 0.05, "{}", ratio(0, 2));
         assert!((ratio(1, 2) / 2.09 - 1.0).abs() < 0.05, "{}", ratio(1, 2));
     }
@@ -266,12 +281,23 @@ mod tests {
     #[test]
     fn two_hundred_modes_are_sorted_and_sane() {
         let d = standard_26();
-        let cfg = ModeConfig { count: 200, ..ModeConfig::default() };
+        let cfg = ModeConfig {
+            count: 200,
+            ..ModeConfig::default()
+        };
         let h = HeadModes::new(&d, &cfg).unwrap();
         assert_eq!(h.modes().len(), 200);
-        let unlisted: Vec<f64> = h.modes().iter().filter(|k| !k.listed).map(|k| k.freq_hz).collect();
+        let unlisted: Vec<f64> = h
+            .modes()
+            .iter()
+            .filter(|k| !k.listed)
+            .map(|k| k.freq_hz)
+            .collect();
         assert!(unlisted.windows(2).all(|w| w[0] <= w[1]));
-        assert!(h.modes().iter().all(|k| k.freq_hz > 0.0 && k.t60_s > 0.0 && k.modal_mass_kg > 0.0 && k.gain.is_finite()));
+        assert!(h.modes().iter().all(|k| k.freq_hz > 0.0
+            && k.t60_s > 0.0
+            && k.modal_mass_kg > 0.0
+            && k.gain.is_finite()));
         assert!(ModeConfig { count: 0, ..cfg }.check().is_err());
         assert!(ModeConfig { count: 201, ..cfg }.check().is_err());
     }
@@ -281,7 +307,10 @@ mod tests {
     #[test]
     fn membrane_source_uses_bessel_ratios() {
         let d = standard_26();
-        let cfg = ModeConfig { count: 24, source: FrequencySource::Membrane };
+        let cfg = ModeConfig {
+            count: 24,
+            source: FrequencySource::Membrane,
+        };
         let h = HeadModes::new(&d, &cfg).unwrap();
         let f11 = h.modes()[0].freq_hz;
         assert!((f11 / d.membrane_f11_hz() - 1.0).abs() < 1e-9);
@@ -312,7 +341,11 @@ mod tests {
         }
         for (k, mode) in h.modes().iter().enumerate() {
             let m = sigma_eff * integral[k];
-            assert!((m / mode.modal_mass_kg - 1.0).abs() < 1e-3, "mode {k}: {m} vs {}", mode.modal_mass_kg);
+            assert!(
+                (m / mode.modal_mass_kg - 1.0).abs() < 1e-3,
+                "mode {k}: {m} vs {}",
+                mode.modal_mass_kg
+            );
         }
         h.shapes_at(DVec2::ZERO, &mut shapes);
         for (s, mode) in shapes.iter().zip(h.modes()) {

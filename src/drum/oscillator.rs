@@ -82,10 +82,16 @@ mod tests {
             }
         }
         let expected = f * t60;
-        assert!((f64::from(crossings) - expected).abs() <= 1.0, "{crossings}");
+        assert!(
+            (f64::from(crossings) - expected).abs() <= 1.0,
+            "{crossings}"
+        );
         // The window holds the last two periods: its peak is the envelope at its start.
         let envelope = 1e-3 * (2.0 / f / tau_from_t60(t60)).exp();
-        assert!((peak_late / envelope - 1.0).abs() < 0.02, "{peak_late} vs {envelope}");
+        assert!(
+            (peak_late / envelope - 1.0).abs() < 0.02,
+            "{peak_late} vs {envelope}"
+        );
     }
 
     /// A held unit input settles at q = 1/ω0² (the static deflection), even for a mode far

@@ -151,7 +151,11 @@ impl DrumSet {
                 })
             })
             .collect::<Result<Vec<_>, DrumError>>()?;
-        let most = heads.iter().map(|h| h.modes.modes().len()).max().unwrap_or(0);
+        let most = heads
+            .iter()
+            .map(|h| h.modes.modes().len())
+            .max()
+            .unwrap_or(0);
         Ok(DrumSet {
             dt_s,
             config: *config,
@@ -182,7 +186,8 @@ impl DrumSet {
             let bottom_end = bottom + v.z * dt;
             let surface = head.modes.centre().z;
             // NaN positions fail every comparison and never touch.
-            if !(bottom.min(bottom_end) - surface <= head.bound_m) {
+            let height = bottom.min(bottom_end) - surface;
+            if height.is_nan() || height > head.bound_m {
                 continue;
             }
             head.modes.shapes_at(local, &mut self.shapes[i]);
@@ -191,7 +196,9 @@ impl DrumSet {
             // other tip's force (already solved) in c0, and S the membrane's one-step
             // compliance at the point plus the tip's (dt²/m_eff). Solving F = k·c(F)^α
             // (implicit in the contact) keeps the stiff felt–membrane coupling stable.
-            let other = touching[1 - i].filter(|&(tj, _)| tj == j).map(|_| (force[1 - i], &self.shapes[1 - i]));
+            let other = touching[1 - i]
+                .filter(|&(tj, _)| tj == j)
+                .map(|_| (force[1 - i], &self.shapes[1 - i]));
             let mut d_free = 0.0;
             let mut compliance = 0.0;
             for ((&k, x), (step, inv_m)) in head
@@ -209,6 +216,11 @@ impl DrumSet {
             // Mid-step compression (trapezoidal: second order, no numerical damping of
             // the contact for a linear spring, still implicit in F).
             let c_now = surface + head.displacement(&self.shapes[i]) - bottom;
+            // A tip that is already deeper than the felt radius without having been in
+            // contact came from the side or below the head: it does not touch it.
+            if self.open[i].is_none() && c_now > self.law.ball_radius_m {
+                continue;
+            }
             let c_end = surface + d_free - bottom_end;
             let c0 = 0.5 * (c_now + c_end);
             let f = self.law.solve(c0, 0.5 * (compliance + tip_compliance));

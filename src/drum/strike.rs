@@ -145,7 +145,8 @@ pub fn scripted(
         }
         // Taken away once clearly leaving: moving up and 5 mm above the resting head
         // (a brief double touch while the head swings back still counts).
-        let clear = sticks[i].position.z - mallet.head_radius_m > drum.placement.head_height_m + 0.005;
+        let clear =
+            sticks[i].position.z - mallet.head_radius_m > drum.placement.head_height_m + 0.005;
         if forces[i].z > 0.0 {
             touched = true;
         } else if touched && sticks[i].velocity.z > 0.0 && clear {

@@ -57,7 +57,10 @@ impl SoundModel {
 
 impl fmt::Display for SoundModel {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let name = Self::ALL.iter().find(|(m, _)| m == self).map_or("?", |(_, n)| n);
+        let name = Self::ALL
+            .iter()
+            .find(|(m, _)| m == self)
+            .map_or("?", |(_, n)| n);
         f.write_str(name)
     }
 }

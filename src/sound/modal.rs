@@ -79,7 +79,10 @@ pub fn render_drum(drums: &DrumSet, j: usize, out: &mut [f32]) -> bool {
             first += 1;
         }
         let mut driven = false;
-        for e in entries[first..].iter().take_while(|e| span(e.time_s).1 < n1) {
+        for e in entries[first..]
+            .iter()
+            .take_while(|e| span(e.time_s).1 < n1)
+        {
             let (c, lo, hi) = span(e.time_s);
             let (lo, hi) = (lo.max(n0), hi.min(n1));
             if lo >= hi {

@@ -19,9 +19,18 @@ use std::sync::OnceLock;
 
 /// The embedded recordings: (file name, WAV bytes).
 pub const RECORDINGS: [(&str, &[u8]); 3] = [
-    ("Timpani_1L.wav", include_bytes!("../../kits/samples/Timpani_1L.wav")),
-    ("Timpani_2L.wav", include_bytes!("../../kits/samples/Timpani_2L.wav")),
-    ("Timpani_3L.wav", include_bytes!("../../kits/samples/Timpani_3L.wav")),
+    (
+        "Timpani_1L.wav",
+        include_bytes!("../../kits/samples/Timpani_1L.wav"),
+    ),
+    (
+        "Timpani_2L.wav",
+        include_bytes!("../../kits/samples/Timpani_2L.wav"),
+    ),
+    (
+        "Timpani_3L.wav",
+        include_bytes!("../../kits/samples/Timpani_3L.wav"),
+    ),
 ];
 
 /// Kettledrum mode ratios used to recognise the (1,1) in a recording.
@@ -95,9 +104,12 @@ pub fn recordings() -> Result<&'static [Recording], SoundError> {
 
 /// The recording whose (1,1) is nearest `hz` in log frequency.
 pub fn nearest(recordings: &[Recording], hz: f64) -> Option<&Recording> {
-    recordings
-        .iter()
-        .min_by(|a, b| (a.principal_hz / hz).ln().abs().total_cmp(&(b.principal_hz / hz).ln().abs()))
+    recordings.iter().min_by(|a, b| {
+        (a.principal_hz / hz)
+            .ln()
+            .abs()
+            .total_cmp(&(b.principal_hz / hz).ln().abs())
+    })
 }
 
 /// Cubic Hermite (Catmull–Rom) interpolation of `x` at fractional index `pos` (0 outside).

@@ -7,7 +7,10 @@ use std::f64::consts::{PI, TAU};
 /// In-place iterative radix-2 FFT of (re, im); the length must be a power of two.
 pub fn fft(re: &mut [f64], im: &mut [f64]) {
     let n = re.len();
-    assert!(n.is_power_of_two() && im.len() == n, "FFT length must be a power of two");
+    assert!(
+        n.is_power_of_two() && im.len() == n,
+        "FFT length must be a power of two"
+    );
     let mut j = 0;
     for i in 1..n {
         let mut bit = n >> 1;
@@ -83,9 +86,17 @@ pub fn peak_in(spec: &[(f64, f64)], lo: f64, hi: f64) -> Option<(f64, f64)> {
     if k == 0 || k + 1 >= spec.len() || a <= 0.0 {
         return Some(spec[k]);
     }
-    let (l, c, r) = (spec[k - 1].1.max(1e-30).ln(), a.ln(), spec[k + 1].1.max(1e-30).ln());
+    let (l, c, r) = (
+        spec[k - 1].1.max(1e-30).ln(),
+        a.ln(),
+        spec[k + 1].1.max(1e-30).ln(),
+    );
     let denom = l - 2.0 * c + r;
-    let shift = if denom < 0.0 { (0.5 * (l - r) / denom).clamp(-0.5, 0.5) } else { 0.0 };
+    let shift = if denom < 0.0 {
+        (0.5 * (l - r) / denom).clamp(-0.5, 0.5)
+    } else {
+        0.0
+    };
     let bin = spec[1].0 - spec[0].0;
     Some((spec[k].0 + shift * bin, (c - 0.25 * (l - r) * shift).exp()))
 }
@@ -168,7 +179,10 @@ mod tests {
         let s: Vec<f32> = (0..48_000)
             .map(|i| {
                 let t = i as f64 / 48_000.0;
-                parts.iter().map(|(r, a)| a * (TAU * 100.0 * r * t).sin()).sum::<f64>() as f32
+                parts
+                    .iter()
+                    .map(|(r, a)| a * (TAU * 100.0 * r * t).sin())
+                    .sum::<f64>() as f32
             })
             .collect();
         let spec = spectrum(&s, rate);

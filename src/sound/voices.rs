@@ -88,8 +88,13 @@ impl VoiceBank {
             let mut acc = [0.0f32; LANES];
             for c in 0..self.x1.len() {
                 let (x1, x2) = (&mut self.x1[c], &mut self.x2[c]);
-                let (a11, a12, a21, a22, g) =
-                    (&self.a11[c], &self.a12[c], &self.a21[c], &self.a22[c], &self.gain[c]);
+                let (a11, a12, a21, a22, g) = (
+                    &self.a11[c],
+                    &self.a12[c],
+                    &self.a21[c],
+                    &self.a22[c],
+                    &self.gain[c],
+                );
                 for l in 0..LANES {
                     let n1 = a11[l] * x1[l] + a12[l] * x2[l];
                     let n2 = a21[l] * x1[l] + a22[l] * x2[l];
@@ -177,8 +182,16 @@ mod tests {
     fn voices_ring_and_decay() {
         let rate = 48_000.0;
         let voices = [
-            Voice { freq_hz: 220.0, t60_s: 0.5, gain: 1.0 },
-            Voice { freq_hz: 1000.0, t60_s: 0.2, gain: 0.0 },
+            Voice {
+                freq_hz: 220.0,
+                t60_s: 0.5,
+                gain: 1.0,
+            },
+            Voice {
+                freq_hz: 1000.0,
+                t60_s: 0.2,
+                gain: 0.0,
+            },
         ];
         let mut bank = VoiceBank::new(&voices, rate);
         assert_eq!((bank.len(), bank.stride()), (2, 8));
@@ -192,7 +205,10 @@ mod tests {
         twin.render_driven(&vec![0.0; n * 8], &mut out2);
         assert_eq!(out, out2);
         let crossings = out.windows(2).filter(|w| w[0] < 0.0 && w[1] >= 0.0).count();
-        assert!((crossings as f64 - 220.0 * n as f64 / rate).abs() <= 1.0, "{crossings}");
+        assert!(
+            (crossings as f64 - 220.0 * n as f64 / rate).abs() <= 1.0,
+            "{crossings}"
+        );
         let env = |t: f64| {
             let i = (t * rate) as usize;
             out[i..i + 220].iter().fold(0.0f32, |m, v| m.max(v.abs()))
