@@ -53,23 +53,38 @@ impl HertzContact {
             return 0.0;
         }
         let residual = |f: f64| f - self.force(c0 - compliance * f);
+        // The compression cannot go below 0, so F ≤ c0/compliance.
         let (mut lo, mut hi) = (0.0, self.force(c0));
         if compliance.is_nan() || compliance <= 0.0 || hi <= 0.0 {
             return hi.max(0.0);
         }
-        // residual is increasing: bisect to a relative 1e-10.
-        for _ in 0..80 {
-            let mid = 0.5 * (lo + hi);
-            if residual(mid) > 0.0 {
-                hi = mid;
+        hi = hi.min(c0 / compliance);
+        // residual is increasing in F: Newton steps kept inside a shrinking bracket
+        // (bisection when Newton leaves it), to a relative 1e-12.
+        let mut f = 0.5 * (lo + hi);
+        for _ in 0..100 {
+            let r = residual(f);
+            if r > 0.0 {
+                hi = f;
             } else {
-                lo = mid;
+                lo = f;
             }
-            if hi - lo <= 1e-10 * hi {
-                break;
+            let c = c0 - compliance * f;
+            let slope = if c > 0.0 && c < self.ball_radius_m {
+                1.0 + compliance * self.exponent * self.stiffness * c.powf(self.exponent - 1.0)
+            } else {
+                1.0
+            };
+            let mut next = f - r / slope;
+            if !(next > lo && next < hi) {
+                next = 0.5 * (lo + hi);
             }
+            if (next - f).abs() <= 1e-12 * f.abs().max(1e-9) || hi - lo <= 1e-12 * hi {
+                return next;
+            }
+            f = next;
         }
-        0.5 * (lo + hi)
+        f
     }
 }
 
