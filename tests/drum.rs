@@ -55,6 +55,7 @@ fn one_stroke_partials_and_decay() {
             .find(|(f, _)| (f / f11 / r - 1.0).abs() < 0.02)
             .unwrap_or_else(|| panic!("no partial within 2 % of {r}: {found:?}"));
         assert!(hit.1 > 0.01 * a11, "partial {r} too weak: {hit:?}");
+        eprintln!("partial {r}: measured ratio {:.4}", hit.0 / f11);
     }
     let drop_db = |ratio: f64| {
         let level = |w: &[f32]| {
@@ -69,6 +70,9 @@ fn one_stroke_partials_and_decay() {
     assert!(
         d11 < d21 - 3.0 && d11 < d31 - 3.0,
         "drops {d11} {d21} {d31} dB"
+    );
+    eprintln!(
+        "level change 0.1–0.6 s → 1.1–1.6 s: (1,1) {d11:.1}, (2,1) {d21:.1}, (3,1) {d31:.1} dB"
     );
 }
 
@@ -94,6 +98,13 @@ fn centre_and_playing_spot_differ() {
     );
     assert!(db(mid11) < db(spot11) - 30.0, "{mid11} vs {spot11}");
     assert!(db(mid21) < db(spot21) - 30.0, "{mid21} vs {spot21}");
+    eprintln!(
+        "(1,1), (2,1) re strongest partial: spot {:.1}, {:.1} dB; centre {:.1}, {:.1} dB",
+        db(spot11),
+        db(spot21),
+        db(mid11),
+        db(mid21)
+    );
 }
 
 /// Contacts of single free strokes last 2–8 ms, end with the stick rebounding, and peak
