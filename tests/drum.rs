@@ -332,3 +332,26 @@ fn wav_file_written() {
     let r = hound::WavReader::open(&path).unwrap();
     assert_eq!(r.duration() as usize, audio.frames());
 }
+
+/// At a coarse 1 kHz step the modes at or above its 500 Hz Nyquist frequency are left out
+/// of the mechanical coupling (all of them below it stay in), and a strike stays finite.
+#[test]
+fn modes_above_sim_nyquist_are_not_coupled() {
+    let kit = Kit::standard();
+    let mallet = &kit.mallets[0];
+    let cfg = ModeConfig {
+        count: 60,
+        ..ModeConfig::default()
+    };
+    let mut drums = DrumSet::new(&kit, mallet, &cfg, 1e-3).unwrap();
+    let head = drums.head(D26).unwrap();
+    let below = head.modes().iter().filter(|m| m.freq_hz < 500.0).count();
+    assert!(below < 60 && below > 10, "{below}");
+    assert_eq!(drums.coupled_mode_count(D26), below);
+    let drum = &kit.drums[D26];
+    let p = drum.point_on_head(PLAYING_SPOT_FRACTION, 0.0);
+    strike::scripted(&mut drums, drum, mallet, Side::Right, p, 3.0, 0.2);
+    assert!(!drums.contacts().is_empty());
+    assert!(drums.contacts().iter().all(|c| c.peak_force_n.is_finite()));
+    assert!(drums.displacement_at(D26, p).is_finite());
+}
