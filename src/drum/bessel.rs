@@ -118,7 +118,8 @@ impl RadialProfile {
 /// The radial profile of mode (m, n), computed once per process and shared (it does not
 /// depend on the drum).
 pub fn radial_profile(m: u32, n: u32) -> Arc<RadialProfile> {
-    static CACHE: OnceLock<Mutex<BTreeMap<(u32, u32), Arc<RadialProfile>>>> = OnceLock::new();
+    type Cache = Mutex<BTreeMap<(u32, u32), Arc<RadialProfile>>>;
+    static CACHE: OnceLock<Cache> = OnceLock::new();
     let cache = CACHE.get_or_init(|| Mutex::new(BTreeMap::new()));
     if let Some(p) = cache.lock().expect("cache lock").get(&(m, n)) {
         return Arc::clone(p);

@@ -45,6 +45,49 @@ impl HertzContact {
     }
 }
 
+impl HertzContact {
+    /// The force F ≥ 0 that satisfies F = k·c^α with c = c0 − compliance·F (m, m/N): the
+    /// contact force when the compression itself yields under it. 0 when c0 ≤ 0.
+    pub fn solve(&self, c0: f64, compliance: f64) -> f64 {
+        if c0.is_nan() || c0 <= 0.0 {
+            return 0.0;
+        }
+        let residual = |f: f64| f - self.force(c0 - compliance * f);
+        // The compression cannot go below 0, so F ≤ c0/compliance.
+        let (mut lo, mut hi) = (0.0, self.force(c0));
+        if compliance.is_nan() || compliance <= 0.0 || hi <= 0.0 {
+            return hi.max(0.0);
+        }
+        hi = hi.min(c0 / compliance);
+        // residual is increasing in F: Newton steps kept inside a shrinking bracket
+        // (bisection when Newton leaves it), to a relative 1e-12.
+        let mut f = 0.5 * (lo + hi);
+        for _ in 0..100 {
+            let r = residual(f);
+            if r > 0.0 {
+                hi = f;
+            } else {
+                lo = f;
+            }
+            let c = c0 - compliance * f;
+            let slope = if c > 0.0 && c < self.ball_radius_m {
+                1.0 + compliance * self.exponent * self.stiffness * c.powf(self.exponent - 1.0)
+            } else {
+                1.0
+            };
+            let mut next = f - r / slope;
+            if !(next > lo && next < hi) {
+                next = 0.5 * (lo + hi);
+            }
+            if (next - f).abs() <= 1e-12 * f.abs().max(1e-9) || hi - lo <= 1e-12 * hi {
+                return next;
+            }
+            f = next;
+        }
+        f
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -61,5 +104,12 @@ mod tests {
         assert_eq!(law.force(f64::NAN), 0.0);
         assert_eq!(law.force(10.0), law.force(law.ball_radius_m));
         assert!(law.force(2.0 * c) > law.force(c));
+        // The yielding solution satisfies its equation and is below the rigid force.
+        let (c0, s) = (0.004, 2e-5);
+        let f = law.solve(c0, s);
+        assert!((f - law.force(c0 - s * f)).abs() < 1e-6 * f, "{f}");
+        assert!(f > 0.0 && f < law.force(c0));
+        assert_eq!(law.solve(-1e-3, s), 0.0);
+        assert_eq!(law.solve(f64::NAN, s), 0.0);
     }
 }

@@ -4,8 +4,12 @@
 //! membrane modes down (generalised force −F·Φ_k(x)) and the stick up, so the stick
 //! rebounds physically and a strike on a ringing head feels its motion.
 //!
-//! Each mode is advanced by its exact (ZOH) step with the force held over the step, the
-//! force computed from the state at the start of the step (explicit coupling). Modes at or
+//! Each mode is advanced by its exact (ZOH) step with the force held over the step. The
+//! force is implicit in the contact: the one that satisfies F = k·c^α with c the
+//! compression at the *end* of the step, predicted from the modes' exact response to F
+//! and the tip moving on with its velocity (plus F·dt²/m_eff, m_eff from
+//! [`effective_mass_kg`](super::strike::effective_mass_kg)). An explicit force (from the
+//! start-of-step state) gained energy when a stick rested on the head and blew up. Modes at or
 //! above the simulation's Nyquist frequency (f ≥ 1/(2·dt)) are left out of the mechanical
 //! coupling — they would alias — but still sound: the audio voices (48 kHz) take every
 //! mode below the audio Nyquist, driven by the recorded force.
@@ -91,6 +95,8 @@ pub struct DrumSet {
     dt_s: f64,
     config: ModeConfig,
     law: HertzContact,
+    /// The tip's effective mass used to predict its motion over a step, kg.
+    tip_mass_kg: f64,
     heads: Vec<Head>,
     step: u64,
     contacts: Vec<ContactEvent>,
@@ -154,6 +160,7 @@ impl DrumSet {
             dt_s,
             config: *config,
             law,
+            tip_mass_kg: super::strike::effective_mass_kg(mallet),
             heads,
             step: 0,
             contacts: Vec::new(),
@@ -167,22 +174,56 @@ impl DrumSet {
     /// (0 left, 1 right), performer frame. Returns the force on each tip, N (+z pushes
     /// the stick up). A tip outside every head (horizontally) never touches.
     pub fn step(&mut self, time_s: f64, tips: [(DVec3, DVec3); 2]) -> [DVec3; 2] {
+        let dt = self.dt_s;
         let mut force = [0.0f64; 2];
         let mut touching: [Option<(usize, DVec2)>; 2] = [None, None];
-        for (i, &(p, _)) in tips.iter().enumerate() {
+        for (i, &(p, v)) in tips.iter().enumerate() {
             let Some((j, local)) = self.head_under(p) else {
                 continue;
             };
             let head = &self.heads[j];
             let bottom = p.z - self.law.ball_radius_m;
+            let bottom_end = bottom + v.z * dt;
             let surface = head.modes.centre().z;
             // NaN positions fail every comparison and never touch.
-            if !(bottom - surface <= head.bound_m) {
+            let height = bottom.min(bottom_end) - surface;
+            if height.is_nan() || height > head.bound_m {
                 continue;
             }
             head.modes.shapes_at(local, &mut self.shapes[i]);
-            let d = head.displacement(&self.shapes[i]);
-            let f = self.law.force(surface + d - bottom);
+            // Compression at the end of the step as a function of the force F held over
+            // it: c(F) = c0 − S·F, with the membrane's free motion and the response to the
+            // other tip's force (already solved) in c0, and S the membrane's one-step
+            // compliance at the point plus the tip's (dt²/m_eff). Solving F = k·c(F)^α
+            // (implicit in the contact) keeps the stiff felt–membrane coupling stable.
+            let other = touching[1 - i]
+                .filter(|&(tj, _)| tj == j)
+                .map(|_| (force[1 - i], &self.shapes[1 - i]));
+            let mut d_free = 0.0;
+            let mut compliance = 0.0;
+            for ((&k, x), (step, inv_m)) in head
+                .coupled
+                .iter()
+                .zip(&head.x)
+                .zip(head.steps.iter().zip(&head.inv_mass))
+            {
+                let phi = self.shapes[i][k];
+                let other_u = other.map_or(0.0, |(f, sh)| -f * sh[k] * inv_m);
+                d_free += phi * step.advance(*x, other_u)[0] / step.omega0;
+                compliance += phi * phi * step.b[0] / step.omega0 * inv_m;
+            }
+            let tip_compliance = dt * dt / self.tip_mass_kg;
+            // Mid-step compression (trapezoidal: second order, no numerical damping of
+            // the contact for a linear spring, still implicit in F).
+            let c_now = surface + head.displacement(&self.shapes[i]) - bottom;
+            // A tip that is already deeper than the felt radius without having been in
+            // contact came from the side or below the head: it does not touch it.
+            if self.open[i].is_none() && c_now > self.law.ball_radius_m {
+                continue;
+            }
+            let c_end = surface + d_free - bottom_end;
+            let c0 = 0.5 * (c_now + c_end);
+            let f = self.law.solve(c0, 0.5 * (compliance + tip_compliance));
             if f > 0.0 {
                 force[i] = f;
                 touching[i] = Some((j, local));

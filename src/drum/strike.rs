@@ -3,9 +3,10 @@
 //! through [`DrumSet::step`] (semi-implicit Euler), so the contact and the rebound come
 //! from the two-way coupling alone. Also the dynamics → impact-speed map.
 //!
-//! Effective mass: the free-mallet limit, the whole mallet mass (`Mallet::mass_kg`): a
-//! timpanist's loose grip lets the mallet rebound almost freely. The body simulation
-//! supplies its own (arm-loaded) dynamics instead.
+//! Effective mass at the tip ([`effective_mass_kg`]): the mallet pivots about the grip; with
+//! a third of its mass in the felt head at the tip and two thirds in a uniform shaft
+//! (I/L² = m_shaft/3), m_eff = m/3 + (2m/3)/3 = 5m/9. The body simulation supplies its own
+//! (arm-loaded) dynamics instead.
 
 use super::set::DrumSet;
 use crate::kit::{Drum, Mallet, Side};
@@ -21,12 +22,18 @@ pub const SIM_RATE_HZ: f64 = 10_000.0;
 /// (guide §5).
 pub const PLAYING_SPOT_FRACTION: f64 = 0.6;
 /// Downward tip speed at impact for velocity 1 (MIDI 127), m/s: impact speed =
-/// `FULL_SPEED_MPS` × velocity, so pp 1.04, p 1.54, mp 2.02, mf 2.52, f 3.02, ff 3.53 m/s.
-pub const FULL_SPEED_MPS: f64 = 4.0;
+/// `FULL_SPEED_MPS` × velocity, so pp 1.46, p 2.16, mp 2.82, mf 3.53, f 4.23, ff 4.94 m/s
+/// (chosen so mf–ff strokes on the standard kit peak at 62–107 N as seed 000 reports).
+pub const FULL_SPEED_MPS: f64 = 5.6;
 
 /// Downward impact speed for a dynamic, m/s (linear in MIDI velocity, see [`FULL_SPEED_MPS`]).
 pub fn impact_speed_mps(dynamic: Dynamic) -> f64 {
     FULL_SPEED_MPS * dynamic.velocity().clamp(0.0, 1.0)
+}
+
+/// Effective mass of a mallet at its tip when it pivots about the grip, kg (5/9 of its mass).
+pub fn effective_mass_kg(mallet: &Mallet) -> f64 {
+    mallet.mass_kg * 5.0 / 9.0
 }
 
 /// A stick tip as a point mass.
@@ -46,7 +53,7 @@ impl ScriptedStick {
     /// A stick held still 2.5 m up, 1 m behind the player: far from every head.
     pub fn parked(mallet: &Mallet) -> ScriptedStick {
         ScriptedStick {
-            mass_kg: mallet.mass_kg,
+            mass_kg: effective_mass_kg(mallet),
             position: DVec3::new(0.0, -1.0, 2.5),
             velocity: DVec3::ZERO,
             push_n: 0.0,
@@ -63,7 +70,7 @@ impl ScriptedStick {
         gap_m: f64,
     ) -> ScriptedStick {
         ScriptedStick {
-            mass_kg: mallet.mass_kg,
+            mass_kg: effective_mass_kg(mallet),
             position: DVec3::new(
                 point.x,
                 point.y,
@@ -109,8 +116,9 @@ pub fn run(
 }
 
 /// One free stroke by `side` at `point` on drum `drum` of the set, starting 1 mm above
-/// the head at `speed_mps`, the other stick parked; runs `duration_s` from t = 0.
-/// Returns the two sticks after the run.
+/// the head at `speed_mps`, the other stick parked; runs `duration_s` from t = 0. As the
+/// stick rises clear of the head after touching it the player takes it away (it is
+/// parked), so it does not fall back for a second stroke. Returns the two sticks after the run.
 pub fn scripted(
     drums: &mut DrumSet,
     drum: &Drum,
@@ -127,6 +135,23 @@ pub fn scripted(
     };
     sticks[i] = ScriptedStick::above(drum, mallet, point, speed_mps, 0.001);
     let steps = (duration_s / drums.dt_s()).round() as usize;
-    run(drums, &mut sticks, 0.0, steps);
+    let dt = drums.dt_s();
+    let mut touched = false;
+    for k in 0..steps {
+        let t = k as f64 * dt;
+        let forces = drums.step(t, [sticks[0].tip(), sticks[1].tip()]);
+        for (stick, f) in sticks.iter_mut().zip(forces) {
+            stick.advance(f, dt);
+        }
+        // Taken away once clearly leaving: moving up and 5 mm above the resting head
+        // (a brief double touch while the head swings back still counts).
+        let clear =
+            sticks[i].position.z - mallet.head_radius_m > drum.placement.head_height_m + 0.005;
+        if forces[i].z > 0.0 {
+            touched = true;
+        } else if touched && sticks[i].velocity.z > 0.0 && clear {
+            sticks[i] = ScriptedStick::parked(mallet);
+        }
+    }
     sticks
 }

@@ -29,7 +29,7 @@ pub const PEAK_LIMIT: f64 = 0.891_250_938_133_745_5;
 pub const PAN_SPAN_M: f64 = 1.2;
 /// Impact speed of the reference strike every model calibrates to, m/s (ff, see
 /// [`crate::drum::strike::impact_speed_mps`]).
-pub const REFERENCE_SPEED_MPS: f64 = 3.5;
+pub const REFERENCE_SPEED_MPS: f64 = 4.94;
 /// Peak level the sample and signal models give the reference strike (−6 dBFS); the
 /// modal model's calibration puts a reference strike on the 26-inch drum there too.
 pub const REFERENCE_LEVEL: f64 = 0.5;

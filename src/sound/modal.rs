@@ -16,7 +16,7 @@ use crate::drum::{DrumSet, HeadModes, Orientation};
 
 /// Output per unit of Σ gain × modal velocity, 1/(m/s): an ff strike (3.5 m/s) at the
 /// playing spot of the standard 26-inch drum peaks near −6 dBFS.
-pub const MODAL_CALIBRATION: f64 = 1.0;
+pub const MODAL_CALIBRATION: f64 = 0.083;
 /// Samples per processing block.
 const BLOCK: usize = 128;
 /// States below this (m/s, about −200 dB re 1 m/s) are flushed to zero.

@@ -116,21 +116,23 @@ pub fn peaks(spec: &[(f64, f64)], lo: f64, hi: f64, floor: f64) -> Vec<(f64, f64
 }
 
 /// The principal (1,1) frequency of a kettledrum sound: among the peaks in [lo, hi] Hz
-/// within 20 dB of the strongest, the one whose multiples by `ratios` (the first being 1)
-/// hold the most amplitude (the largest peak within ±3 % of each multiple), refined.
+/// within 20 dB of the strongest, the one whose own amplitude plus the largest peak within
+/// ±2 % of each further multiple in `ratios` (after the leading 1) is largest, refined by
+/// interpolation.
 pub fn principal_hz(spec: &[(f64, f64)], lo: f64, hi: f64, ratios: &[f64]) -> Option<f64> {
     let candidates = peaks(spec, lo, hi, 0.1);
-    let score = |f: f64| -> f64 {
-        ratios
+    let score = |(f, a): (f64, f64)| -> f64 {
+        a + ratios
             .iter()
-            .map(|r| peak_in(spec, r * f * 0.97, r * f * 1.03).map_or(0.0, |p| p.1))
-            .sum()
+            .skip(1)
+            .map(|r| peak_in(spec, r * f * 0.98, r * f * 1.02).map_or(0.0, |p| p.1))
+            .sum::<f64>()
     };
     let best = candidates
         .iter()
-        .map(|&(f, _)| (f, score(f)))
+        .map(|&p| (p.0, score(p)))
         .max_by(|x, y| x.1.total_cmp(&y.1).then(y.0.total_cmp(&x.0)))?;
-    peak_in(spec, best.0 * 0.99, best.0 * 1.01).map(|p| p.0)
+    peak_in(spec, best.0 * 0.995, best.0 * 1.005).map(|p| p.0)
 }
 
 /// Hann window value w(i) of an `n`-point window.
