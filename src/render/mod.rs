@@ -44,10 +44,14 @@ pub struct RenderParams {
     /// Player's height, m, and mass, kg.
     pub height_m: f64,
     pub mass_kg: f64,
-    /// Most simulation passes of the timing compensation (1 = none).
+    /// Most simulation passes of the timing compensation (1 = none); the best pass is kept.
     pub max_passes: usize,
-    /// Compensation stops once every stroke's contact is this close to its time, s.
+    /// Compensation stops once every stroke's contact is this close to its time, s, and
+    /// every force is within `force_tolerance` of its aim...
     pub timing_tolerance_s: f64,
+    /// ...or, from pass `settle_passes` on, once every stroke sounds within this, s.
+    pub timing_acceptable_s: f64,
+    pub settle_passes: usize,
     /// How far below the head the felt first aims at impact (strike-through), m; each
     /// stroke's depth is then adapted toward its dynamic's force.
     pub strike_depth_m: f64,
@@ -76,9 +80,11 @@ impl Default for RenderParams {
             mallet: 0,
             height_m: 1.75,
             mass_kg: 70.0,
-            max_passes: 3,
+            max_passes: 6,
             timing_tolerance_s: 0.0015,
-            strike_depth_m: 0.025,
+            timing_acceptable_s: 0.004,
+            settle_passes: 3,
+            strike_depth_m: 0.018,
             force_at_silence_n: 15.0,
             force_range_n: 95.0,
             force_tolerance: 0.25,
@@ -240,6 +246,9 @@ pub fn render(
         .map(|s| params.force_at_silence_n + params.force_range_n * s.dynamic.velocity())
         .collect();
     let mut pass = 0;
+    // The best pass so far: fewest missed strokes, then smallest worst timing error.
+    type Pass = (Reference, Motion, DrumSet, Vec<Option<usize>>, Timing);
+    let mut best: Option<Pass> = None;
     let (reference, motion, drums, matches, timing) = loop {
         pass += 1;
         let mut reference = reference::targets(&composition, &shape, &adjust);
@@ -296,8 +305,16 @@ pub fn render(
             .iter()
             .zip(&aims)
             .all(|(f, aim)| f.is_some_and(|f| (f / aim - 1.0).abs() <= params.force_tolerance));
-        if (on_time && on_force) || pass >= passes {
-            break (reference, motion, drums, matches, timing);
+        let acceptable = timing.missed == 0
+            && timing.worst_abs_s <= params.timing_acceptable_s
+            && pass >= params.settle_passes;
+        let done = (on_time && on_force) || acceptable || pass >= passes;
+        let key = |t: &Timing| (t.missed, t.worst_abs_s);
+        if best.as_ref().is_none_or(|b| key(&timing) <= key(&b.4)) {
+            best = Some((reference, motion, drums.clone(), matches.clone(), timing));
+        }
+        if done {
+            break best.take().expect("a pass was kept");
         }
         // Late contacts play their target earlier; weak strokes aim deeper (the felt's
         // Hertz force grows about as the square of how far the hand drives through).
