@@ -82,32 +82,37 @@ impl VoiceBank {
         self.a11.len() * LANES
     }
 
-    /// Ring freely for `out.len()` samples, adding the output to `out`.
+    /// Ring freely for `out.len()` samples, adding the output to `out`. Works in blocks of
+    /// samples with each chunk of voices held in registers through the block (the same
+    /// sums in the same order as one sample at a time, so the output is identical).
     pub fn render_free(&mut self, out: &mut [f32]) {
+        const BLOCK: usize = 64;
         let chunks = self.x1.len();
-        let (a11, a12, a21, a22, g) = (
-            &self.a11[..chunks],
-            &self.a12[..chunks],
-            &self.a21[..chunks],
-            &self.a22[..chunks],
-            &self.gain[..chunks],
-        );
-        let (x1s, x2s) = (&mut self.x1[..chunks], &mut self.x2[..chunks]);
-        for o in out.iter_mut() {
-            let mut acc = [0.0f32; LANES];
-            let coeffs = a11.iter().zip(a12).zip(a21.iter().zip(a22)).zip(g);
-            for ((x1, x2), (((a11, a12), (a21, a22)), g)) in
-                x1s.iter_mut().zip(x2s.iter_mut()).zip(coeffs)
-            {
-                for l in 0..LANES {
-                    let n1 = a11[l] * x1[l] + a12[l] * x2[l];
-                    let n2 = a21[l] * x1[l] + a22[l] * x2[l];
-                    x1[l] = n1;
-                    x2[l] = n2;
-                    acc[l] += g[l] * n2;
+        for block in out.chunks_mut(BLOCK) {
+            let mut acc = [[0.0f32; LANES]; BLOCK];
+            for c in 0..chunks {
+                let (a11, a12, a21, a22, g) = (
+                    self.a11[c],
+                    self.a12[c],
+                    self.a21[c],
+                    self.a22[c],
+                    self.gain[c],
+                );
+                let (mut x1, mut x2) = (self.x1[c], self.x2[c]);
+                for acc in acc.iter_mut().take(block.len()) {
+                    for l in 0..LANES {
+                        let n1 = a11[l] * x1[l] + a12[l] * x2[l];
+                        let n2 = a21[l] * x1[l] + a22[l] * x2[l];
+                        x1[l] = n1;
+                        x2[l] = n2;
+                        acc[l] += g[l] * n2;
+                    }
                 }
+                (self.x1[c], self.x2[c]) = (x1, x2);
             }
-            *o += acc.iter().sum::<f32>();
+            for (o, a) in block.iter_mut().zip(&acc) {
+                *o += a.iter().sum::<f32>();
+            }
         }
     }
 
