@@ -22,6 +22,7 @@ fn harness(score: Option<PathBuf>, dir: &Path) -> Harness<'static, EditorApp> {
         score,
         recent_store: Some(dir.join("recent.txt")),
         audio_device: false,
+        render: false,
     };
     let mut h = Harness::builder()
         .with_size(egui::vec2(1400.0, 900.0))

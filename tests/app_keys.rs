@@ -16,6 +16,7 @@ fn harness(dir: &Path) -> Harness<'static, EditorApp> {
         score: Some(root.join("scores/etude-modes.ron")),
         recent_store: Some(dir.join("recent.txt")),
         audio_device: false,
+        render: false,
     };
     let mut h = Harness::builder()
         .with_size(egui::vec2(1400.0, 900.0))

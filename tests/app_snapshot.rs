@@ -17,6 +17,7 @@ fn main_window_snapshot() {
         score: Some(root.join("scores/etude-modes.ron")),
         recent_store: Some(dir.path().join("recent.txt")),
         audio_device: false,
+        render: false,
     };
     let mut h = Harness::builder()
         .with_size(egui::vec2(1400.0, 900.0))

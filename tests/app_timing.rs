@@ -31,6 +31,7 @@ fn edit_to_composition_and_frame_times() {
         score: Some(sixty_seconds(dir.path())),
         recent_store: Some(dir.path().join("recent.txt")),
         audio_device: false,
+        render: false,
     };
     let mut h = Harness::builder()
         .with_size(egui::vec2(1400.0, 900.0))

@@ -17,6 +17,7 @@ pub mod picking;
 pub mod playback;
 mod pose;
 mod recent;
+mod renderer;
 mod selection;
 mod tempo_lane;
 mod time_axis;
@@ -58,6 +59,9 @@ pub struct EditorOptions {
     pub recent_store: Option<PathBuf>,
     /// Try to open the sound device (otherwise the silent clock is used).
     pub audio_device: bool,
+    /// Render each version of the score (simulation and sound) on a worker thread for
+    /// playback and the simulated body.
+    pub render: bool,
 }
 
 impl Default for EditorOptions {
@@ -66,6 +70,7 @@ impl Default for EditorOptions {
             score: None,
             recent_store: recent::default_store(),
             audio_device: true,
+            render: true,
         }
     }
 }
@@ -97,6 +102,10 @@ pub struct EditorApp {
     /// The window title last sent, so it is only sent when it changes.
     shown_title: String,
     composer: Composer,
+    /// Renders each version of the score for playback (`None` when disabled).
+    renderer: Option<renderer::Renderer>,
+    /// Why the latest render failed.
+    render_error: Option<String>,
     /// Counts compositions received (for caches).
     generation: u64,
     selection: Selection,
@@ -139,6 +148,8 @@ impl EditorApp {
             status: String::new(),
             shown_title: String::new(),
             composer: Composer::new(),
+            renderer: options.render.then(renderer::Renderer::new),
+            render_error: None,
             generation: 0,
             selection: Selection::default(),
             clipboard: Clipboard::default(),
@@ -305,10 +316,33 @@ impl EditorApp {
 
     fn recompose(&mut self) {
         match &self.doc {
-            Some(d) => self
-                .composer
-                .request(&d.loaded.score, &d.loaded.kit, self.ctx.clone()),
+            Some(d) => {
+                self.composer
+                    .request(&d.loaded.score, &d.loaded.kit, self.ctx.clone());
+                if let Some(r) = &mut self.renderer {
+                    r.request(&d.loaded.score, &d.loaded.kit, self.ctx.clone());
+                }
+            }
             None => self.composer.clear(),
+        }
+    }
+
+    /// Take a finished render: its audio to playback, its body to the view.
+    fn take_render(&mut self) {
+        let Some(done) = self.renderer.as_mut().and_then(|r| r.poll()) else {
+            return;
+        };
+        match done {
+            Ok(r) => {
+                if let Err(e) = self.playback.set_audio(&r.audio) {
+                    self.render_error = Some(format!("playback: {e}"));
+                } else {
+                    self.render_error = None;
+                }
+                self.simulated = Some(r.simulated);
+                self.status = r.summary;
+            }
+            Err(e) => self.render_error = Some(format!("render: {e}")),
         }
     }
 
@@ -753,6 +787,14 @@ impl EditorApp {
                 ui.label(format!("composed in {:.0} ms", d.as_secs_f64() * 1e3));
                 ui.separator();
             }
+            if self.renderer.as_ref().is_some_and(|r| r.is_busy()) {
+                ui.spinner();
+                ui.label("rendering sound and motion");
+                ui.separator();
+            } else if let Some(e) = &self.render_error {
+                ui.colored_label(ui.visuals().error_fg_color, e);
+                ui.separator();
+            }
             if self.is_dirty() {
                 ui.label("unsaved changes");
                 ui.separator();
@@ -936,6 +978,7 @@ impl eframe::App for EditorApp {
         if self.composer.poll() {
             self.generation += 1;
         }
+        self.take_render();
         if self.composer.is_busy() {
             ctx.request_repaint_after(std::time::Duration::from_millis(30));
         }

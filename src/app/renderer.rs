@@ -1,0 +1,189 @@
+//! The render pipeline off the UI thread: after each composition request the latest score
+//! is rendered (body + drums + sound, `crate::render`) on one long-lived worker; a newer
+//! request cancels the render in progress. The UI polls once per frame and hands the audio
+//! to playback and the simulated poses to the 3D view.
+
+use super::pose::Simulated;
+use crate::kit::Kit;
+use crate::mocap::db::MotionDb;
+use crate::render::{RenderParams, render};
+use crate::score::{LoadedScore, Score};
+use eframe::egui;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Condvar, Mutex, mpsc};
+
+/// A finished render, ready for playback and the view.
+pub struct Rendered {
+    /// Stereo interleaved 48 kHz audio from score time 0.
+    pub audio: Vec<f32>,
+    pub simulated: Simulated,
+    /// One line for the status bar.
+    pub summary: String,
+}
+
+struct Request {
+    generation: u64,
+    score: Score,
+    kit: Kit,
+    ctx: Option<egui::Context>,
+}
+
+#[derive(Default)]
+struct Slot {
+    request: Option<Request>,
+    quit: bool,
+}
+
+type Reply = (u64, Result<Rendered, String>);
+
+/// The rendering worker.
+pub struct Renderer {
+    shared: Arc<(Mutex<Slot>, Condvar)>,
+    /// The newest generation requested; the worker stops a render that is older.
+    latest: Arc<AtomicU64>,
+    replies: mpsc::Receiver<Reply>,
+    done: u64,
+}
+
+impl Renderer {
+    /// Start the worker.
+    pub fn new() -> Renderer {
+        let shared = Arc::new((Mutex::new(Slot::default()), Condvar::new()));
+        let latest = Arc::new(AtomicU64::new(0));
+        let (tx, replies) = mpsc::channel();
+        let (worker, newest) = (Arc::clone(&shared), Arc::clone(&latest));
+        std::thread::Builder::new()
+            .name("render".into())
+            .spawn(move || work(&worker, &newest, &tx))
+            .expect("spawn the rendering thread");
+        Renderer {
+            shared,
+            latest,
+            replies,
+            done: 0,
+        }
+    }
+
+    /// Render `score` on `kit`, cancelling any render in progress.
+    pub fn request(&mut self, score: &Score, kit: &Kit, ctx: Option<egui::Context>) {
+        let generation = self.latest.fetch_add(1, Ordering::SeqCst) + 1;
+        let (lock, cv) = &*self.shared;
+        let mut slot = lock.lock().expect("renderer lock");
+        slot.request = Some(Request {
+            generation,
+            score: score.clone(),
+            kit: kit.clone(),
+            ctx,
+        });
+        cv.notify_one();
+    }
+
+    /// The newest finished render, if one arrived since the last poll.
+    pub fn poll(&mut self) -> Option<Result<Rendered, String>> {
+        let mut newest = None;
+        while let Ok((generation, result)) = self.replies.try_recv() {
+            if generation >= self.done {
+                self.done = generation;
+                newest = Some(result);
+            }
+        }
+        newest
+    }
+
+    /// Whether a render of the latest request is still to come.
+    pub fn is_busy(&self) -> bool {
+        self.done < self.latest.load(Ordering::SeqCst)
+    }
+}
+
+impl Default for Renderer {
+    fn default() -> Self {
+        Renderer::new()
+    }
+}
+
+impl Drop for Renderer {
+    fn drop(&mut self) {
+        self.latest.fetch_add(1, Ordering::SeqCst);
+        let (lock, cv) = &*self.shared;
+        if let Ok(mut slot) = lock.lock() {
+            slot.quit = true;
+            cv.notify_one();
+        }
+    }
+}
+
+fn work(shared: &(Mutex<Slot>, Condvar), latest: &AtomicU64, tx: &mpsc::Sender<Reply>) {
+    let mut db: Option<Result<MotionDb, String>> = None;
+    loop {
+        let request = {
+            let (lock, cv) = shared;
+            let mut slot = lock.lock().expect("renderer lock");
+            loop {
+                if slot.quit {
+                    return;
+                }
+                if let Some(r) = slot.request.take() {
+                    break r;
+                }
+                slot = cv.wait(slot).expect("renderer lock");
+            }
+        };
+        let db = db.get_or_insert_with(|| {
+            MotionDb::load(&crate::mocap::db::default_dir())
+                .map_err(|e| format!("no motion database: {e}"))
+        });
+        let result = match db {
+            Ok(db) => run(&request, db, latest),
+            Err(e) => Err(e.clone()),
+        };
+        if result.as_ref().is_err_and(|e| e == CANCELLED) {
+            continue;
+        }
+        if tx.send((request.generation, result)).is_err() {
+            return;
+        }
+        if let Some(ctx) = request.ctx {
+            ctx.request_repaint();
+        }
+    }
+}
+
+const CANCELLED: &str = "cancelled";
+
+fn run(request: &Request, db: &MotionDb, latest: &AtomicU64) -> Result<Rendered, String> {
+    let loaded = LoadedScore {
+        score: request.score.clone(),
+        kit: request.kit.clone(),
+        kit_source: String::new(),
+        notices: Vec::new(),
+    };
+    let r = render(&loaded, db, &RenderParams::default(), &mut |_| {
+        latest.load(Ordering::SeqCst) == request.generation
+    })
+    .map_err(|e| match e {
+        crate::render::RenderError::Cancelled => CANCELLED.to_string(),
+        e => e.to_string(),
+    })?;
+    let summary = format!(
+        "rendered: {} strokes, timing median {:.1} ms, worst {:.1} ms{}",
+        r.timing.strokes,
+        r.timing.median_abs_s * 1e3,
+        r.timing.worst_abs_s * 1e3,
+        if r.timing.missed > 0 {
+            format!(", {} missed", r.timing.missed)
+        } else {
+            String::new()
+        }
+    );
+    Ok(Rendered {
+        audio: r.audio.samples,
+        simulated: Simulated {
+            start_s: r.start_s,
+            rate_hz: r.motion.rate_hz,
+            poses: r.motion.poses,
+            tips: r.motion.tips,
+        },
+        summary,
+    })
+}
