@@ -171,15 +171,16 @@ fn randomised_scores_never_explode() {
     assert!(rendered > 900, "only {rendered} of 1000 rendered");
 }
 
-/// `timpanist render` writes a WAV, the motion CSV and the events JSON with the issue's
-/// fields, and prints its statistics.
+/// `timpanist render` writes a WAV, the motion CSV, the events JSON with the issue's
+/// fields and a PNG plot, and prints its statistics.
 #[test]
 fn cli_render_writes_wav_motion_and_events() {
     let dir = tempfile::tempdir().unwrap();
-    let (wav, csv, json) = (
+    let (wav, csv, json, png) = (
         dir.path().join("out.wav"),
         dir.path().join("motion.csv"),
         dir.path().join("events.json"),
+        dir.path().join("plot.png"),
     );
     let out = Command::new(env!("CARGO_BIN_EXE_timpanist"))
         .current_dir(root())
@@ -189,6 +190,8 @@ fn cli_render_writes_wav_motion_and_events() {
         .arg(&csv)
         .arg("--events")
         .arg(&json)
+        .arg("--plot")
+        .arg(&png)
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -226,6 +229,7 @@ fn cli_render_writes_wav_motion_and_events() {
     let motion = std::fs::read_to_string(&csv).unwrap();
     assert!(motion.starts_with("time_s,left_tip_x_m"));
     assert!(motion.lines().count() > 250);
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
 }
 
 /// A malformed score fails with its name and place, a non-zero exit, and no WAV.

@@ -114,6 +114,9 @@ pub enum Command {
         /// Also write one JSON object per stick-head contact.
         #[arg(long)]
         events: Option<PathBuf>,
+        /// Also draw target and simulated tip heights and each contact's peak force (PNG).
+        #[arg(long)]
+        plot: Option<PathBuf>,
         /// The control pipeline driving the body.
         #[arg(long, value_enum, default_value_t = ControlArg::Himc)]
         control: ControlArg,
@@ -275,6 +278,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             wav,
             motion,
             events,
+            plot,
             control,
             sound,
             stats,
@@ -287,6 +291,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 wav: &wav,
                 motion: motion.as_deref(),
                 events: events.as_deref(),
+                plot: plot.as_deref(),
             },
             control.into(),
             sound.into(),

@@ -1,15 +1,18 @@
 //! `timpanist render`: a whole score to a WAV (and optionally the simulated motion as CSV
-//! and one JSON object per contact), through the same pipeline as the editor, with a
+//! and one JSON object per contact, and a PNG of tip heights and contact forces), through the same pipeline as the editor, with a
 //! progress bar on stderr and, with `--stats`, where the time went. Everything is computed
 //! before anything is written; each file is written atomically.
 
+use super::compose::HAND_COLOURS;
 use crate::body::sim::Pipeline;
+use crate::io::plot::{Figure, Panel, Series};
 use crate::io::{motion_csv, ron_file};
 use crate::mocap::db::MotionDb;
 use crate::motion::plan::PlanParams;
 use crate::render::{Progress, RenderParams, Rendering, render};
 use crate::score::LoadedScore;
 use crate::sound::SoundModel;
+use plotters::style::RGBColor;
 use std::io::{IsTerminal, Write};
 use std::path::Path;
 
@@ -18,6 +21,7 @@ pub struct Outputs<'a> {
     pub wav: &'a Path,
     pub motion: Option<&'a Path>,
     pub events: Option<&'a Path>,
+    pub plot: Option<&'a Path>,
 }
 
 /// Render `score` and write `outputs`.
@@ -60,7 +64,13 @@ pub fn run(
     let motion = outputs
         .motion
         .map(|_| motion_csv::to_csv(&rendering.motion, &rendering.reference, rendering.start_s));
+    let figure = outputs
+        .plot
+        .map(|_| figure(&rendering, &loaded.score.title));
     crate::sound::write_wav(outputs.wav, &rendering.audio)?;
+    if let (Some(path), Some(figure)) = (outputs.plot, figure) {
+        figure.save_png(path).map_err(anyhow::Error::msg)?;
+    }
     if let (Some(path), Some(text)) = (outputs.motion, motion) {
         ron_file::write_atomic(path, text.as_bytes())?;
     }
@@ -88,6 +98,57 @@ pub fn run(
         print_stats(&rendering);
     }
     Ok(())
+}
+
+/// Tip heights, target (pale) against simulated, with each contact marked at its peak
+/// force; scheduled strokes as guides.
+fn figure(r: &Rendering, title: &str) -> Figure {
+    let time = |k: usize| r.start_s + k as f64 / r.motion.rate_hz;
+    let pale = |c: RGBColor| RGBColor(c.0 / 2 + 127, c.1 / 2 + 127, c.2 / 2 + 127);
+    let mut series = Vec::new();
+    for (h, hand) in ["left", "right"].into_iter().enumerate() {
+        let colour = HAND_COLOURS[h];
+        series.push(Series {
+            label: format!("{hand} target"),
+            colour: pale(colour),
+            points: r.reference.tips[h]
+                .iter()
+                .enumerate()
+                .map(|(k, p)| (time(k), p.z))
+                .collect(),
+        });
+        series.push(Series {
+            label: format!("{hand} simulated"),
+            colour,
+            points: r.motion.tips[h]
+                .iter()
+                .enumerate()
+                .map(|(k, p)| (time(k), p.z))
+                .collect(),
+        });
+    }
+    let colour_of = |hand: &str| HAND_COLOURS[usize::from(hand == "right")];
+    Figure {
+        title: format!("{title}: rendered performance"),
+        panels: vec![
+            Panel {
+                y_label: "stick tip height z (m)".into(),
+                series,
+                markers: Vec::new(),
+            },
+            Panel {
+                y_label: "peak contact force (N)".into(),
+                series: Vec::new(),
+                markers: r
+                    .events
+                    .iter()
+                    .map(|e| (e.contact_s, e.peak_force_n, colour_of(e.hand)))
+                    .collect(),
+            },
+        ],
+        guides: r.composition.strokes.iter().map(|s| s.time_s).collect(),
+        size: (1400, 800),
+    }
 }
 
 fn print_stats(r: &Rendering) {

@@ -90,7 +90,8 @@ impl Figure {
                 panel
                     .series
                     .iter()
-                    .flat_map(|s| s.points.iter().map(|p| p.1)),
+                    .flat_map(|s| s.points.iter().map(|p| p.1))
+                    .chain(panel.markers.iter().map(|m| m.1)),
             );
             let mut chart = ChartBuilder::on(area)
                 .margin(8)
