@@ -1,21 +1,69 @@
-//! Whole-score rendering speed: the one-minute demo study (60 s of music, 109 strokes)
-//! composed, simulated with HIMC and the modal drums at 10 kHz with timing compensation,
-//! and synthesised to 48 kHz stereo. Each iteration is one full `timpanist render`
-//! (≈ 10–15 s), so this takes a few minutes. `cargo bench --bench render`.
+//! Whole-score rendering speed and the editor's edit-to-ready-audio on the one-minute demo
+//! study (60 s of music, 109 strokes), HIMC with the modal drums at 10 kHz and timing
+//! compensation, synthesised to 48 kHz stereo:
+//!
+//! * a full `timpanist render` (≈ 6 s per iteration, so this takes a few minutes);
+//! * after a one-beat edit near 30 s (its dynamic changed), the rendering that resumes
+//!   the previous performance from its saved state before the edit and stops 1 s past it
+//!   (what the editor plays at once: its audio is final up to there), and the resumed
+//!   rendering of the whole rest.
+//!
+//! `cargo bench --bench render`.
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use std::path::Path;
 use timpanist::mocap::db::MotionDb;
-use timpanist::render::{RenderParams, render};
-use timpanist::score::LoadedScore;
+use timpanist::render::{Previous, RenderParams, render, render_after};
+use timpanist::score::{Dynamic, LoadedScore};
 
 fn bench(c: &mut Criterion) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let db = MotionDb::load(&root.join("mocap")).expect("the shipped database");
     let loaded = LoadedScore::load(&root.join("scores/minute-study.ron")).expect("demo score");
+    let params = RenderParams::default();
     c.bench_function("render the one-minute study (HIMC, modal)", |b| {
-        b.iter(|| render(&loaded, &db, &RenderParams::default(), &mut |_| true).expect("renders"))
+        b.iter(|| render(&loaded, &db, &params, &mut |_| true).expect("renders"))
     });
+    let before = render(&loaded, &db, &params, &mut |_| true).expect("renders");
+    let mut edited = loaded.clone();
+    let beat = before
+        .composition
+        .strokes
+        .iter()
+        .find(|s| s.time_s >= 30.0)
+        .expect("a stroke after 30 s")
+        .beat;
+    let b = &mut edited.score.beats[beat];
+    b.dynamic = if b.dynamic == Dynamic::Ff {
+        Dynamic::Mp
+    } else {
+        Dynamic::Ff
+    };
+    for (name, stop_after_s) in [
+        (
+            "one-beat edit at 30 s: audio ready 1 s past the resume point",
+            Some(1.0),
+        ),
+        ("one-beat edit at 30 s: the whole rest re-rendered", None),
+    ] {
+        c.bench_function(name, |b| {
+            b.iter_batched(
+                || before.sound.clone(),
+                |mut sound| {
+                    let previous = Previous {
+                        rendering: &before,
+                        sound: &mut sound,
+                        stop_after_s,
+                    };
+                    let r = render_after(Some(previous), &edited, &db, &params, &mut |_| true)
+                        .expect("renders");
+                    assert!(r.stats.resumed_from_s.is_some(), "the edit resumes");
+                    r
+                },
+                BatchSize::LargeInput,
+            )
+        });
+    }
 }
 
 criterion_group! {

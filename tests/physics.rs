@@ -128,20 +128,23 @@ fn randomised_runs_stay_finite_and_deterministic() {
     }
 }
 
-/// Without a joint trajectory ID cannot run and says so instead of guessing.
+/// Without a captured joint trajectory (a composed score), ID tracks the task-rate IK
+/// solution of the tips: the same motion as giving it those joint targets explicitly.
 #[test]
-fn id_needs_joints() {
+fn id_without_joints_tracks_the_ik_solution() {
     let db = db();
     let mut reference = evaluate::reference_of(&db, &db.index.units[0]);
     reference.poses = None;
-    let err = simulate(
-        &BodyModel::default(),
-        &reference,
-        Pipeline::Id,
-        &SimParams::default(),
-        &timpanist::body::skeleton::REST,
-        &[1.0; JOINT_COUNT],
-    )
-    .unwrap_err();
-    assert!(err.to_string().contains("joint"), "{err}");
+    let (model, params) = (BodyModel::default(), SimParams::default());
+    let rest = timpanist::body::skeleton::REST;
+    let run = |r: &timpanist::body::sim::Reference| {
+        simulate(&model, r, Pipeline::Id, &params, &rest, &[1.0; JOINT_COUNT]).unwrap()
+    };
+    let implicit = run(&reference);
+    let mut explicit = reference.clone();
+    explicit.poses = Some(timpanist::body::sim::ik_targets(
+        &model, &reference, &params, &rest,
+    ));
+    assert_eq!(implicit, run(&explicit));
+    assert!(implicit.tips.iter().flatten().all(|p| p.is_finite()));
 }

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use timpanist::kit::Kit;
 use timpanist::mocap::db::MotionDb;
-use timpanist::render::{RenderError, RenderParams, Rendering, render};
+use timpanist::render::{Previous, RenderError, RenderParams, Rendering, render, render_after};
 use timpanist::rng::Rng;
 use timpanist::score::{Beat, Dynamic, Hand, ImpactLocation, LoadedScore, PlayingMode, Score};
 
@@ -88,6 +88,100 @@ fn render_is_deterministic() {
 }
 
 /// A uniform integer in 0..n.
+/// After a one-beat edit late in a score, resuming the previous rendering's performance
+/// from a saved state before the edit gives bit for bit what rendering the edited score
+/// from scratch gives (audio, motion, targets, events), simulating less; an edit at the
+/// first beat resumes (if at all) no later than it.
+#[test]
+fn resumed_render_after_an_edit_equals_a_whole_render() {
+    let db = db();
+    let loaded = LoadedScore::load(&root().join("scores/tempo-change.ron")).unwrap();
+    let params = RenderParams::default();
+    let before = render(&loaded, &db, &params, &mut |_| true).unwrap();
+    let late = loaded.score.beats.len() * 3 / 4;
+    for (beat, resumes) in [(late, true), (0, false)] {
+        let mut edited = loaded.clone();
+        let b = &mut edited.score.beats[beat];
+        b.dynamic = if b.dynamic == Dynamic::Ff {
+            Dynamic::P
+        } else {
+            Dynamic::Ff
+        };
+        let whole = render(&edited, &db, &params, &mut |_| true).unwrap();
+        let previous = Previous {
+            rendering: &before,
+            sound: &mut before.sound.clone(),
+            stop_after_s: None,
+        };
+        let resumed = render_after(Some(previous), &edited, &db, &params, &mut |_| true).unwrap();
+        assert!(resumed.complete);
+        let edit_s = whole
+            .composition
+            .strokes
+            .iter()
+            .find(|s| s.beat == beat)
+            .unwrap()
+            .time_s;
+        if let Some(from) = resumed.stats.resumed_from_s {
+            assert!(from < edit_s, "resumed at {from} s, edit at {edit_s} s");
+        }
+        if resumes {
+            let from = resumed.stats.resumed_from_s.expect("a late edit resumes");
+            assert!(from > 0.5, "resumed at {from} s, edit at {edit_s} s");
+            assert!(resumed.stats.simulated_s < 0.8 * whole.stats.simulated_s);
+        }
+        assert_eq!(resumed.audio.samples, whole.audio.samples, "beat {beat}");
+        assert_eq!(resumed.motion, whole.motion, "beat {beat}");
+        assert_eq!(resumed.reference.tips, whole.reference.tips, "beat {beat}");
+        assert_eq!(resumed.events, whole.events, "beat {beat}");
+        assert_ne!(
+            whole.audio.samples, before.audio.samples,
+            "the edit is heard"
+        );
+    }
+}
+
+/// A partial rendering that stops shortly after the resume point has final audio up to
+/// its `ready_s`, the same as the whole rendering's; resuming from it completes the
+/// score bit for bit as a whole rendering does.
+#[test]
+fn partial_render_then_rest_equals_a_whole_render() {
+    let db = db();
+    let loaded = LoadedScore::load(&root().join("scores/tempo-change.ron")).unwrap();
+    let params = RenderParams::default();
+    let before = render(&loaded, &db, &params, &mut |_| true).unwrap();
+    let mut edited = loaded.clone();
+    let beat = edited.score.beats.len() / 2;
+    edited.score.beats[beat].mode = PlayingMode::Staccato;
+    let whole = render(&edited, &db, &params, &mut |_| true).unwrap();
+    let previous = Previous {
+        rendering: &before,
+        sound: &mut before.sound.clone(),
+        stop_after_s: Some(0.3),
+    };
+    let mut partial = render_after(Some(previous), &edited, &db, &params, &mut |_| true).unwrap();
+    let from = partial.stats.resumed_from_s.expect("resumes");
+    assert!(!partial.complete);
+    assert!(
+        partial.ready_s > from + 0.2 && partial.ready_s < whole.ready_s - 0.5,
+        "resumed at {from} s, ready to {} s",
+        partial.ready_s
+    );
+    let ready = 2 * (partial.ready_s * 48_000.0) as usize;
+    assert_eq!(partial.audio.samples[..ready], whole.audio.samples[..ready]);
+    let mut sound = std::mem::take(&mut partial.sound);
+    let rest = Previous {
+        rendering: &partial,
+        sound: &mut sound,
+        stop_after_s: None,
+    };
+    let rest = render_after(Some(rest), &edited, &db, &params, &mut |_| true).unwrap();
+    assert!(rest.complete && rest.stats.resumed_from_s.is_some());
+    assert_eq!(rest.audio.samples, whole.audio.samples);
+    assert_eq!(rest.motion, whole.motion);
+    assert_eq!(rest.events, whole.events);
+}
+
 fn below(rng: &mut Rng, n: u64) -> u64 {
     rng.next_u64() % n
 }
@@ -125,7 +219,7 @@ fn randomised_scores_never_explode() {
     let kit = Kit::standard();
     let root_rng = Rng::new(2026);
     let params = RenderParams {
-        max_passes: 1,
+        max_attempts: 1,
         tail_s: 0.1,
         compose: timpanist::motion::compose::ComposeParams {
             margin_s: 0.15,

@@ -68,7 +68,7 @@ impl Composer {
         slot.request = Some(Request {
             generation: self.generation,
             score: score.clone(),
-            kit: kit.clone(),
+            kit: score.settings.kit(kit),
             ctx,
         });
         cv.notify_one();

@@ -1,7 +1,8 @@
 //! The inspector: properties of the selected beats (several at once: a field shows a
 //! value when all agree, "(mixed)" otherwise, and setting it sets it on all), of the
-//! selected trajectory handle, the score (tempo points), the kit and its drums. Every
-//! change is pushed as an edit command.
+//! selected trajectory handle, the score (tempo points), the kit, and the physics, sound
+//! and drum settings ([`super::settings_panel`]). Every change is pushed as an edit
+//! command.
 
 use super::command::Command;
 use super::selection::{self, Selection};
@@ -187,10 +188,7 @@ pub fn show(ui: &mut egui::Ui, doc: &LoadedScore, sel: &Selection, out: &mut Vec
     score_section(ui, doc, out);
     ui.separator();
     kit_section(ui, doc);
-    ui.separator();
-    ui.collapsing("Physics and sound", |ui| {
-        ui.label("Control pipeline, IK method, gains and the sound model are set by the render pipeline, which is not connected to the editor yet.");
-    });
+    super::settings_panel::show(ui, doc, out);
 }
 
 fn score_section(ui: &mut egui::Ui, doc: &LoadedScore, out: &mut Vec<Command>) {
@@ -259,24 +257,6 @@ fn kit_section(ui: &mut egui::Ui, doc: &LoadedScore) {
     };
     ui.label(format!("from {short}"))
         .on_hover_text(&doc.kit_source);
-    ui.collapsing("Drums and membranes", |ui| {
-        egui::Grid::new("drums").striped(true).show(ui, |ui| {
-            for h in ["#", "drum", "tuning", "diameter", "tension", "modes"] {
-                ui.strong(h);
-            }
-            ui.end_row();
-            for (i, d) in doc.kit.drums.iter().enumerate() {
-                ui.label(i.to_string());
-                ui.label(&d.name);
-                ui.label(d.tuning.to_string());
-                ui.label(format!("{:.3} m", d.diameter_m));
-                ui.label(format!("{:.0} N/m", d.membrane.tension_n_per_m));
-                ui.label(d.modes.len().to_string());
-                ui.end_row();
-            }
-        });
-        ui.label("Kit parameters are read from the kit file; editing them here comes with the render pipeline.");
-    });
 }
 
 #[cfg(test)]

@@ -19,6 +19,7 @@ mod pose;
 mod recent;
 mod renderer;
 mod selection;
+mod settings_panel;
 mod tempo_lane;
 mod time_axis;
 mod timeline;
@@ -910,6 +911,7 @@ impl EditorApp {
                 generation: self.generation,
                 pose: pose.as_ref(),
                 simulated: self.simulated.as_ref().map(|s| &s.tips),
+                drums: self.simulated.as_ref().and_then(|s| s.drums.as_deref()),
                 selection: &self.selection,
                 time_s: self.playhead_s,
             },

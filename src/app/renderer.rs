@@ -1,13 +1,16 @@
 //! The render pipeline off the UI thread: after each composition request the latest score
 //! is rendered (body + drums + sound, `crate::render`) on one long-lived worker; a newer
-//! request cancels the render in progress. The UI polls once per frame and hands the audio
+//! request cancels the render in progress. Each rendering resumes the previous one's
+//! performance from its latest saved state before the edit (`render::render_after`), so
+//! an edit late in a score re-simulates only from there. The UI polls once per frame and hands the audio
 //! to playback and the simulated poses to the 3D view.
 
 use super::pose::Simulated;
 use crate::kit::Kit;
 use crate::mocap::db::MotionDb;
-use crate::render::{RenderParams, render};
+use crate::render::{Previous, RenderParams, Rendering, render_after};
 use crate::score::{LoadedScore, Score};
+use crate::sound::SoundState;
 use eframe::egui;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex, mpsc};
@@ -19,6 +22,9 @@ pub struct Rendered {
     pub simulated: Simulated,
     /// One line for the status bar.
     pub summary: String,
+    /// Whether the whole score is rendered (else the audio is final up to a time the
+    /// summary names, and the rest follows).
+    pub complete: bool,
 }
 
 struct Request {
@@ -43,6 +49,8 @@ pub struct Renderer {
     latest: Arc<AtomicU64>,
     replies: mpsc::Receiver<Reply>,
     done: u64,
+    /// Whether the newest reply was a whole rendering.
+    complete: bool,
 }
 
 impl Renderer {
@@ -61,6 +69,7 @@ impl Renderer {
             latest,
             replies,
             done: 0,
+            complete: true,
         }
     }
 
@@ -84,15 +93,16 @@ impl Renderer {
         while let Ok((generation, result)) = self.replies.try_recv() {
             if generation >= self.done {
                 self.done = generation;
+                self.complete = result.as_ref().map_or(true, |r| r.complete);
                 newest = Some(result);
             }
         }
         newest
     }
 
-    /// Whether a render of the latest request is still to come.
+    /// Whether a render of the latest request is still to come (or its rest).
     pub fn is_busy(&self) -> bool {
-        self.done < self.latest.load(Ordering::SeqCst)
+        self.done < self.latest.load(Ordering::SeqCst) || !self.complete
     }
 }
 
@@ -115,6 +125,9 @@ impl Drop for Renderer {
 
 fn work(shared: &(Mutex<Slot>, Condvar), latest: &AtomicU64, tx: &mpsc::Sender<Reply>) {
     let mut db: Option<Result<MotionDb, String>> = None;
+    // The latest finished rendering and its sound state: the next one resumes from them
+    // where it can.
+    let mut previous: Option<(Arc<Rendering>, SoundState)> = None;
     loop {
         let request = {
             let (lock, cv) = shared;
@@ -133,57 +146,101 @@ fn work(shared: &(Mutex<Slot>, Condvar), latest: &AtomicU64, tx: &mpsc::Sender<R
             MotionDb::load(&crate::mocap::db::default_dir())
                 .map_err(|e| format!("no motion database: {e}"))
         });
-        let result = match db {
-            Ok(db) => run(&request, db, latest),
-            Err(e) => Err(e.clone()),
-        };
-        if result.as_ref().is_err_and(|e| e == CANCELLED) {
+        let Ok(db) = db else {
+            let e = db.as_ref().err().cloned().unwrap_or_default();
+            if tx.send((request.generation, Err(e))).is_err() {
+                return;
+            }
             continue;
-        }
-        if tx.send((request.generation, result)).is_err() {
-            return;
-        }
-        if let Some(ctx) = request.ctx {
-            ctx.request_repaint();
+        };
+        // First the edited part (quick, to play at once), then the rest.
+        let mut complete = false;
+        let mut quick = true;
+        while !complete {
+            let from = previous.as_mut().map(|(r, sound)| Previous {
+                rendering: r,
+                sound,
+                stop_after_s: quick.then_some(QUICK_AHEAD_S),
+            });
+            quick = false;
+            let result = run(&request, db, latest, from).map(|(rendered, r, sound)| {
+                previous = Some((r, sound));
+                rendered
+            });
+            if result.as_ref().is_err_and(|e| e == CANCELLED) {
+                break;
+            }
+            complete = result.as_ref().map_or(true, |r| r.complete);
+            if tx.send((request.generation, result)).is_err() {
+                return;
+            }
+            if let Some(ctx) = &request.ctx {
+                ctx.request_repaint();
+            }
         }
     }
 }
 
+/// After an edit, the first rendering stops this long past where it resumed, s; the rest
+/// follows in one more.
+const QUICK_AHEAD_S: f64 = 1.0;
+
 const CANCELLED: &str = "cancelled";
 
-fn run(request: &Request, db: &MotionDb, latest: &AtomicU64) -> Result<Rendered, String> {
+fn run(
+    request: &Request,
+    db: &MotionDb,
+    latest: &AtomicU64,
+    previous: Option<Previous>,
+) -> Result<(Rendered, Arc<Rendering>, SoundState), String> {
     let loaded = LoadedScore {
         score: request.score.clone(),
         kit: request.kit.clone(),
         kit_source: String::new(),
         notices: Vec::new(),
     };
-    let r = render(&loaded, db, &RenderParams::default(), &mut |_| {
+    let params = RenderParams::for_score(&loaded.score.settings);
+    let mut r = render_after(previous, &loaded, db, &params, &mut |_| {
         latest.load(Ordering::SeqCst) == request.generation
     })
     .map_err(|e| match e {
         crate::render::RenderError::Cancelled => CANCELLED.to_string(),
         e => e.to_string(),
     })?;
-    let summary = format!(
-        "rendered: {} strokes, timing median {:.1} ms, worst {:.1} ms{}",
-        r.timing.strokes,
-        r.timing.median_abs_s * 1e3,
-        r.timing.worst_abs_s * 1e3,
-        if r.timing.missed > 0 {
-            format!(", {} missed", r.timing.missed)
-        } else {
-            String::new()
-        }
-    );
-    Ok(Rendered {
-        audio: r.audio.samples,
+    let summary = if !r.complete {
+        format!("rendered up to {:.1} s; rendering the rest", r.ready_s)
+    } else {
+        format!(
+            "rendered: {} strokes, timing median {:.1} ms, worst {:.1} ms{}; {}",
+            r.timing.strokes,
+            r.timing.median_abs_s * 1e3,
+            r.timing.worst_abs_s * 1e3,
+            if r.timing.missed > 0 {
+                format!(", {} missed", r.timing.missed)
+            } else {
+                String::new()
+            },
+            match r.stats.resumed_from_s {
+                Some(t) => format!(
+                    "re-simulated from {t:.1} s in {:.2} s",
+                    r.stats.wall().as_secs_f64()
+                ),
+                None => format!("in {:.2} s", r.stats.wall().as_secs_f64()),
+            }
+        )
+    };
+    let rendered = Rendered {
+        audio: r.audio.samples.clone(),
         simulated: Simulated {
             start_s: r.start_s,
             rate_hz: r.motion.rate_hz,
-            poses: r.motion.poses,
-            tips: r.motion.tips,
+            poses: r.motion.poses.clone(),
+            tips: r.motion.tips.clone(),
+            drums: Some(Arc::new(r.drums.clone())),
         },
         summary,
-    })
+        complete: r.complete,
+    };
+    let sound = std::mem::take(&mut r.sound);
+    Ok((rendered, Arc::new(r), sound))
 }

@@ -1,6 +1,6 @@
-//! The 3D viewport: orbit/pan/zoom camera, the floor, the drums with their heads (through
-//! [`head_displacement`], so membrane vibration can be drawn once the drum model provides
-//! it), the body as capsules with sticks, the composed target tip trajectories (one
+//! The 3D viewport: orbit/pan/zoom camera, the floor, the drums with their heads (rings
+//! and spokes lifted by the rendered membrane motion at the playhead, magnified
+//! [`MEMBRANE_MAGNIFICATION`] times), the body as capsules with sticks, the composed target tip trajectories (one
 //! colour per hand) with impacts, pins and handles marked, and room for simulated
 //! trajectories in other colours. Handles: drag on a trajectory to add one and move it,
 //! drag a handle to move it (in the view plane, or along x/y/z while X/Y/Z is held),
@@ -12,6 +12,7 @@ use super::picking::{drag_along_axis, drag_in_plane, pick_polyline};
 use super::selection::Selection;
 use crate::body::model::BodyModel;
 use crate::body::skeleton::{JOINT_COUNT, Joint, Pose};
+use crate::drum::DrumSet;
 use crate::kit::{Drum, Side};
 use crate::mocap::db::side_index;
 use crate::motion::compose::Composition;
@@ -31,10 +32,14 @@ pub const SIMULATED_COLOURS: [Color32; 2] = [
     Color32::from_rgb(250, 220, 90),
 ];
 
-/// Vertical displacement of `drum`'s head at `point` (performer frame), m. Zero until
-/// the drum model's membrane state is connected.
-pub fn head_displacement(_drum: &Drum, _point: DVec3) -> f64 {
-    0.0
+/// How much the membranes' motion is magnified in the view (a loud strike moves the
+/// head a millimetre or two).
+pub const MEMBRANE_MAGNIFICATION: f64 = 25.0;
+
+/// Vertical displacement of drum `index`'s head at `point` (performer frame) at score
+/// time `time_s`, m, as recorded by the rendering in `drums`; zero without one.
+pub fn head_displacement(drums: Option<&DrumSet>, index: usize, time_s: f64, point: DVec3) -> f64 {
+    drums.map_or(0.0, |d| d.recorded_displacement(index, time_s, point))
 }
 
 /// What the viewport draws.
@@ -47,6 +52,8 @@ pub struct ViewportInput<'a> {
     pub pose: Option<&'a Pose>,
     /// Simulated tip trajectories on the composition's time grid, [left, right].
     pub simulated: Option<&'a [Vec<DVec3>; 2]>,
+    /// The rendered drums, whose recorded membrane motion the heads show.
+    pub drums: Option<&'a DrumSet>,
     pub selection: &'a Selection,
     /// The playhead, s.
     pub time_s: f64,
@@ -150,8 +157,10 @@ impl Viewport {
         painter.rect_filled(rect, 4.0, Color32::from_rgb(28, 30, 36));
         draw_floor(&painter, rect, &proj);
         // Drums first: the body and sticks are above the heads, which are translucent.
-        for drum in &input.doc.kit.drums {
-            draw_drum(&painter, rect, &proj, drum);
+        let kit = input.doc.score.settings.kit(&input.doc.kit);
+        for (index, drum) in kit.drums.iter().enumerate() {
+            let membrane = |p: DVec3| head_displacement(input.drums, index, input.time_s, p);
+            draw_drum(&painter, rect, &proj, drum, &membrane);
         }
         if let Some(pose) = input.pose {
             self.draw_body(&painter, rect, &proj, pose);
@@ -615,7 +624,15 @@ fn draw_floor(painter: &egui::Painter, rect: Rect, proj: &Projector) {
     }
 }
 
-fn draw_drum(painter: &egui::Painter, rect: Rect, proj: &Projector, drum: &Drum) {
+/// A drum: kettle, head (translucent) and, on the head, rings and spokes lifted by
+/// `membrane` (the head's displacement at a point, m, magnified).
+fn draw_drum(
+    painter: &egui::Painter,
+    rect: Rect,
+    proj: &Projector,
+    drum: &Drum,
+    membrane: &dyn Fn(DVec3) -> f64,
+) {
     const N: usize = 48;
     let centre = DVec3::new(
         drum.placement.x_m,
@@ -623,15 +640,16 @@ fn draw_drum(painter: &egui::Painter, rect: Rect, proj: &Projector, drum: &Drum)
         drum.placement.head_height_m,
     );
     let r = 0.5 * drum.diameter_m;
+    let on_head = |a: f64, scale: f64| {
+        let mut p = centre + DVec3::new(a.cos(), a.sin(), 0.0) * r * scale;
+        p.z += (MEMBRANE_MAGNIFICATION * membrane(p)).clamp(-0.1, 0.1);
+        proj.project(p).map(|(q, _)| to_pos(rect, q))
+    };
     let ring = |z_drop: f64, scale: f64| -> Option<Vec<Pos2>> {
         (0..N)
             .map(|k| {
                 let a = std::f64::consts::TAU * k as f64 / N as f64;
-                let mut p = centre + DVec3::new(a.cos(), a.sin(), 0.0) * r * scale;
-                p.z -= z_drop;
-                if z_drop == 0.0 {
-                    p.z += head_displacement(drum, p);
-                }
+                let p = centre + DVec3::new(a.cos(), a.sin(), 0.0) * r * scale - DVec3::Z * z_drop;
                 proj.project(p).map(|(q, _)| to_pos(rect, q))
             })
             .collect()
@@ -654,6 +672,23 @@ fn draw_drum(painter: &egui::Painter, rect: Rect, proj: &Projector, drum: &Drum)
             Color32::from_rgba_unmultiplied(225, 215, 190, 170),
             Stroke::new(1.5, kettle),
         ));
+    }
+    // The membrane: three rings and eight spokes over the head (the rim is fixed).
+    let grid = Stroke::new(1.0, Color32::from_rgba_unmultiplied(120, 100, 70, 150));
+    for scale in [0.25, 0.5, 0.75] {
+        let points: Option<Vec<Pos2>> = (0..N)
+            .map(|k| on_head(std::f64::consts::TAU * k as f64 / N as f64, scale))
+            .collect();
+        if let Some(points) = points {
+            painter.add(Shape::closed_line(points, grid));
+        }
+    }
+    for k in 0..8 {
+        let a = std::f64::consts::TAU * f64::from(k) / 8.0;
+        let points: Option<Vec<Pos2>> = (0..=8).map(|i| on_head(a, f64::from(i) / 8.0)).collect();
+        if let Some(points) = points {
+            painter.add(Shape::line(points, grid));
+        }
     }
     if let Some((q, _)) = proj.project(centre) {
         painter.text(

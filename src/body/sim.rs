@@ -3,7 +3,8 @@
 //!
 //! * **IK** — kinematic only: each task step, inverse kinematics brings both tips to
 //!   their targets; no dynamics.
-//! * **ID** — PD inverse dynamics tracking the captured joint rotations (seed 000 eq. 2):
+//! * **ID** — PD inverse dynamics tracking the captured joint rotations (seed 000 eq. 2;
+//!   for a composed reference without them, the task-rate IK solution of its tips):
 //!   PD on the joint error plus the feed-forward torques of the target motion (gravity,
 //!   velocity terms and M·q̈, once per task step).
 //! * **HIMC** — hybrid inverse motion control (seed 000 Alg. 2): each task step IK turns
@@ -195,23 +196,36 @@ pub fn ik_targets(
     let mut pose = *initial;
     (0..reference.tips[0].len())
         .map(|k| {
-            let pull = reference.poses.as_ref().map(|p| &p[k]);
-            let start = pose;
-            pose = *pull.unwrap_or(&start);
-            for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
-                pose = ik::solve(
-                    &model.skeleton,
-                    &pose,
-                    side,
-                    reference.tips[h][k],
-                    pull.or(Some(&start)),
-                    &params.ik,
-                )
-                .pose;
-            }
+            pose = ik_target(model, reference, params, k, &pose);
             pose
         })
         .collect()
+}
+
+/// The IK joint target of reference sample `k`, from the previous one (`previous`; the
+/// initial pose for sample 0).
+fn ik_target(
+    model: &BodyModel,
+    reference: &Reference,
+    params: &SimParams,
+    k: usize,
+    previous: &Pose,
+) -> Pose {
+    let pull = reference.poses.as_ref().map(|p| &p[k]);
+    let start = *previous;
+    let mut pose = *pull.unwrap_or(&start);
+    for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
+        pose = ik::solve(
+            &model.skeleton,
+            &pose,
+            side,
+            reference.tips[h][k],
+            pull.or(Some(&start)),
+            &params.ik,
+        )
+        .pose;
+    }
+    pose
 }
 
 /// [`simulate`] with the body meeting `environment` (e.g. the drums) every simulation step.
@@ -224,110 +238,250 @@ pub fn simulate_in(
     initial: &Pose,
     gains_scale: &[f64; JOINT_COUNT],
 ) -> Result<Motion, SimError> {
-    let n = reference.tips[0].len();
-    let skeleton = &model.skeleton;
-    let substeps = (params.sim_hz / reference.rate_hz).round().max(1.0) as usize;
-    let dt = 1.0 / (reference.rate_hz * substeps as f64);
-    let mut motion = Motion {
-        rate_hz: reference.rate_hz,
-        tips: [Vec::with_capacity(n), Vec::with_capacity(n)],
-        poses: Vec::with_capacity(n),
-    };
-    let record = |motion: &mut Motion, pose: &Pose| {
-        let frames = skeleton.forward(pose);
-        motion.tips[0].push(frames.tip(Side::Left));
-        motion.tips[1].push(frames.tip(Side::Right));
-        motion.poses.push(*pose);
-    };
-    // Joint targets at the task rate.
-    let targets: Vec<Pose> = match pipeline {
-        Pipeline::Id => reference.poses.clone().ok_or_else(|| Diverged {
-            time_s: 0.0,
-            beat: None,
-            what: "cannot run ID without captured joint rotations".into(),
-        })?,
-        _ => ik_targets(model, reference, params, initial),
-    };
-    if pipeline == Pipeline::Ik {
-        for (k, pose) in targets.iter().enumerate() {
-            record(&mut motion, pose);
-            if k == 0 {
-                continue;
+    let mut sim = Simulator::new(model, reference, pipeline, params, initial, gains_scale)?;
+    sim.advance(environment, reference, reference.tips[0].len())?;
+    Ok(sim.into_motion())
+}
+
+/// Where a [`Simulator`] was: enough to rewind it there (its history is truncated).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Checkpoint {
+    samples: usize,
+    state: State,
+}
+
+impl Checkpoint {
+    /// Task-rate samples recorded at the checkpoint.
+    pub fn samples(&self) -> usize {
+        self.samples
+    }
+}
+
+/// A simulation advanced piecewise along a reference, which may change ahead of what has
+/// been simulated: rewinding to a [`Checkpoint`] and advancing again gives bit for bit
+/// what one run along the changed reference gives, provided the reference is unchanged
+/// up to sample `checkpoint.samples()` (the feed-forward looks one task sample ahead).
+#[derive(Clone, Debug)]
+pub struct Simulator {
+    model: BodyModel,
+    params: SimParams,
+    pipeline: Pipeline,
+    /// The nested IK of HIMC: pulled fully toward the task-rate posture.
+    nested: IkParams,
+    dynamics: Dynamics,
+    gains: Gains,
+    substeps: usize,
+    dt: f64,
+    initial: Pose,
+    state: State,
+    /// Task-rate joint targets computed so far.
+    targets: Vec<Pose>,
+    motion: Motion,
+}
+
+impl Simulator {
+    /// A body at rest in `initial`, to follow references at `reference`'s rate with
+    /// `pipeline`, PD gains scaled per joint by `gains_scale` (1 = nominal).
+    pub fn new(
+        model: &BodyModel,
+        reference: &Reference,
+        pipeline: Pipeline,
+        params: &SimParams,
+        initial: &Pose,
+        gains_scale: &[f64; JOINT_COUNT],
+    ) -> Result<Simulator, SimError> {
+        let substeps = (params.sim_hz / reference.rate_hz).round().max(1.0) as usize;
+        let mut dynamics = Dynamics::new(model.clone());
+        let state = State {
+            q: *initial,
+            w: [DVec3::ZERO; JOINT_COUNT],
+        };
+        let gains = Gains::from_effective_inertia(
+            &mut dynamics,
+            &state,
+            &params.frequency_hz,
+            params.zeta,
+            params.max_torque,
+        )
+        .scaled(gains_scale);
+        Ok(Simulator {
+            model: model.clone(),
+            params: params.clone(),
+            pipeline,
+            nested: IkParams {
+                reference_gain: 1.0,
+                ..params.ik.clone()
+            },
+            dynamics,
+            gains,
+            substeps,
+            dt: 1.0 / (reference.rate_hz * substeps as f64),
+            initial: *initial,
+            state,
+            targets: Vec::new(),
+            motion: Motion {
+                rate_hz: reference.rate_hz,
+                tips: [Vec::new(), Vec::new()],
+                poses: Vec::new(),
+            },
+        })
+    }
+
+    /// Task-rate samples recorded so far.
+    pub fn samples(&self) -> usize {
+        self.motion.poses.len()
+    }
+
+    /// What the body did so far.
+    pub fn motion(&self) -> &Motion {
+        &self.motion
+    }
+
+    /// The recorded motion.
+    pub fn into_motion(self) -> Motion {
+        self.motion
+    }
+
+    /// Where the simulation is now.
+    pub fn checkpoint(&self) -> Checkpoint {
+        Checkpoint {
+            samples: self.samples(),
+            state: self.state.clone(),
+        }
+    }
+
+    /// Go back to `checkpoint` (taken from this simulator, not after a rewind before it).
+    pub fn rewind(&mut self, checkpoint: &Checkpoint) {
+        let m = checkpoint.samples;
+        self.state = checkpoint.state.clone();
+        self.targets.truncate(m + 1);
+        for tips in &mut self.motion.tips {
+            tips.truncate(m);
+        }
+        self.motion.poses.truncate(m);
+    }
+
+    /// The joint target of sample `k` (computed on first use; `k` ≤ one past the last
+    /// computed).
+    fn target(&mut self, reference: &Reference, k: usize) -> Pose {
+        while self.targets.len() <= k {
+            let next = self.targets.len();
+            let pose = match (self.pipeline, &reference.poses) {
+                (Pipeline::Id, Some(poses)) => poses[next],
+                _ => {
+                    let previous = self.targets.last().unwrap_or(&self.initial);
+                    ik_target(&self.model, reference, &self.params, next, previous)
+                }
+            };
+            self.targets.push(pose);
+        }
+        self.targets[k]
+    }
+
+    fn record(&mut self, pose: &Pose) {
+        let frames = self.model.skeleton.forward(pose);
+        self.motion.tips[0].push(frames.tip(Side::Left));
+        self.motion.tips[1].push(frames.tip(Side::Right));
+        self.motion.poses.push(*pose);
+    }
+
+    /// Target joint velocity over the task interval ending at sample `k` (clamped to the
+    /// reference), rad/s.
+    fn target_velocity(&mut self, reference: &Reference, k: usize) -> [DVec3; JOINT_COUNT] {
+        let n = reference.tips[0].len();
+        let k = k.clamp(1, n.max(2) - 1);
+        let (a, b) = (self.target(reference, k - 1), self.target(reference, k));
+        std::array::from_fn(|j| rotation_error(a[j], b[j]) * reference.rate_hz)
+    }
+
+    /// Simulate until `until` task-rate samples are recorded (at most the reference's
+    /// length), meeting `environment` every simulation step.
+    pub fn advance(
+        &mut self,
+        environment: &mut dyn Environment,
+        reference: &Reference,
+        until: usize,
+    ) -> Result<(), SimError> {
+        let n = reference.tips[0].len();
+        let until = until.min(n);
+        if self.samples() == 0 && until > 0 {
+            let first = self.target(reference, 0);
+            if self.pipeline == Pipeline::Ik {
+                self.record(&first);
+            } else {
+                self.state.w = self.target_velocity(reference, 1);
+                let q = self.state.q;
+                self.record(&q);
             }
+        }
+        for k in self.samples()..until {
             if !environment.progress(k, n) {
                 return Err(SimError::Cancelled);
             }
-            // The drums still hear the kinematic sticks, at the simulation rate.
-            let (a, b) = (k - 1, k);
-            let velocity: [DVec3; 2] = std::array::from_fn(|h| {
-                (motion.tips[h][b] - motion.tips[h][a]) * reference.rate_hz
-            });
-            for s in 0..substeps {
-                let u = s as f64 / substeps as f64;
-                let tips = std::array::from_fn(|h| {
-                    (motion.tips[h][a].lerp(motion.tips[h][b], u), velocity[h])
-                });
-                environment.tip_forces(a as f64 / reference.rate_hz + s as f64 * dt, tips);
+            if self.pipeline == Pipeline::Ik {
+                self.kinematic_step(environment, reference, k);
+            } else {
+                self.dynamic_step(environment, reference, k)?;
             }
         }
-        return Ok(motion);
+        Ok(())
     }
-    let mut dynamics = Dynamics::new(model.clone());
-    let mut state = State {
-        q: *initial,
-        w: [DVec3::ZERO; JOINT_COUNT],
-    };
-    let gains = Gains::from_effective_inertia(
-        &mut dynamics,
-        &state,
-        &params.frequency_hz,
-        params.zeta,
-        params.max_torque,
-    )
-    .scaled(gains_scale);
-    let nested = IkParams {
-        reference_gain: 1.0,
-        ..params.ik.clone()
-    };
-    // Target joint velocities (over each task interval) and accelerations.
-    let velocity = |k: usize| -> [DVec3; JOINT_COUNT] {
-        let k = k.clamp(1, n.max(2) - 1);
-        std::array::from_fn(|j| {
-            rotation_error(targets[k - 1][j], targets[k][j]) * reference.rate_hz
-        })
-    };
-    state.w = velocity(1);
-    record(&mut motion, &state.q);
-    for k in 1..n {
-        if !environment.progress(k, n) {
-            return Err(SimError::Cancelled);
+
+    /// IK: the body takes the joint target of sample `k`; the drums still hear the
+    /// kinematic sticks, at the simulation rate.
+    fn kinematic_step(
+        &mut self,
+        environment: &mut dyn Environment,
+        reference: &Reference,
+        k: usize,
+    ) {
+        let pose = self.target(reference, k);
+        self.record(&pose);
+        let (a, b) = (k - 1, k);
+        let tips = &self.motion.tips;
+        let velocity: [DVec3; 2] =
+            std::array::from_fn(|h| (tips[h][b] - tips[h][a]) * reference.rate_hz);
+        for s in 0..self.substeps {
+            let u = s as f64 / self.substeps as f64;
+            let at = std::array::from_fn(|h| (tips[h][a].lerp(tips[h][b], u), velocity[h]));
+            environment.tip_forces(a as f64 / reference.rate_hz + s as f64 * self.dt, at);
         }
-        let (from, to) = (&targets[k - 1], &targets[k]);
-        let target_w = velocity(k);
-        let next_w = velocity(k + 1);
+    }
+
+    /// ID or HIMC: the task interval from sample `k − 1` to `k` at the simulation rate.
+    fn dynamic_step(
+        &mut self,
+        environment: &mut dyn Environment,
+        reference: &Reference,
+        k: usize,
+    ) -> Result<(), SimError> {
+        let (from, to) = (self.target(reference, k - 1), self.target(reference, k));
+        let target_w = self.target_velocity(reference, k);
+        let next_w = self.target_velocity(reference, k + 1);
         let qdd: [DVec3; JOINT_COUNT] =
             std::array::from_fn(|j| (next_w[j] - target_w[j]) * reference.rate_hz);
         // Feed-forward inverse dynamics of the target motion, once per task step.
-        let bias = dynamics.inverse_dynamics(
+        let bias = self.dynamics.inverse_dynamics(
             &State {
-                q: *from,
+                q: from,
                 w: target_w,
             },
             &qdd,
         );
+        let (substeps, dt) = (self.substeps, self.dt);
         for s in 1..=substeps {
             let u = s as f64 / substeps as f64;
             let time_s = (k - 1) as f64 / reference.rate_hz + (s - 1) as f64 * dt;
             // Normalised lerp: within one 4 ms task interval it matches slerp to ~1e-7 rad.
             let mut goal: Pose = std::array::from_fn(|j| from[j].lerp(to[j], u));
-            if pipeline == Pipeline::Himc {
+            if self.pipeline == Pipeline::Himc {
                 // IK nested in PD (seed 000 Alg. 2): every step, solve the tips' targets from
                 // the simulated pose, Δq = J⁺(X_t − X(q)), with the redundancy pulled toward
                 // the task-rate IK posture; PD then tracks that.
                 let reference_pose = goal;
-                goal = state.q;
-                for _ in 0..params.nested_iterations {
-                    let frames = skeleton.forward(&goal);
+                goal = self.state.q;
+                for _ in 0..self.params.nested_iterations {
+                    let frames = self.model.skeleton.forward(&goal);
                     for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
                         let target = reference.tips[h][k - 1].lerp(reference.tips[h][k], u);
                         ik::iterate(
@@ -336,25 +490,27 @@ pub fn simulate_in(
                             side,
                             target,
                             Some(&reference_pose),
-                            &nested,
+                            &self.nested,
                         );
                     }
                 }
             }
-            let tau = pd_torques(&gains, &state, &goal, &target_w, &bias);
-            dynamics.step_with_tip_forces(
-                &mut state,
+            let tau = pd_torques(&self.gains, &self.state, &goal, &target_w, &bias);
+            self.dynamics.step_with_tip_forces(
+                &mut self.state,
                 &tau,
                 |tips| environment.tip_forces(time_s, tips),
                 dt,
             );
-            let speed = state.w.iter().map(|w| w.length()).fold(0.0, f64::max);
-            if !state.is_finite() || speed > params.max_angular_speed {
+            let max_speed = self.params.max_angular_speed;
+            let speed = self.state.w.iter().map(|w| w.length()).fold(0.0, f64::max);
+            if !self.state.is_finite() || speed > max_speed {
                 let time_s = time_s + dt;
-                let joint = state
+                let joint = self
+                    .state
                     .w
                     .iter()
-                    .position(|w| !w.is_finite() || w.length() > params.max_angular_speed)
+                    .position(|w| !w.is_finite() || w.length() > max_speed)
                     .map_or("?", |j| Joint::ALL[j].name());
                 return Err(Diverged {
                     time_s,
@@ -364,9 +520,10 @@ pub fn simulate_in(
                 .into());
             }
         }
-        record(&mut motion, &state.q);
+        let q = self.state.q;
+        self.record(&q);
+        Ok(())
     }
-    Ok(motion)
 }
 
 /// RMS distance between two equally long point sequences, m.
@@ -428,5 +585,46 @@ mod tests {
         };
         assert!(err.time_s > 0.0 && err.beat.is_some(), "{err}");
         assert!(err.to_string().contains("during beat"), "{err}");
+    }
+
+    /// Rewinding to a checkpoint and advancing along a reference changed after it gives
+    /// bit for bit what one run along the changed reference gives (HIMC).
+    #[test]
+    fn rewind_then_advance_equals_one_run() {
+        let model = BodyModel::default();
+        let here = model.skeleton.forward(&REST);
+        let path = |late: f64| -> [Vec<DVec3>; 2] {
+            std::array::from_fn(|h| {
+                let side = [Side::Left, Side::Right][h];
+                (0..60)
+                    .map(|k| {
+                        let t = k as f64 / 250.0;
+                        let bend = if k > 30 { late * (t - 0.12) } else { 0.0 };
+                        here.tip(side) + DVec3::new(0.0, 0.05 * t, -0.2 * t * t + bend)
+                    })
+                    .collect()
+            })
+        };
+        let reference = |late| Reference {
+            rate_hz: 250.0,
+            tips: path(late),
+            poses: None,
+            beats: Vec::new(),
+        };
+        let params = SimParams::default();
+        let (a, b) = (reference(0.0), reference(0.5));
+        let ones = [1.0; JOINT_COUNT];
+        let mut sim = Simulator::new(&model, &a, Pipeline::Himc, &params, &REST, &ones).unwrap();
+        sim.advance(&mut FreeSpace, &a, 30).unwrap();
+        let checkpoint = sim.checkpoint();
+        sim.advance(&mut FreeSpace, &a, 60).unwrap();
+        let first = sim.motion().clone();
+        sim.rewind(&checkpoint);
+        assert_eq!(sim.samples(), 30);
+        sim.advance(&mut FreeSpace, &b, 60).unwrap();
+        let once = simulate(&model, &b, Pipeline::Himc, &params, &REST, &ones).unwrap();
+        assert_eq!(sim.motion(), &once);
+        assert_ne!(first, once, "the change after the checkpoint is followed");
+        assert_eq!(first.poses[..30], once.poses[..30]);
     }
 }

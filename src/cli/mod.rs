@@ -117,12 +117,12 @@ pub enum Command {
         /// Also draw target and simulated tip heights and each contact's peak force (PNG).
         #[arg(long)]
         plot: Option<PathBuf>,
-        /// The control pipeline driving the body.
-        #[arg(long, value_enum, default_value_t = ControlArg::Himc)]
-        control: ControlArg,
-        /// The sound model.
-        #[arg(long, value_enum, default_value_t = SoundArg::Modal)]
-        sound: SoundArg,
+        /// The control pipeline driving the body [default: the score's settings, himc].
+        #[arg(long, value_enum)]
+        control: Option<ControlArg>,
+        /// The sound model [default: the score's settings, modal].
+        #[arg(long, value_enum)]
+        sound: Option<SoundArg>,
         /// Print simulated seconds per wall second and where the time went.
         #[arg(long)]
         stats: bool,
@@ -293,8 +293,8 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 events: events.as_deref(),
                 plot: plot.as_deref(),
             },
-            control.into(),
-            sound.into(),
+            control.map(Into::into),
+            sound.map(Into::into),
             seed,
             stats,
         )

@@ -29,8 +29,8 @@ pub fn run(
     score: &Path,
     db_dir: &Path,
     outputs: &Outputs,
-    control: Pipeline,
-    sound: SoundModel,
+    control: Option<Pipeline>,
+    sound: Option<SoundModel>,
     seed: u64,
     stats: bool,
 ) -> anyhow::Result<()> {
@@ -39,14 +39,15 @@ pub fn run(
         eprintln!("note: {notice}");
     }
     let db = MotionDb::load(db_dir)?;
+    let settings = RenderParams::for_score(&loaded.score.settings);
     let params = RenderParams {
-        control,
-        sound,
+        control: control.unwrap_or(settings.control),
+        sound: sound.unwrap_or(settings.sound),
         plan: PlanParams {
             seed,
             ..PlanParams::default()
         },
-        ..RenderParams::default()
+        ..settings
     };
     let started = std::time::Instant::now();
     let mut bar = ProgressBar::new();
@@ -153,33 +154,37 @@ fn figure(r: &Rendering, title: &str) -> Figure {
 
 fn print_stats(r: &Rendering) {
     let s = &r.stats;
-    let simulate: std::time::Duration = s.passes.iter().sum();
     println!(
-        "simulated {:.2} s of motion x {} pass(es) at {:.0} Hz",
-        s.simulated_s,
-        s.passes.len(),
+        "score: {:.2} s of motion, {} strokes in {} clusters at {:.0} Hz",
+        s.score_s,
+        r.composition.strokes.len(),
+        s.clusters,
         1.0 / r.drums.dt_s()
     );
     println!(
-        "speed: {:.1} simulated s per wall s overall; body+drums {:.1}x real time per pass",
+        "speed: {:.1}x real time overall (score s per wall s); body+drums {:.1} simulated s \
+         per wall s ({:.2} s simulated in {} attempts, retries included)",
         s.realtime_factor(),
-        s.simulated_s * s.passes.len() as f64 / simulate.as_secs_f64().max(1e-9)
+        s.simulation_speed(),
+        s.simulated_s,
+        s.attempts
     );
-    println!("time: compose {:.3} s", s.compose.as_secs_f64());
-    for (i, (p, t)) in s.passes.iter().zip(&s.timing).enumerate() {
-        println!(
-            "      pass {}: {:.3} s (timing median {:.2} ms, worst {:.2} ms, missed {})",
-            i + 1,
-            p.as_secs_f64(),
-            t.median_abs_s * 1e3,
-            t.worst_abs_s * 1e3,
-            t.missed
-        );
-    }
     println!(
-        "      of which drums and contact {:.3} s; sound {:.3} s; normalisation gain {:.3}",
+        "time: compose {:.3} s, simulate {:.3} s (drums and contact {:.3} s), sound {:.3} s; \
+         total {:.3} s",
+        s.compose.as_secs_f64(),
+        s.simulate.as_secs_f64(),
         s.drums.as_secs_f64(),
         s.sound.as_secs_f64(),
+        s.wall().as_secs_f64()
+    );
+    let t = &r.timing;
+    println!(
+        "timing: median {:.2} ms, worst {:.2} ms, missed {} of {}; normalisation gain {:.3}",
+        t.median_abs_s * 1e3,
+        t.worst_abs_s * 1e3,
+        t.missed,
+        t.strokes,
         r.audio.gain
     );
 }
@@ -188,7 +193,7 @@ fn print_stats(r: &Rendering) {
 /// per stage when stderr is not a terminal).
 struct ProgressBar {
     tty: bool,
-    last: Option<(&'static str, usize, u32)>,
+    last: Option<(&'static str, u32)>,
 }
 
 impl ProgressBar {
@@ -201,18 +206,12 @@ impl ProgressBar {
 
     fn show(&mut self, p: Progress) {
         let percent = (p.fraction * 100.0).floor() as u32;
-        let key = (p.stage, p.pass, percent);
-        if self.last == Some(key)
-            || (!self.tty && self.last.is_some_and(|l| l.0 == p.stage && l.1 == p.pass))
-        {
+        let key = (p.stage, percent);
+        if self.last == Some(key) || (!self.tty && self.last.is_some_and(|l| l.0 == p.stage)) {
             return;
         }
         self.last = Some(key);
-        let stage = if p.pass > 0 {
-            format!("{} (pass {})", p.stage, p.pass)
-        } else {
-            p.stage.to_string()
-        };
+        let stage = p.stage;
         let mut err = std::io::stderr();
         if self.tty {
             let filled = (percent as usize * 30) / 100;

@@ -13,7 +13,7 @@ pub mod strike;
 
 pub use contact::HertzContact;
 pub use modes::{HeadMode, HeadModes, Orientation};
-pub use set::{ContactEvent, DrumSet, Excitation};
+pub use set::{ContactEvent, DrumCheckpoint, DrumSet, Excitation};
 
 /// Default number of mode orientations per head.
 pub const DEFAULT_MODE_COUNT: usize = 24;

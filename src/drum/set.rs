@@ -89,6 +89,26 @@ impl Head {
     }
 }
 
+/// A [`DrumSet`]'s state at one step, without its history (which it only truncates).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DrumCheckpoint {
+    step: u64,
+    /// Per head: the coupled modes' states and their bound.
+    heads: Vec<(Vec<[f64; 2]>, f64)>,
+    contacts: usize,
+    /// Each tip's ongoing contact as it was.
+    open: [Option<(usize, ContactEvent)>; 2],
+    excitation: usize,
+    membrane: usize,
+}
+
+impl DrumCheckpoint {
+    /// Contacts started before the checkpoint.
+    pub fn contacts(&self) -> usize {
+        self.contacts
+    }
+}
+
 /// Every head of a kit with both stick tips; `Clone` is the snapshot for re-simulation.
 #[derive(Clone, Debug)]
 pub struct DrumSet {
@@ -105,7 +125,15 @@ pub struct DrumSet {
     excitation: Vec<Excitation>,
     /// Scratch: mode shapes under each tip.
     shapes: [Vec<f64>; 2],
+    /// Time of step 0, s.
+    first_time_s: f64,
+    /// Every [`MEMBRANE_FRAME_STEPS`] steps from step 0, each head's coupled mode
+    /// displacements q_k (m), heads one after another: the membranes' motion to show.
+    membrane: Vec<f32>,
 }
+
+/// Steps between recorded membrane frames (10 ms at 10 kHz).
+pub const MEMBRANE_FRAME_STEPS: u64 = 100;
 
 const SIDES: [Side; 2] = [Side::Left, Side::Right];
 
@@ -167,6 +195,8 @@ impl DrumSet {
             open: [None, None],
             excitation: Vec::new(),
             shapes: [vec![0.0; most], vec![0.0; most]],
+            first_time_s: 0.0,
+            membrane: Vec::new(),
         })
     }
 
@@ -175,6 +205,15 @@ impl DrumSet {
     /// the stick up). A tip outside every head (horizontally) never touches.
     pub fn step(&mut self, time_s: f64, tips: [(DVec3, DVec3); 2]) -> [DVec3; 2] {
         let dt = self.dt_s;
+        if self.step == 0 {
+            self.first_time_s = time_s;
+        }
+        if self.step.is_multiple_of(MEMBRANE_FRAME_STEPS) {
+            for head in &self.heads {
+                let q = head.x.iter().zip(&head.steps).map(|(x, s)| x[0] / s.omega0);
+                self.membrane.extend(q.map(|q| q as f32));
+            }
+        }
         let mut force = [0.0f64; 2];
         let mut touching: [Option<(usize, DVec2)>; 2] = [None, None];
         for (i, &(p, v)) in tips.iter().enumerate() {
@@ -307,6 +346,41 @@ impl DrumSet {
         });
     }
 
+    /// Where the drums are now: enough to [`rewind`](DrumSet::rewind) them there.
+    pub fn checkpoint(&self) -> DrumCheckpoint {
+        DrumCheckpoint {
+            step: self.step,
+            heads: self
+                .heads
+                .iter()
+                .map(|h| (h.x.clone(), h.bound_m))
+                .collect(),
+            contacts: self.contacts.len(),
+            open: self.open.map(|o| o.map(|k| (k, self.contacts[k].clone()))),
+            excitation: self.excitation.len(),
+            membrane: self.membrane.len(),
+        }
+    }
+
+    /// Go back to `checkpoint` (taken from this set, not after a rewind before it):
+    /// modes, ongoing contacts and the records are as they were then.
+    pub fn rewind(&mut self, checkpoint: &DrumCheckpoint) {
+        self.step = checkpoint.step;
+        for (head, (x, bound)) in self.heads.iter_mut().zip(&checkpoint.heads) {
+            head.x.clone_from(x);
+            head.bound_m = *bound;
+        }
+        self.contacts.truncate(checkpoint.contacts);
+        self.excitation.truncate(checkpoint.excitation);
+        self.membrane.truncate(checkpoint.membrane);
+        self.open = checkpoint.open.clone().map(|o| {
+            o.map(|(k, contact)| {
+                self.contacts[k] = contact;
+                k
+            })
+        });
+    }
+
     /// Finished and ongoing contacts, in start order.
     pub fn contacts(&self) -> &[ContactEvent] {
         &self.contacts
@@ -330,6 +404,35 @@ impl DrumSet {
         let mut shapes = vec![0.0; head.modes.modes().len()];
         head.modes.shapes_at(local, &mut shapes);
         head.displacement(&shapes)
+    }
+
+    /// The recorded displacement (m, +up) of drum `drum`'s head at the performer-frame
+    /// point `point` at `time_s` (the frame before it, every 10 ms; coupled modes only);
+    /// 0 off the head, for an unknown drum, or outside the recorded time.
+    pub fn recorded_displacement(&self, drum: usize, time_s: f64, point: DVec3) -> f64 {
+        let Some(head) = self.heads.get(drum) else {
+            return 0.0;
+        };
+        let local = head.modes.local(point);
+        let frame_s = MEMBRANE_FRAME_STEPS as f64 * self.dt_s;
+        let per_frame: usize = self.heads.iter().map(|h| h.coupled.len()).sum();
+        let frames = self.membrane.len() / per_frame.max(1);
+        let f = ((time_s - self.first_time_s) / frame_s).floor();
+        if !head.modes.contains(local) || !(0.0..frames as f64).contains(&f) {
+            return 0.0;
+        }
+        let offset: usize = self.heads[..drum].iter().map(|h| h.coupled.len()).sum();
+        let q = &self.membrane[f as usize * per_frame + offset..][..head.coupled.len()];
+        if q.iter().all(|q| q.abs() < 1e-9) {
+            return 0.0;
+        }
+        let mut shapes = vec![0.0; head.modes.modes().len()];
+        head.modes.shapes_at(local, &mut shapes);
+        head.coupled
+            .iter()
+            .zip(q)
+            .map(|(&k, &q)| f64::from(q) * shapes[k])
+            .sum()
     }
 
     /// The modes of drum `drum` (all of them, coupled or not).

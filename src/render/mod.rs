@@ -4,29 +4,32 @@
 //! compose (plan + splice, `motion`) → targets (strike-through, per-stroke time warp,
 //! [`reference`]) → the body simulated at 10 kHz by the chosen control pipeline with its
 //! stick tips meeting the modal heads through the Hertz contact (`body::sim` +
-//! `drum::DrumSet`, two-way) → contacts matched to strokes ([`strikes`]) → timing
-//! compensation: each stroke's target is replayed earlier by however late its contact
-//! was, and the score re-simulated, until every contact is within the tolerance → sound
-//! from the recorded contact forces (`sound`). Deterministic: the same score and
-//! parameters give bit-identical audio and motion.
+//! `drum::DrumSet`, two-way), the strokes settled on the beat front to back
+//! ([`compensate`]: each cluster of strokes re-simulated from a saved state until its
+//! contacts are on time) → contacts matched to strokes ([`strikes`]) → sound from the
+//! recorded contact forces (`sound`). Deterministic: the same score and parameters give
+//! bit-identical audio and motion, also when a rendering resumes a previous one after an
+//! edit ([`render_after`]).
 
+pub mod compensate;
 pub mod reference;
 pub mod strikes;
 
-use crate::body::ik::{self, IkParams};
+use crate::body::ik::{self, IkMethod, IkParams};
 use crate::body::model::BodyModel;
-use crate::body::sim::{self, Environment, Motion, Pipeline, Reference, SimError, SimParams};
+use crate::body::sim::{Motion, Pipeline, Reference, SimError, SimParams, Simulator};
 use crate::body::skeleton::{Pose, REST, Skeleton};
-use crate::drum::{DrumError, DrumSet, ModeConfig};
+use crate::drum::{DrumError, DrumSet, FrequencySource, ModeConfig};
+use crate::kit::Kit;
 use crate::kit::Side;
 use crate::mocap::db::MotionDb;
 use crate::motion::compose::{ComposeParams, Composition};
 use crate::motion::perform;
 use crate::motion::plan::PlanParams;
-use crate::score::LoadedScore;
-use crate::sound::{Audio, SoundError, SoundModel};
-use glam::DVec3;
-use reference::{Adjustments, StrikeShape};
+use crate::score::{LoadedScore, Settings};
+use crate::sound::{Audio, SoundError, SoundModel, SoundState};
+use compensate::{Aims, Performance, Stage};
+use reference::{StrikeShape, Targets, Warp};
 use std::time::{Duration, Instant};
 use strikes::{StrikeEvent, Timing};
 
@@ -44,14 +47,15 @@ pub struct RenderParams {
     /// Player's height, m, and mass, kg.
     pub height_m: f64,
     pub mass_kg: f64,
-    /// Most simulation passes of the timing compensation (1 = none); the best pass is kept.
-    pub max_passes: usize,
-    /// Compensation stops once every stroke's contact is this close to its time, s, and
+    /// Most simulation attempts per stroke cluster of the timing compensation (1 = none);
+    /// the best attempt is kept.
+    pub max_attempts: usize,
+    /// A cluster is settled once every stroke's contact is this close to its time, s, and
     /// every force is within `force_tolerance` of its aim...
     pub timing_tolerance_s: f64,
-    /// ...or, from pass `settle_passes` on, once every stroke sounds within this, s.
+    /// ...or, from attempt `settle_attempts` on, once every stroke sounds within this, s.
     pub timing_acceptable_s: f64,
-    pub settle_passes: usize,
+    pub settle_attempts: usize,
     /// How far below the head the felt first aims at impact (strike-through), m; each
     /// stroke's depth is then adapted toward its dynamic's force.
     pub strike_depth_m: f64,
@@ -66,6 +70,48 @@ pub struct RenderParams {
     pub strike_half_width_s: f64,
     /// Sound rendered after the last motion sample, s.
     pub tail_s: f64,
+    /// Every PD gain multiplied by this.
+    pub gain_scale: f64,
+}
+
+impl RenderParams {
+    /// The defaults with a score's settings (control, IK, gains, sound, modes).
+    pub fn for_score(settings: &Settings) -> RenderParams {
+        use crate::score::settings::{Control, Frequencies, IkSolver, Sound};
+        let sim = SimParams::default();
+        RenderParams {
+            control: match settings.control {
+                Control::Himc => Pipeline::Himc,
+                Control::Id => Pipeline::Id,
+                Control::Ik => Pipeline::Ik,
+            },
+            sim: SimParams {
+                ik: IkParams {
+                    method: match settings.ik {
+                        IkSolver::Transpose => IkMethod::Transpose,
+                        IkSolver::PseudoInverse => IkMethod::PseudoInverse,
+                        IkSolver::DampedLeastSquares => IkMethod::DampedLeastSquares,
+                    },
+                    ..sim.ik.clone()
+                },
+                ..sim
+            },
+            gain_scale: settings.gain_scale,
+            sound: match settings.sound {
+                Sound::Modal => SoundModel::Modal,
+                Sound::Sample => SoundModel::Sample,
+                Sound::Signal => SoundModel::Signal,
+            },
+            modes: ModeConfig {
+                count: settings.modes,
+                source: match settings.frequencies {
+                    Frequencies::Measured => FrequencySource::Measured,
+                    Frequencies::Membrane => FrequencySource::Membrane,
+                },
+            },
+            ..RenderParams::default()
+        }
+    }
 }
 
 impl Default for RenderParams {
@@ -80,16 +126,17 @@ impl Default for RenderParams {
             mallet: 0,
             height_m: 1.75,
             mass_kg: 70.0,
-            max_passes: 6,
+            max_attempts: 6,
             timing_tolerance_s: 0.0015,
             timing_acceptable_s: 0.004,
-            settle_passes: 3,
+            settle_attempts: 3,
             strike_depth_m: 0.018,
             force_at_silence_n: 15.0,
             force_range_n: 95.0,
             force_tolerance: 0.25,
             strike_half_width_s: 0.012,
             tail_s: 2.5,
+            gain_scale: 1.0,
         }
     }
 }
@@ -97,11 +144,9 @@ impl Default for RenderParams {
 /// Where a rendering is, for progress bars.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Progress {
-    /// What is being done ("composing", "simulating pass 2", "sound").
+    /// What is being done ("composing", "simulating", "sound").
     pub stage: &'static str,
-    /// Pass number (from 1) while simulating, else 0.
-    pub pass: usize,
-    /// Fraction of the whole rendering done, 0–1 (estimated: later passes may not run).
+    /// Fraction of the whole rendering done, 0–1 (estimated: simulating is ~90 %).
     pub fraction: f64,
 }
 
@@ -109,22 +154,37 @@ pub struct Progress {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Stats {
     pub compose: Duration,
-    /// Each simulation pass (body + drums).
-    pub passes: Vec<Duration>,
-    /// Of the passes, the time spent stepping the drums and contacts.
+    /// Simulating body and drums, retries included.
+    pub simulate: Duration,
+    /// Of `simulate`, the time spent stepping the drums and contacts.
     pub drums: Duration,
     pub sound: Duration,
-    /// Seconds of motion simulated per pass.
+    /// Seconds of motion in the score.
+    pub score_s: f64,
+    /// Seconds of motion simulated, retries included (after a resumed edit: since the
+    /// resume point).
     pub simulated_s: f64,
-    /// Timing after each pass.
-    pub timing: Vec<Timing>,
+    /// Stroke clusters settled and simulation attempts over them.
+    pub clusters: usize,
+    pub attempts: usize,
+    /// Score time the rendering resumed a previous one's performance from, s.
+    pub resumed_from_s: Option<f64>,
 }
 
 impl Stats {
-    /// Simulated seconds per wall-clock second over the whole rendering.
+    /// Wall-clock time of the whole rendering.
+    pub fn wall(&self) -> Duration {
+        self.compose + self.simulate + self.sound
+    }
+
+    /// Seconds of score rendered per wall-clock second.
     pub fn realtime_factor(&self) -> f64 {
-        let wall = self.compose + self.passes.iter().sum::<Duration>() + self.sound;
-        self.simulated_s * self.passes.len() as f64 / wall.as_secs_f64().max(1e-9)
+        self.score_s / self.wall().as_secs_f64().max(1e-9)
+    }
+
+    /// Simulated seconds (retries included) per wall-clock second of simulation.
+    pub fn simulation_speed(&self) -> f64 {
+        self.simulated_s / self.simulate.as_secs_f64().max(1e-9)
     }
 }
 
@@ -143,11 +203,23 @@ pub struct Rendering {
     pub drums: DrumSet,
     /// Every contact, in time order.
     pub events: Vec<StrikeEvent>,
-    /// Timing of the strokes in the final pass.
+    /// Timing of the strokes.
     pub timing: Timing,
     /// Stereo audio from score time 0.
     pub audio: Audio,
     pub stats: Stats,
+    /// The settled performance, to resume from after an edit.
+    pub performance: Performance,
+    /// What re-synthesis after an edit needs (large: take it out to keep it apart).
+    pub sound: SoundState,
+    /// Whether the whole score is rendered (else see [`Previous::stop_after_s`]).
+    pub complete: bool,
+    /// Score time up to which the audio is final, s (the end of the audio when
+    /// complete).
+    pub ready_s: f64,
+    /// What it was rendered with.
+    pub params: RenderParams,
+    pub kit: Kit,
 }
 
 /// Why a score could not be rendered.
@@ -177,27 +249,6 @@ pub enum RenderError {
     Cancelled,
 }
 
-/// The drums seen by the simulated body, in score time, with progress reporting.
-struct Stage<'a> {
-    drums: &'a mut DrumSet,
-    start_s: f64,
-    spent: Duration,
-    report: &'a mut dyn FnMut(f64) -> bool,
-}
-
-impl Environment for Stage<'_> {
-    fn tip_forces(&mut self, time_s: f64, tips: [(DVec3, DVec3); 2]) -> [DVec3; 2] {
-        let began = Instant::now();
-        let forces = self.drums.step(self.start_s + time_s, tips);
-        self.spent += began.elapsed();
-        forces
-    }
-
-    fn progress(&mut self, done: usize, total: usize) -> bool {
-        !done.is_multiple_of(64) || (self.report)(done as f64 / total.max(1) as f64)
-    }
-}
-
 /// Render `loaded` with motion units from `db`. `progress` is called now and then; when
 /// it returns `false` the rendering stops with [`RenderError::Cancelled`].
 pub fn render(
@@ -206,8 +257,33 @@ pub fn render(
     params: &RenderParams,
     progress: &mut dyn FnMut(Progress) -> bool,
 ) -> Result<Rendering, RenderError> {
+    render_after(None, loaded, db, params, progress)
+}
+
+/// A rendering to resume from, with its sound state kept apart (it is large): the state
+/// is moved into the new rendering once its sound is being made, and left as it was if
+/// the rendering stops before.
+pub struct Previous<'a> {
+    pub rendering: &'a Rendering,
+    pub sound: &'a mut SoundState,
+    /// When resuming, stop about this long past the resume point, s: a partial rendering
+    /// whose audio is final up to [`Rendering::ready_s`], to play at once while the rest
+    /// is rendered (resuming from it).
+    pub stop_after_s: Option<f64>,
+}
+
+/// [`render`], resuming `previous`'s performance from the latest point before the score
+/// changed when it can (same kit and parameters), and its sound from there: bit for bit
+/// the same result, faster.
+pub fn render_after(
+    previous: Option<Previous>,
+    loaded: &LoadedScore,
+    db: &MotionDb,
+    params: &RenderParams,
+    progress: &mut dyn FnMut(Progress) -> bool,
+) -> Result<Rendering, RenderError> {
     let mut stats = Stats::default();
-    let kit = &loaded.kit;
+    let kit = &loaded.score.settings.kit(&loaded.kit);
     let mallet = kit
         .mallets
         .get(params.mallet)
@@ -215,7 +291,6 @@ pub fn render(
     let law = crate::drum::HertzContact::of(mallet)?;
     if !progress(Progress {
         stage: "composing",
-        pass: 0,
         fraction: 0.0,
     }) {
         return Err(RenderError::Cancelled);
@@ -228,142 +303,163 @@ pub fn render(
         return Err(RenderError::Empty);
     }
     let start_s = composition.start_s;
-    let model = BodyModel::new(
-        Skeleton::new(params.height_m, mallet.length_m),
-        params.mass_kg,
-    );
+    let rate = composition.rate_hz;
+    stats.score_s = (composition.len() - 1) as f64 / rate;
     let shape = StrikeShape {
         ball_radius_m: law.ball_radius_m,
         half_width_s: params.strike_half_width_s,
     };
-    let dt = 1.0 / (composition.rate_hz * (params.sim.sim_hz / composition.rate_hz).round());
-    stats.simulated_s = (composition.len() - 1) as f64 / composition.rate_hz;
-    let passes = params.max_passes.max(1);
-    let mut adjust = Adjustments::uniform(composition.strokes.len(), params.strike_depth_m);
-    let aims: Vec<f64> = composition
-        .strokes
-        .iter()
-        .map(|s| params.force_at_silence_n + params.force_range_n * s.dynamic.velocity())
-        .collect();
-    let mut pass = 0;
-    // The best pass so far: fewest missed strokes, then smallest worst timing error.
-    type Pass = (Reference, Motion, DrumSet, Vec<Option<usize>>, Timing);
-    let mut best: Option<Pass> = None;
-    let (reference, motion, drums, matches, timing) = loop {
-        pass += 1;
-        let mut reference = reference::targets(&composition, &shape, &adjust);
-        let initial = initial_pose(&model, &reference);
-        if params.control == Pipeline::Id {
-            // A composed score has no captured joint rotations: ID tracks the task-rate IK
-            // solution of the targets instead.
-            reference.poses = Some(sim::ik_targets(&model, &reference, &params.sim, &initial));
+    let targets = Targets::new(&composition, &shape, params.strike_depth_m);
+    let strokes = composition.strokes.len();
+    let (previous, previous_sound, stop_after_s) = match previous {
+        Some(p) => (Some(p.rendering), Some(p.sound), p.stop_after_s),
+        None => (None, None, None),
+    };
+    let resumed = previous.and_then(|p| {
+        let same = p.params == *params
+            && p.kit == *kit
+            && p.composition.start_s == start_s
+            && p.composition.rate_hz == rate;
+        let old = &p.composition;
+        let same_until = (0..old.len().min(composition.len()))
+            .find(|&k| (0..2).any(|h| old.tips[h][k] != composition.tips[h][k]))
+            .unwrap_or(old.len().min(composition.len()));
+        let at = p
+            .performance
+            .resumable(&old.strokes, &composition.strokes, &targets, same_until);
+        same.then_some(at).flatten().map(|at| (p, at))
+    });
+    let mut performance = match resumed {
+        Some((p, at)) => {
+            let mut performance = p.performance.clone();
+            performance.resume_at(at, targets, strokes);
+            stats.resumed_from_s = Some(start_s + performance.sim.samples() as f64 / rate);
+            performance
         }
-        let mut drums = DrumSet::new(kit, mallet, &params.modes, dt)?;
-        let began = Instant::now();
-        let mut report = |f: f64| {
-            progress(Progress {
-                stage: "simulating",
-                pass,
-                fraction: 0.02 + 0.9 * ((pass - 1) as f64 + f) / passes as f64,
-            })
-        };
-        let mut stage = Stage {
-            drums: &mut drums,
-            start_s,
-            spent: Duration::ZERO,
-            report: &mut report,
-        };
-        let motion = sim::simulate_in(
-            &mut stage,
-            &model,
-            &reference,
-            params.control,
-            &params.sim,
-            &initial,
-            &[1.0; crate::body::skeleton::JOINT_COUNT],
-        );
-        stats.drums += stage.spent;
-        stats.passes.push(began.elapsed());
-        let motion = motion.map_err(|e| match e {
-            SimError::Diverged(d) => RenderError::Diverged {
-                time_s: d.time_s + start_s,
-                beat: d.beat,
-                what: d.what,
-            },
-            _ => RenderError::Cancelled,
-        })?;
-        let matches = strikes::match_strokes(&composition.strokes, drums.contacts());
-        let errors = strikes::errors(&composition.strokes, drums.contacts(), &matches);
-        let timing = strikes::timing(&errors);
-        stats.timing.push(timing);
-        let forces: Vec<Option<f64>> = matches
-            .iter()
-            .map(|m| m.map(|c| drums.contacts()[c].peak_force_n))
-            .collect();
-        let on_time = timing.missed == 0 && timing.worst_abs_s <= params.timing_tolerance_s;
-        let on_force = forces
-            .iter()
-            .zip(&aims)
-            .all(|(f, aim)| f.is_some_and(|f| (f / aim - 1.0).abs() <= params.force_tolerance));
-        let acceptable = timing.missed == 0
-            && timing.worst_abs_s <= params.timing_acceptable_s
-            && pass >= params.settle_passes;
-        let done = (on_time && on_force) || acceptable || pass >= passes;
-        let key = |t: &Timing| (t.missed, t.worst_abs_s);
-        if best.as_ref().is_none_or(|b| key(&timing) <= key(&b.4)) {
-            best = Some((reference, motion, drums.clone(), matches.clone(), timing));
-        }
-        if done {
-            break best.take().expect("a pass was kept");
-        }
-        // Late contacts play their target earlier; weak strokes aim deeper (the felt's
-        // Hertz force grows about as the square of how far the hand drives through).
-        // A deeper aim reaches the head earlier, by about the extra depth over the impact
-        // speed: the shift allows for that so the two corrections do not fight.
-        for i in 0..adjust.shift_s.len() {
-            adjust.shift_s[i] += errors[i].unwrap_or(0.0);
-            let in_tolerance =
-                forces[i].is_some_and(|f| (f / aims[i] - 1.0).abs() <= params.force_tolerance);
-            if in_tolerance {
-                continue;
-            }
-            let ratio = forces[i].map_or(2.0, |f| (aims[i] / f.max(1e-3)).sqrt().clamp(0.6, 1.6));
-            let depth = (adjust.depth_m[i] * ratio).clamp(0.002, 0.06);
-            if let Some(c) = matches[i] {
-                let speed = drums.contacts()[c].impact_speed_mps.max(0.5);
-                adjust.shift_s[i] -= (depth - adjust.depth_m[i]) / speed;
-            }
-            adjust.depth_m[i] = depth;
+        None => {
+            let model = BodyModel::new(
+                Skeleton::new(params.height_m, mallet.length_m),
+                params.mass_kg,
+            );
+            let first = targets.reference(&Warp::default());
+            let initial = initial_pose(&model, &first);
+            let sim = Simulator::new(
+                &model,
+                &first,
+                params.control,
+                &params.sim,
+                &initial,
+                &[params.gain_scale; crate::body::skeleton::JOINT_COUNT],
+            )
+            .map_err(|e| RenderError::of_simulation(e, start_s))?;
+            let dt = 1.0 / (rate * (params.sim.sim_hz / rate).round().max(1.0));
+            let drums = DrumSet::new(kit, mallet, &params.modes, dt)?;
+            Performance::new(targets, sim, drums, strokes)
         }
     };
+    let aims = Aims {
+        force_n: composition
+            .strokes
+            .iter()
+            .map(|s| params.force_at_silence_n + params.force_range_n * s.dynamic.velocity())
+            .collect(),
+        force_tolerance: params.force_tolerance,
+        tolerance_s: params.timing_tolerance_s,
+        acceptable_s: params.timing_acceptable_s,
+        settle_attempts: params.settle_attempts,
+        max_attempts: params.max_attempts.max(1),
+        first_depth_m: params.strike_depth_m,
+    };
+    let began = Instant::now();
+    let mut report = |f: f64| {
+        progress(Progress {
+            stage: "simulating",
+            fraction: 0.02 + 0.9 * f,
+        })
+    };
+    let mut stage = Stage {
+        start_s,
+        drum_time: Duration::ZERO,
+        report: &mut report,
+    };
+    let horizon = stats
+        .resumed_from_s
+        .zip(stop_after_s)
+        .map(|(from, after)| ((from + after - start_s) * rate).ceil().max(0.0) as usize);
+    let outcome = performance.run(&composition.strokes, &aims, &mut stage, horizon);
+    stats.drums = stage.drum_time;
+    stats.simulate = began.elapsed();
+    let complete = outcome.map_err(|e| RenderError::of_simulation(e, start_s))?;
+    let simulated_to_s = start_s + (performance.sim.samples().max(1) - 1) as f64 / rate;
+    stats.simulated_s = performance.simulated_samples as f64 / rate;
+    stats.clusters = performance.commits.len();
+    stats.attempts = performance.attempts;
+    let drums = performance.drums.clone();
+    let matches = strikes::match_strokes(&composition.strokes, drums.contacts());
+    let timing = strikes::timing(&strikes::errors(
+        &composition.strokes,
+        drums.contacts(),
+        &matches,
+    ));
     if !progress(Progress {
         stage: "sound",
-        pass: 0,
         fraction: 0.93,
     }) {
         return Err(RenderError::Cancelled);
     }
     let began = Instant::now();
-    let end_s = start_s + stats.simulated_s;
-    let audio = crate::sound::render(kit, &drums, end_s.max(0.0) + params.tail_s, params.sound)?;
+    // A partial rendering's audio stops where later strikes could still change it.
+    let (end_s, ready_s) = if complete {
+        let end_s = start_s + stats.score_s + params.tail_s;
+        (end_s, end_s)
+    } else {
+        (
+            simulated_to_s,
+            simulated_to_s - 2.0 * performance.drums.dt_s(),
+        )
+    };
+    let resume_sound = previous_sound.map(std::mem::take).zip(stats.resumed_from_s);
+    let (audio, sound) =
+        crate::sound::render_resuming(kit, &drums, end_s.max(0.0), params.sound, resume_sound)?;
     stats.sound = began.elapsed();
     let events = strikes::events(&composition.strokes, drums.contacts(), &matches);
     progress(Progress {
         stage: "done",
-        pass: 0,
         fraction: 1.0,
     });
+    let reference = performance.targets.reference(&performance.warp);
     Ok(Rendering {
-        composition,
         reference,
-        motion,
+        motion: performance.sim.motion().clone(),
+        composition,
         start_s,
         drums,
         events,
         timing,
         audio,
         stats,
+        performance,
+        sound,
+        complete,
+        ready_s: ready_s.max(0.0),
+        params: params.clone(),
+        kit: kit.clone(),
     })
+}
+
+impl RenderError {
+    /// A simulation failure, its time moved to score time (the simulation starts at
+    /// `start_s`).
+    fn of_simulation(e: SimError, start_s: f64) -> RenderError {
+        match e {
+            SimError::Diverged(d) => RenderError::Diverged {
+                time_s: d.time_s + start_s,
+                beat: d.beat,
+                what: d.what,
+            },
+            SimError::Cancelled => RenderError::Cancelled,
+        }
+    }
 }
 
 /// The posture the body starts in: both tips on the reference's first targets.

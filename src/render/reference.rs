@@ -4,29 +4,17 @@
 //! few millimetres into the head (players strike through the head, not onto it), and a
 //! per-hand time warp that plays each stroke earlier or later by the shift the timing
 //! compensation measured (issue 6 §5).
+//!
+//! The warp is a list of knots per hand: each stroke holds its shift over its dip, and
+//! *anchors* fix the shift at times the compensation has settled; between knots the shift
+//! is interpolated linearly, outside them it is held. A stroke's knots therefore change
+//! the targets only after the anchor before it, which lets the compensation settle a
+//! score front to back and resume from any settled point.
 
 use crate::body::sim::Reference;
 use crate::motion::compose::Composition;
-
-/// What the compensation adjusts per stroke: the target of stroke i is played
-/// `shift_s[i]` earlier and aims `depth_m[i]` below the head. Between a hand's strokes the
-/// shift is interpolated linearly, before its first and after its last it is held, so the
-/// warp stays smooth and monotonic (shifts ≪ stroke gaps).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Adjustments {
-    pub shift_s: Vec<f64>,
-    pub depth_m: Vec<f64>,
-}
-
-impl Adjustments {
-    /// No shift and the same depth for `strokes` strokes.
-    pub fn uniform(strokes: usize, depth_m: f64) -> Adjustments {
-        Adjustments {
-            shift_s: vec![0.0; strokes],
-            depth_m: vec![depth_m; strokes],
-        }
-    }
-}
+use glam::DVec3;
+use std::ops::Range;
 
 /// How the targets are shaped around impacts.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -37,76 +25,254 @@ pub struct StrikeShape {
     pub half_width_s: f64,
 }
 
-/// The reference of `comp` shaped by `shape` and `adjust` (one entry per stroke). Its time
-/// 0 is `comp.start_s` of the score; its beats are the strokes' impacts.
-pub fn targets(comp: &Composition, shape: &StrikeShape, adjust: &Adjustments) -> Reference {
-    let rate = comp.rate_hz;
-    let n = comp.len();
-    let tips: [Vec<glam::DVec3>; 2] = std::array::from_fn(|h| {
-        let side = crate::mocap::db::SIDES[h];
-        // This hand's strokes: (reference time of the impact, shift) and depths.
-        let (mine, depths): (Vec<(f64, f64)>, Vec<f64>) = comp
+/// One stroke's strike-through dip.
+#[derive(Clone, Debug, PartialEq)]
+struct Dip {
+    /// Hand index (0 left, 1 right).
+    hand: usize,
+    /// Impact time from sample 0, s.
+    time_s: f64,
+    /// Half-width, s.
+    half_s: f64,
+    /// Samples it lowers.
+    samples: Range<usize>,
+    /// How far below the head it aims, m.
+    depth_m: f64,
+}
+
+/// The composed tips shaped for striking, before the time warp: raised by the ball
+/// radius, with each stroke's dip at its current depth.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Targets {
+    rate_hz: f64,
+    /// Composed tips raised by the ball radius, [left, right], m.
+    raised: [Vec<DVec3>; 2],
+    /// `raised` with the dips, m.
+    shaped: [Vec<DVec3>; 2],
+    /// One per stroke of the composition, in its order.
+    dips: Vec<Dip>,
+    /// Scored impacts (s from sample 0, beat), in time order.
+    beats: Vec<(f64, usize)>,
+}
+
+impl Targets {
+    /// The targets of `comp` with every stroke aiming `depth_m` below the head.
+    pub fn new(comp: &Composition, shape: &StrikeShape, depth_m: f64) -> Targets {
+        let rate = comp.rate_hz;
+        let n = comp.len();
+        let raised: [Vec<DVec3>; 2] = std::array::from_fn(|h| {
+            comp.tips[h]
+                .iter()
+                .map(|p| *p + DVec3::Z * shape.ball_radius_m)
+                .collect()
+        });
+        let hand_of = |s: &crate::motion::plan::PlannedStroke| {
+            crate::mocap::db::SIDES
+                .iter()
+                .position(|&side| side == s.hand)
+                .unwrap_or(0)
+        };
+        let dips = comp
             .strokes
             .iter()
-            .zip(adjust.shift_s.iter().zip(&adjust.depth_m))
-            .filter(|(s, _)| s.hand == side)
-            .map(|(s, (&d, &depth))| ((s.time_s - comp.start_s, d), depth))
-            .unzip();
-        let mut shaped = comp.tips[h].clone();
-        for p in &mut shaped {
-            p.z += shape.ball_radius_m;
-        }
-        for (i, &(t, _)) in mine.iter().enumerate() {
-            let gap = |j: Option<&(f64, f64)>| j.map_or(f64::INFINITY, |&(u, _)| (u - t).abs());
-            let half = shape
-                .half_width_s
-                .min(0.4 * gap(i.checked_sub(1).and_then(|j| mine.get(j))))
-                .min(0.4 * gap(mine.get(i + 1)));
-            let (first, last) = (((t - half) * rate).ceil(), ((t + half) * rate).floor());
-            let first = (first.max(0.0) as usize).min(n);
-            let last = (last.max(0.0) as usize + 1).min(n).max(first);
-            for (k, p) in shaped.iter_mut().enumerate().take(last).skip(first) {
-                let x = (k as f64 / rate - t) / half;
-                if x.abs() < 1.0 {
-                    p.z -= depths[i] * 0.5 * (1.0 + (std::f64::consts::PI * x).cos());
+            .enumerate()
+            .map(|(i, s)| {
+                let hand = hand_of(s);
+                let t = s.time_s - comp.start_s;
+                let gap = comp
+                    .strokes
+                    .iter()
+                    .enumerate()
+                    .filter(|&(j, o)| j != i && hand_of(o) == hand)
+                    .map(|(_, o)| (o.time_s - s.time_s).abs())
+                    .fold(f64::INFINITY, f64::min);
+                let half = shape.half_width_s.min(0.4 * gap);
+                let first = (((t - half) * rate).ceil().max(0.0) as usize).min(n);
+                let last = ((((t + half) * rate).floor().max(0.0) as usize) + 1)
+                    .min(n)
+                    .max(first);
+                Dip {
+                    hand,
+                    time_s: t,
+                    half_s: half,
+                    samples: first..last,
+                    depth_m: 0.0,
                 }
+            })
+            .collect();
+        let mut beats: Vec<(f64, usize)> = comp
+            .strokes
+            .iter()
+            .map(|s| (s.time_s - comp.start_s, s.beat))
+            .collect();
+        beats.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut targets = Targets {
+            rate_hz: rate,
+            shaped: raised.clone(),
+            raised,
+            dips,
+            beats,
+        };
+        for i in 0..targets.dips.len() {
+            targets.set_depth(i, depth_m);
+        }
+        targets
+    }
+
+    /// Samples per hand.
+    pub fn len(&self) -> usize {
+        self.raised[0].len()
+    }
+
+    /// Whether there are no samples.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Hand index (0 left, 1 right) of stroke `i`.
+    pub fn hand(&self, i: usize) -> usize {
+        self.dips[i].hand
+    }
+
+    /// How far below the head stroke `i` aims, m.
+    pub fn depth(&self, i: usize) -> f64 {
+        self.dips[i].depth_m
+    }
+
+    /// Aim stroke `i` `depth_m` below the head (dips of one hand never overlap).
+    pub fn set_depth(&mut self, i: usize, depth_m: f64) {
+        let dip = &mut self.dips[i];
+        dip.depth_m = depth_m;
+        let (raised, shaped) = (&self.raised[dip.hand], &mut self.shaped[dip.hand]);
+        for k in dip.samples.clone() {
+            let x = (k as f64 / self.rate_hz - dip.time_s) / dip.half_s;
+            let lowered = if x.abs() < 1.0 {
+                depth_m * 0.5 * (1.0 + (std::f64::consts::PI * x).cos())
+            } else {
+                0.0
+            };
+            shaped[k] = raised[k] - DVec3::Z * lowered;
+        }
+    }
+
+    /// Whether the first `k` strokes' dips are placed as in `other` (depths aside).
+    pub fn same_dips(&self, other: &Targets, k: usize) -> bool {
+        let placed = |d: &Dip| (d.hand, d.time_s, d.half_s, d.samples.clone());
+        k <= self.dips.len()
+            && k <= other.dips.len()
+            && self.dips[..k]
+                .iter()
+                .zip(&other.dips[..k])
+                .all(|(a, b)| placed(a) == placed(b))
+    }
+
+    /// The two knots that hold stroke `i`'s shift over its dip: (time from sample 0, s).
+    pub fn knots(&self, i: usize, shift_s: f64) -> [(f64, f64); 2] {
+        let dip = &self.dips[i];
+        [
+            (dip.time_s - dip.half_s, shift_s),
+            (dip.time_s + dip.half_s, shift_s),
+        ]
+    }
+
+    /// An empty reference of this length to [`write`](Targets::write) into.
+    pub fn blank(&self) -> Reference {
+        Reference {
+            rate_hz: self.rate_hz,
+            tips: std::array::from_fn(|h| self.shaped[h].clone()),
+            poses: None,
+            beats: self.beats.clone(),
+        }
+    }
+
+    /// Write samples `range` of `reference` (made by [`blank`](Targets::blank)) through
+    /// `warp`: sample k at time t takes the shaped tip at t + shift(t).
+    pub fn write(&self, warp: &Warp, reference: &mut Reference, range: Range<usize>) {
+        let rate = self.rate_hz;
+        let end = range.end.min(self.len());
+        for h in 0..2 {
+            let knots = &warp.knots[h];
+            // The first knot after the time: found once, then walked forward.
+            let mut next = knots.partition_point(|&(u, _)| u <= range.start as f64 / rate);
+            for k in range.start..end {
+                let t = k as f64 / rate;
+                while next < knots.len() && knots[next].0 <= t {
+                    next += 1;
+                }
+                let shift = match next {
+                    0 => knots.first().map_or(0.0, |p| p.1),
+                    i if i == knots.len() => knots[i - 1].1,
+                    i => {
+                        let ((t0, s0), (t1, s1)) = (knots[i - 1], knots[i]);
+                        s0 + (s1 - s0) * (t - t0) / (t1 - t0)
+                    }
+                };
+                reference.tips[h][k] = sample(&self.shaped[h], (t + shift) * rate);
             }
         }
-        (0..n)
-            .map(|k| {
-                let t = k as f64 / rate;
-                sample(&shaped, (t + shift_at(&mine, t)) * rate)
-            })
-            .collect()
-    });
-    let mut beats: Vec<(f64, usize)> = comp
-        .strokes
-        .iter()
-        .map(|s| (s.time_s - comp.start_s, s.beat))
-        .collect();
-    beats.sort_by(|a, b| a.0.total_cmp(&b.0));
-    Reference {
-        rate_hz: rate,
-        tips,
-        poses: None,
-        beats,
+    }
+
+    /// The whole reference through `warp`.
+    pub fn reference(&self, warp: &Warp) -> Reference {
+        let mut reference = self.blank();
+        self.write(warp, &mut reference, 0..self.len());
+        reference
     }
 }
 
-/// The shift at time `t` from a hand's (time, shift) points.
-fn shift_at(points: &[(f64, f64)], t: f64) -> f64 {
-    match points.iter().position(|&(u, _)| u > t) {
-        None => points.last().map_or(0.0, |p| p.1),
-        Some(0) => points[0].1,
-        Some(i) => {
-            let ((t0, d0), (t1, d1)) = (points[i - 1], points[i]);
-            d0 + (d1 - d0) * (t - t0) / (t1 - t0)
+/// Per hand, the shift (s; positive plays earlier) at knots (time from sample 0, shift)
+/// in time order: linear between knots, held before the first and after the last.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Warp {
+    pub knots: [Vec<(f64, f64)>; 2],
+}
+
+impl Default for Warp {
+    /// No shift, anchored at time 0.
+    fn default() -> Self {
+        Warp {
+            knots: [vec![(0.0, 0.0)], vec![(0.0, 0.0)]],
+        }
+    }
+}
+
+impl Warp {
+    /// Knots per hand: what [`truncate`](Warp::truncate) goes back to.
+    pub fn lens(&self) -> [usize; 2] {
+        [self.knots[0].len(), self.knots[1].len()]
+    }
+
+    /// Drop knots added since `lens`.
+    pub fn truncate(&mut self, lens: [usize; 2]) {
+        for (knots, len) in self.knots.iter_mut().zip(lens) {
+            knots.truncate(len);
+        }
+    }
+
+    /// The shift of `hand` after its last knot, s.
+    pub fn held(&self, hand: usize) -> f64 {
+        self.knots[hand].last().map_or(0.0, |k| k.1)
+    }
+
+    /// Add a knot to `hand` (at or after its last one).
+    pub fn push(&mut self, hand: usize, knot: (f64, f64)) {
+        debug_assert!(self.knots[hand].last().is_none_or(|k| k.0 <= knot.0));
+        self.knots[hand].push(knot);
+    }
+
+    /// Hold every hand's shift up to time `t_s` (later knots change nothing before it).
+    pub fn anchor(&mut self, t_s: f64) {
+        for h in 0..2 {
+            if self.knots[h].last().is_none_or(|k| k.0 < t_s) {
+                let held = self.held(h);
+                self.knots[h].push((t_s, held));
+            }
         }
     }
 }
 
 /// Linear interpolation of `points` at fractional index `x`, held at the ends.
-fn sample(points: &[glam::DVec3], x: f64) -> glam::DVec3 {
+fn sample(points: &[DVec3], x: f64) -> DVec3 {
     let last = points.len() - 1;
     let x = x.clamp(0.0, last as f64);
     let i = (x.floor() as usize).min(last.saturating_sub(1));
@@ -121,22 +287,54 @@ fn sample(points: &[glam::DVec3], x: f64) -> glam::DVec3 {
 mod tests {
     use super::*;
 
-    /// The warp interpolates between strokes and holds outside them.
+    fn targets(n: usize) -> Targets {
+        let line: Vec<DVec3> = (0..n).map(|k| DVec3::new(k as f64, 0.0, 1.0)).collect();
+        Targets {
+            rate_hz: 1.0,
+            raised: [line.clone(), line.clone()],
+            shaped: [line.clone(), line],
+            dips: Vec::new(),
+            beats: Vec::new(),
+        }
+    }
+
+    /// The warp holds before its first knot and after its last and interpolates between.
     #[test]
-    fn shift_interpolates_and_holds() {
-        let points = [(1.0, 0.01), (2.0, -0.01)];
-        assert_eq!(shift_at(&points, 0.0), 0.01);
-        assert!((shift_at(&points, 1.5) - 0.0).abs() < 1e-12);
-        assert_eq!(shift_at(&points, 3.0), -0.01);
-        assert_eq!(shift_at(&[], 3.0), 0.0);
+    fn warp_interpolates_and_holds() {
+        let t = targets(10);
+        let mut warp = Warp::default();
+        warp.push(0, (4.0, 2.0));
+        warp.anchor(6.0);
+        let r = t.reference(&warp);
+        let x: Vec<f64> = r.tips[0].iter().map(|p| p.x).collect();
+        // Shift 0 at 0, 1 at 2, 2 from 4 on (clamped at the end).
+        assert_eq!(x[0], 0.0);
+        assert_eq!(x[2], 3.0);
+        assert_eq!(x[5], 7.0);
+        assert_eq!(x[9], 9.0);
+        // The other hand is anchored at 0 and 6 with no shift.
+        assert!(r.tips[1].iter().enumerate().all(|(k, p)| p.x == k as f64));
+    }
+
+    /// Writing a range equals the same samples of a whole write.
+    #[test]
+    fn range_writes_match_whole() {
+        let t = targets(40);
+        let mut warp = Warp::default();
+        warp.push(1, (10.0, 0.5));
+        warp.push(1, (20.0, -1.5));
+        let whole = t.reference(&warp);
+        let mut part = t.blank();
+        t.write(&warp, &mut part, 13..27);
+        assert_eq!(whole.tips[1][13..27], part.tips[1][13..27]);
     }
 
     /// Sampling at a fractional index is linear and clamped.
     #[test]
     fn sampling_is_linear_and_clamped() {
-        let pts = [glam::DVec3::ZERO, glam::DVec3::X];
-        assert_eq!(sample(&pts, 0.25), glam::DVec3::new(0.25, 0.0, 0.0));
-        assert_eq!(sample(&pts, -3.0), glam::DVec3::ZERO);
-        assert_eq!(sample(&pts, 9.0), glam::DVec3::X);
+        let pts = [DVec3::ZERO, DVec3::X];
+        assert_eq!(sample(&pts, 0.25), DVec3::new(0.25, 0.0, 0.0));
+        assert_eq!(sample(&pts, -3.0), DVec3::ZERO);
+        assert_eq!(sample(&pts, 9.0), DVec3::X);
     }
 }

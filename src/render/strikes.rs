@@ -40,11 +40,23 @@ pub struct StrikeEvent {
 /// For each stroke, the index of its contact in `contacts` (whose times are in score
 /// seconds), or `None` if the stick never touched its drum near its time.
 pub fn match_strokes(strokes: &[PlannedStroke], contacts: &[ContactEvent]) -> Vec<Option<usize>> {
+    match_range(strokes, 0..strokes.len(), contacts, 0)
+}
+
+/// [`match_strokes`] for the strokes `which` only, among the contacts from index `from`
+/// on (returned indices are into all of `contacts`); the other strokes still narrow the
+/// windows.
+pub fn match_range(
+    strokes: &[PlannedStroke],
+    which: std::ops::Range<usize>,
+    contacts: &[ContactEvent],
+    from: usize,
+) -> Vec<Option<usize>> {
     let mut claimed = vec![false; contacts.len()];
-    strokes
+    strokes[which.clone()]
         .iter()
-        .enumerate()
-        .map(|(i, s)| {
+        .zip(which)
+        .map(|(s, i)| {
             let neighbour_gap = strokes
                 .iter()
                 .enumerate()
@@ -52,7 +64,7 @@ pub fn match_strokes(strokes: &[PlannedStroke], contacts: &[ContactEvent]) -> Ve
                 .map(|(_, o)| (o.time_s - s.time_s).abs())
                 .fold(f64::INFINITY, f64::min);
             let window = MATCH_WINDOW_S.min(0.5 * neighbour_gap);
-            let near: Vec<usize> = (0..contacts.len())
+            let near: Vec<usize> = (from.min(contacts.len())..contacts.len())
                 .filter(|&c| {
                     let e = &contacts[c];
                     !claimed[c]

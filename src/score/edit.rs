@@ -2,7 +2,7 @@
 //! `undo::Record` so every change can be undone and redone; consecutive moves of the same
 //! handle or beat merge, so one drag is one undo step.
 
-use super::{Beat, Handle, ImpactPin, Score, TempoPoint};
+use super::{Beat, Handle, ImpactPin, Score, Settings, TempoPoint};
 
 /// One change to a score.
 #[derive(Clone, Debug, PartialEq)]
@@ -46,6 +46,8 @@ pub enum ScoreEdit {
     /// Replace all beats at once (`after` in time order): a change of several beats
     /// (move, delete, paste, set mode of a selection) as one step.
     SetBeats { before: Vec<Beat>, after: Vec<Beat> },
+    /// Replace the performance and sound settings.
+    SetSettings { before: Settings, after: Settings },
 }
 
 impl ScoreEdit {
@@ -61,6 +63,7 @@ impl ScoreEdit {
             ScoreEdit::SetPin { .. } => "pin impact",
             ScoreEdit::SetTempo { .. } => "change tempo",
             ScoreEdit::SetBeats { .. } => "change beats",
+            ScoreEdit::SetSettings { .. } => "change settings",
         }
     }
 }
@@ -114,6 +117,7 @@ impl undo::Edit for ScoreEdit {
             }
             ScoreEdit::SetTempo { after, .. } => score.tempo = after.clone(),
             ScoreEdit::SetBeats { after, .. } => score.beats = after.clone(),
+            ScoreEdit::SetSettings { after, .. } => score.settings = after.clone(),
         }
     }
 
@@ -159,6 +163,7 @@ impl undo::Edit for ScoreEdit {
             }
             ScoreEdit::SetTempo { before, .. } => score.tempo = before.clone(),
             ScoreEdit::SetBeats { before, .. } => score.beats = before.clone(),
+            ScoreEdit::SetSettings { before, .. } => score.settings = before.clone(),
         }
     }
 
@@ -197,6 +202,16 @@ impl undo::Edit for ScoreEdit {
             (
                 ScoreEdit::SetTempo { after, .. },
                 ScoreEdit::SetTempo {
+                    before: new_before,
+                    after: new_after,
+                },
+            ) if *after == new_before => {
+                *after = new_after;
+                undo::Merged::Yes
+            }
+            (
+                ScoreEdit::SetSettings { after, .. },
+                ScoreEdit::SetSettings {
                     before: new_before,
                     after: new_after,
                 },

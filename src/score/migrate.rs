@@ -32,6 +32,7 @@ pub(super) fn from_v1(v1: ScoreV1) -> Score {
         beats: v1.beats,
         handles: Vec::new(),
         pins: Vec::new(),
+        settings: super::Settings::default(),
     }
 }
 

@@ -5,6 +5,7 @@
 pub mod edit;
 pub mod meter;
 mod migrate;
+pub mod settings;
 pub mod tempo;
 pub mod validate;
 
@@ -15,6 +16,7 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 pub use meter::{BarBeat, MeterChange, MeterMap};
+pub use settings::Settings;
 pub use tempo::{TempoChange, TempoMap, TempoPoint};
 
 /// The score file format this timpanist writes and the newest it reads.
@@ -308,6 +310,9 @@ pub struct Score {
     pub handles: Vec<Handle>,
     /// Impact points pinned by the user (format 2).
     pub pins: Vec<ImpactPin>,
+    /// How it is performed and heard (left out of the file when default).
+    #[serde(default, skip_serializing_if = "Settings::is_default")]
+    pub settings: Settings,
 }
 
 /// A score together with its kit, as loaded from disk.
@@ -343,6 +348,7 @@ impl Score {
             beats: Vec::new(),
             handles: Vec::new(),
             pins: Vec::new(),
+            settings: Settings::default(),
         }
     }
 

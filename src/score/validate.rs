@@ -15,6 +15,7 @@ pub fn problems(score: &Score, kit: &Kit) -> Vec<Problem> {
             format!("expected {SCORE_FORMAT_VERSION}"),
         ));
     }
+    out.extend(score.settings.problems(kit));
     if !(24..=32767).contains(&score.ticks_per_quarter) {
         out.push(Problem::new(
             "ticks_per_quarter",

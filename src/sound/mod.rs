@@ -151,6 +151,18 @@ pub fn pan_gains(x_m: f64) -> (f64, f64) {
     (angle.cos(), angle.sin())
 }
 
+/// What a rendering of sound keeps to re-synthesise only from a change on: each drum's
+/// mono output and saved synthesis states (modal model), and the mix before
+/// normalisation.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SoundState {
+    model: SoundModel,
+    /// Per drum: mono output, saved states, whether anything touched it.
+    drums: Vec<(Vec<f32>, Vec<modal::Saved>, bool)>,
+    /// Interleaved stereo mix before the normalisation gain.
+    mix: Vec<f32>,
+}
+
 /// Render `duration_s` of sound from what `drums` recorded (excitation, contacts).
 pub fn render(
     kit: &Kit,
@@ -158,6 +170,20 @@ pub fn render(
     duration_s: f64,
     model: SoundModel,
 ) -> Result<Audio, SoundError> {
+    render_resuming(kit, drums, duration_s, model, None).map(|(audio, _)| audio)
+}
+
+/// [`render`], re-synthesising only from `changed_s` on when `previous` (of the same kit
+/// and model) is given: `drums` must have recorded the same excitation before
+/// `changed_s` (score seconds) as the rendering that left `previous`. Bit for bit a whole
+/// render. Only the modal model resumes; the others render whole.
+pub fn render_resuming(
+    kit: &Kit,
+    drums: &DrumSet,
+    duration_s: f64,
+    model: SoundModel,
+    previous: Option<(SoundState, f64)>,
+) -> Result<(Audio, SoundState), SoundError> {
     if !(duration_s.is_finite() && (0.0..=86_400.0).contains(&duration_s)) {
         return Err(SoundError::Duration(duration_s));
     }
@@ -167,28 +193,67 @@ pub fn render(
             kit: kit.drums.len(),
         });
     }
-    let frames = (duration_s * f64::from(SAMPLE_RATE_HZ)).round() as usize;
-    let mut samples = vec![0.0f32; 2 * frames];
-    let mut mono = vec![0.0f32; frames];
+    let fs = f64::from(SAMPLE_RATE_HZ);
+    let frames = (duration_s * fs).round() as usize;
+    // Frames before `from` hear only unchanged excitation (an entry's kernel reaches one
+    // simulation step before its time).
+    let (mut state, from) = match previous {
+        Some((state, changed_s))
+            if model == SoundModel::Modal
+                && state.model == model
+                && state.drums.len() == kit.drums.len() =>
+        {
+            let from = ((changed_s - 2.0 * drums.dt_s()) * fs).floor().max(0.0) as usize;
+            (state, from)
+        }
+        _ => (
+            SoundState {
+                model,
+                drums: vec![(Vec::new(), Vec::new(), false); kit.drums.len()],
+                mix: Vec::new(),
+            },
+            0,
+        ),
+    };
+    // The first frame any drum re-synthesises from.
+    let mut start = frames;
     for (j, drum) in kit.drums.iter().enumerate() {
-        mono.fill(0.0);
-        let heard = match model {
-            SoundModel::Modal => modal::render_drum(drums, j, &mut mono),
-            SoundModel::Sample => sample::render_drum(drum, drums, j, &mut mono)?,
-            SoundModel::Signal => signal::render_drum(drums, j, &mut mono),
+        let (mono, saved, heard) = &mut state.drums[j];
+        mono.resize(frames, 0.0);
+        *heard = match model {
+            SoundModel::Modal => {
+                start = start.min(modal::resume_frame(saved, from));
+                modal::render_drum_from(drums, j, mono, saved, from)
+            }
+            SoundModel::Sample => {
+                mono.fill(0.0);
+                start = 0;
+                sample::render_drum(drum, drums, j, mono)?
+            }
+            SoundModel::Signal => {
+                mono.fill(0.0);
+                start = 0;
+                signal::render_drum(drums, j, mono)
+            }
         };
+    }
+    let start = start.min(frames);
+    let mix = &mut state.mix;
+    mix.resize(2 * frames, 0.0);
+    mix[2 * start..].fill(0.0);
+    for (drum, (mono, _, heard)) in kit.drums.iter().zip(&state.drums) {
         if !heard {
             continue;
         }
         let (l, r) = pan_gains(drum.placement.x_m);
         let (l, r) = (l as f32, r as f32);
-        for (frame, &s) in samples.chunks_exact_mut(2).zip(&mono) {
+        for (frame, &s) in mix[2 * start..].chunks_exact_mut(2).zip(&mono[start..]) {
             frame[0] += l * s;
             frame[1] += r * s;
         }
     }
     let mut peak = 0.0f32;
-    for (i, s) in samples.iter().enumerate() {
+    for (i, s) in mix.iter().enumerate() {
         if !s.is_finite() {
             return Err(SoundError::NonFinite {
                 model,
@@ -202,15 +267,16 @@ pub fn render(
     } else {
         1.0
     };
-    if gain < 1.0 {
-        for s in &mut samples {
-            *s = (f64::from(*s) * gain) as f32;
-        }
-    }
-    Ok(Audio {
+    let samples = if gain < 1.0 {
+        mix.iter().map(|s| (f64::from(*s) * gain) as f32).collect()
+    } else {
+        mix.clone()
+    };
+    let audio = Audio {
         rate_hz: SAMPLE_RATE_HZ,
         channels: 2,
         samples,
         gain,
-    })
+    };
+    Ok((audio, state))
 }

@@ -11,7 +11,7 @@
 //! in the simulation).
 
 use super::SAMPLE_RATE_HZ;
-use super::voices::{Voice, VoiceBank};
+use super::voices::{BankState, Voice, VoiceBank};
 use crate::drum::{DrumSet, HeadModes, Orientation};
 
 /// Output per unit of Σ gain × modal velocity, 1/(m/s): an ff strike (3.5 m/s) at the
@@ -45,9 +45,47 @@ pub fn voices_for(head: &HeadModes, calibration: f64) -> (Vec<usize>, Vec<Voice>
         .unzip()
 }
 
+/// Blocks between saved synthesis states (8192 frames, 0.17 s).
+const SAVE_EVERY_BLOCKS: usize = 64;
+
+/// A drum's synthesis state at the start of a block: where re-synthesis can resume.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Saved {
+    /// First frame of the block.
+    pub frame: usize,
+    bank: BankState,
+    silent: bool,
+}
+
+/// The frame synthesis resumes from with states `saved`, for a change at frame `from`.
+pub fn resume_frame(saved: &[Saved], from: usize) -> usize {
+    saved
+        .iter()
+        .rev()
+        .find(|s| s.frame <= from)
+        .map_or(0, |s| s.frame)
+}
+
 /// Render drum `j`'s sound into `out` (mono, 48 kHz, from t = 0). Returns whether anything
 /// touched the drum.
 pub fn render_drum(drums: &DrumSet, j: usize, out: &mut [f32]) -> bool {
+    render_drum_from(drums, j, out, &mut Vec::new(), 0)
+}
+
+/// [`render_drum`] again after the drum's record changed from frame `from` on: `out`
+/// holds the previous output and `saved` its saved states; synthesis resumes from the
+/// latest state at or before `from` (the output before it is kept) and saves new states
+/// as it goes. The result is bit for bit a whole [`render_drum`].
+pub fn render_drum_from(
+    drums: &DrumSet,
+    j: usize,
+    out: &mut [f32],
+    saved: &mut Vec<Saved>,
+    from: usize,
+) -> bool {
+    let start = resume_frame(saved, from).min(out.len());
+    saved.retain(|s| s.frame <= start);
+    out[start..].fill(0.0);
     let Some(head) = drums.head(j) else {
         return false;
     };
@@ -58,6 +96,11 @@ pub fn render_drum(drums: &DrumSet, j: usize, out: &mut [f32]) -> bool {
     entries.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
     let (index, voices) = voices_for(head, MODAL_CALIBRATION);
     let mut bank = VoiceBank::new(&voices, f64::from(SAMPLE_RATE_HZ));
+    let mut silent = true;
+    if let Some(s) = saved.pop() {
+        bank.restore(&s.bank);
+        silent = s.silent;
+    }
     let stride = bank.stride();
     let fs = f64::from(SAMPLE_RATE_HZ);
     let dt = drums.dt_s();
@@ -72,8 +115,14 @@ pub fn render_drum(drums: &DrumSet, j: usize, out: &mut [f32]) -> bool {
         (c, lo, hi)
     };
     let mut first = 0;
-    let mut silent = true;
-    for n0 in (0..out.len()).step_by(BLOCK) {
+    for n0 in (start..out.len()).step_by(BLOCK) {
+        if n0.is_multiple_of(SAVE_EVERY_BLOCKS * BLOCK) {
+            saved.push(Saved {
+                frame: n0,
+                bank: bank.state(),
+                silent,
+            });
+        }
         let n1 = (n0 + BLOCK).min(out.len());
         while first < entries.len() && span(entries[first].time_s).2 <= n0 {
             first += 1;

@@ -21,6 +21,13 @@ pub struct Voice {
     pub gain: f64,
 }
 
+/// The state of a [`VoiceBank`]'s voices.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BankState {
+    x1: Vec<Lane>,
+    x2: Vec<Lane>,
+}
+
 /// A bank of resonators with state (ω₀q, q̇) per voice; padding lanes stay at zero.
 #[derive(Clone, Debug)]
 pub struct VoiceBank {
@@ -65,6 +72,20 @@ impl VoiceBank {
             bank.gain[c][l] = v.gain as f32;
         }
         bank
+    }
+
+    /// The voices' state, to [`restore`](VoiceBank::restore) later.
+    pub fn state(&self) -> BankState {
+        BankState {
+            x1: self.x1.clone(),
+            x2: self.x2.clone(),
+        }
+    }
+
+    /// Go back to a state saved from a bank of the same voices.
+    pub fn restore(&mut self, state: &BankState) {
+        self.x1.clone_from(&state.x1);
+        self.x2.clone_from(&state.x2);
     }
 
     /// Number of voices.

@@ -1,0 +1,411 @@
+//! Strikes on the beat (issue 6 §5), settled front to back. The simulated body lags its
+//! targets, so each stroke's target is played earlier by however late its contact was,
+//! and aims deeper or shallower until its peak force meets its dynamic's. Strokes closer
+//! than [`CLUSTER_GAP_S`] (either hand) are settled together: from a saved state before
+//! the cluster, the body and the drums are simulated a little past its last stroke, the
+//! contacts measured, the cluster's shifts and depths corrected and the span simulated
+//! again, a few times; the best attempt is kept and the performance moves on. Each
+//! cluster starts from its predecessors' settled shifts and depths (same hand, mode and
+//! dynamic), so repeated material settles at once.
+//!
+//! Every cluster start is a [`Commit`]: the performance can rewind there and resume with
+//! a changed score — bit for bit what a whole rendering of it would give, as long as
+//! nothing before the commit changed (the editor's re-simulation after an edit).
+
+use super::reference::{Targets, Warp};
+use super::strikes;
+use crate::body::sim::{Checkpoint, Environment, Reference, SimError, Simulator};
+use crate::drum::{DrumCheckpoint, DrumSet};
+use crate::motion::plan::PlannedStroke;
+use glam::DVec3;
+use std::ops::Range;
+use std::time::{Duration, Instant};
+
+/// Strokes closer together than this, s, are settled together.
+pub const CLUSTER_GAP_S: f64 = 0.09;
+/// How far past a cluster's last stroke its attempts simulate, s.
+const LOOKAHEAD_S: f64 = 0.035;
+/// The most a stroke's target is played earlier or later, s (with the gap and the
+/// look-ahead, it keeps the next cluster's dips out of a cluster's targets).
+const MAX_SHIFT_S: f64 = 0.035;
+/// The shift moves to a cluster's over at most this long before its first dip, s.
+const TRANSITION_S: f64 = 0.06;
+
+/// What each stroke aims for and when a cluster is settled.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Aims {
+    /// Peak contact force aimed at per stroke, N.
+    pub force_n: Vec<f64>,
+    /// A stroke's force counts as met within this fraction of its aim.
+    pub force_tolerance: f64,
+    /// A cluster is settled once every contact is this close to its time, s, and every
+    /// force met...
+    pub tolerance_s: f64,
+    /// ...or, from attempt `settle_attempts` on, every contact this close, s...
+    pub acceptable_s: f64,
+    pub settle_attempts: usize,
+    /// ...or after this many attempts (the best is kept).
+    pub max_attempts: usize,
+    /// Depth of a stroke with no settled predecessor, m.
+    pub first_depth_m: f64,
+}
+
+/// A cluster start the performance can resume from.
+#[derive(Clone, Debug)]
+pub struct Commit {
+    /// Strokes settled before it.
+    pub strokes: usize,
+    /// Task-rate samples simulated before it.
+    pub samples: usize,
+    /// Samples simulated before its lead-in.
+    lead_from: usize,
+    sim: Checkpoint,
+    drums: DrumCheckpoint,
+    warp: [usize; 2],
+}
+
+/// The drums as the simulated body meets them, in score time, timed, with progress.
+pub struct Stage<'a> {
+    /// Score time of the reference's sample 0, s.
+    pub start_s: f64,
+    /// Wall time spent in the drums so far.
+    pub drum_time: Duration,
+    /// Told the fraction of the score simulated; `false` cancels.
+    pub report: &'a mut dyn FnMut(f64) -> bool,
+}
+
+struct Meeting<'a, 'b> {
+    drums: &'a mut DrumSet,
+    stage: &'a mut Stage<'b>,
+}
+
+impl Environment for Meeting<'_, '_> {
+    fn tip_forces(&mut self, time_s: f64, tips: [(DVec3, DVec3); 2]) -> [DVec3; 2] {
+        let began = Instant::now();
+        let forces = self.drums.step(self.stage.start_s + time_s, tips);
+        self.stage.drum_time += began.elapsed();
+        forces
+    }
+
+    fn progress(&mut self, done: usize, total: usize) -> bool {
+        !done.is_multiple_of(64) || (self.stage.report)(done as f64 / total.max(1) as f64)
+    }
+}
+
+/// A performance of a composition, settled up to some stroke.
+#[derive(Clone, Debug)]
+pub struct Performance {
+    pub targets: Targets,
+    pub warp: Warp,
+    /// The targets followed so far (written as far as simulated, plus one sample).
+    pub reference: Reference,
+    pub sim: Simulator,
+    pub drums: DrumSet,
+    /// Per stroke, how much earlier its target is played, s.
+    pub shift_s: Vec<f64>,
+    /// Strokes settled.
+    pub settled: usize,
+    /// Each settled cluster's start.
+    pub commits: Vec<Commit>,
+    /// Simulation attempts over clusters, and task-rate samples simulated in all.
+    pub attempts: usize,
+    pub simulated_samples: usize,
+}
+
+impl Performance {
+    /// A performance of `targets` about to start, `sim` and `drums` at rest.
+    pub fn new(targets: Targets, sim: Simulator, drums: DrumSet, strokes: usize) -> Self {
+        let reference = targets.blank();
+        Performance {
+            targets,
+            warp: Warp::default(),
+            reference,
+            sim,
+            drums,
+            shift_s: vec![0.0; strokes],
+            settled: 0,
+            commits: Vec::new(),
+            attempts: 0,
+            simulated_samples: 0,
+        }
+    }
+
+    /// Go back to commit `index` and continue with `targets` (of a changed score whose
+    /// strokes before the commit, and targets up to its samples, are unchanged).
+    pub fn resume_at(&mut self, index: usize, mut targets: Targets, strokes: usize) {
+        let commit = self.commits[index].clone();
+        self.commits.truncate(index);
+        self.sim.rewind(&commit.sim);
+        self.drums.rewind(&commit.drums);
+        self.warp.truncate(commit.warp);
+        for i in 0..commit.strokes {
+            targets.set_depth(i, self.targets.depth(i));
+        }
+        self.shift_s.resize(strokes, 0.0);
+        self.targets = targets;
+        self.reference = self.targets.blank();
+        self.targets
+            .write(&self.warp, &mut self.reference, 0..commit.samples + 1);
+        self.settled = commit.strokes;
+        self.attempts = 0;
+        self.simulated_samples = 0;
+    }
+
+    /// The latest commit from which the score of `new` strokes and `targets` can resume,
+    /// the performance having played `old` strokes: every stroke before it unchanged, the
+    /// cluster starting there as it did, and the targets unchanged up to
+    /// `same_until` samples, beyond what the commit's targets read.
+    pub fn resumable(
+        &self,
+        old: &[PlannedStroke],
+        new: &[PlannedStroke],
+        targets: &Targets,
+        same_until: usize,
+    ) -> Option<usize> {
+        let clusters = clusters(new);
+        let rate = self.reference.rate_hz;
+        (0..self.commits.len()).rev().find(|&c| {
+            let commit = &self.commits[c];
+            let k = commit.strokes;
+            // The warp reads at most the largest shift (plus a sample) ahead.
+            let reads = commit.samples + 2 + (MAX_SHIFT_S * rate).ceil() as usize;
+            reads < same_until
+                && k <= new.len()
+                && k <= old.len()
+                && old[..k] == new[..k]
+                && targets.same_dips(&self.targets, k)
+                && clusters.iter().find(|r| r.start == k).is_some_and(|r| {
+                    lead_in(targets, r.clone(), rate, commit.lead_from) == commit.samples
+                })
+        })
+    }
+
+    /// Settle every stroke from `self.settled` on and simulate to the end; or, given a
+    /// `horizon` (samples), stop before the first cluster that starts after it. Returns
+    /// whether the performance is complete.
+    pub fn run(
+        &mut self,
+        strokes: &[PlannedStroke],
+        aims: &Aims,
+        stage: &mut Stage,
+        horizon: Option<usize>,
+    ) -> Result<bool, SimError> {
+        let rate = self.reference.rate_hz;
+        for cluster in clusters(strokes) {
+            if cluster.start < self.settled {
+                continue;
+            }
+            let now = self.sim.samples();
+            let lead = lead_in(&self.targets, cluster.clone(), rate, now);
+            if let Some(h) = horizon.filter(|&h| lead > h) {
+                // Up to the horizon the shifts are held as the lead-in would hold them.
+                if h > now {
+                    self.targets
+                        .write(&self.warp, &mut self.reference, now..h + 1);
+                    self.advance(h, stage)?;
+                }
+                return Ok(false);
+            }
+            self.settle(cluster, strokes, aims, stage)?;
+        }
+        let (now, n) = (self.sim.samples(), self.targets.len());
+        self.warp.anchor(now as f64 / rate);
+        self.targets.write(&self.warp, &mut self.reference, now..n);
+        self.advance(n, stage)?;
+        Ok(true)
+    }
+
+    fn advance(&mut self, until: usize, stage: &mut Stage) -> Result<(), SimError> {
+        let from = self.sim.samples();
+        let mut meeting = Meeting {
+            drums: &mut self.drums,
+            stage,
+        };
+        self.sim.advance(&mut meeting, &self.reference, until)?;
+        self.simulated_samples += self.sim.samples().saturating_sub(from);
+        Ok(())
+    }
+
+    /// Start each stroke of `cluster` from the settled shift and depth of the latest
+    /// earlier stroke of its hand with its mode and dynamic (else of its hand).
+    fn warm_start(&mut self, cluster: Range<usize>, strokes: &[PlannedStroke], first_depth: f64) {
+        for i in cluster {
+            let s = &strokes[i];
+            let settled = &strokes[..self.settled];
+            let alike =
+                |o: &PlannedStroke| o.hand == s.hand && o.mode == s.mode && o.dynamic == s.dynamic;
+            let from = settled
+                .iter()
+                .rposition(alike)
+                .or_else(|| settled.iter().rposition(|o| o.hand == s.hand));
+            let (shift, depth) = from.map_or((0.0, first_depth), |j| {
+                (self.shift_s[j], self.targets.depth(j))
+            });
+            self.shift_s[i] = shift;
+            self.targets.set_depth(i, depth);
+        }
+    }
+
+    /// The cluster's knots in the warp and its targets in the reference up to `until`.
+    fn place(&mut self, cluster: Range<usize>, commit: &Commit, until: usize) {
+        self.warp.truncate(commit.warp);
+        for i in cluster {
+            let hand = self.targets.hand(i);
+            for knot in self.targets.knots(i, self.shift_s[i]) {
+                self.warp.push(hand, knot);
+            }
+        }
+        self.targets
+            .write(&self.warp, &mut self.reference, commit.samples..until + 2);
+    }
+
+    fn settle(
+        &mut self,
+        cluster: Range<usize>,
+        strokes: &[PlannedStroke],
+        aims: &Aims,
+        stage: &mut Stage,
+    ) -> Result<(), SimError> {
+        let rate = self.reference.rate_hz;
+        let n = self.targets.len();
+        self.warm_start(cluster.clone(), strokes, aims.first_depth_m);
+        // Lead-in: hold the shifts until shortly before the cluster's first dip, simulated
+        // once.
+        let now = self.sim.samples();
+        let lead = lead_in(&self.targets, cluster.clone(), rate, now);
+        self.warp.anchor(lead as f64 / rate);
+        if lead > now {
+            self.targets
+                .write(&self.warp, &mut self.reference, now..lead + 1);
+            self.advance(lead, stage)?;
+        }
+        let commit = Commit {
+            strokes: cluster.start,
+            lead_from: now,
+            samples: self.sim.samples(),
+            sim: self.sim.checkpoint(),
+            drums: self.drums.checkpoint(),
+            warp: self.warp.lens(),
+        };
+        self.commits.push(commit.clone());
+        let last_s = self.targets.knots(cluster.end - 1, 0.0)[1].0;
+        let until = (((last_s + LOOKAHEAD_S) * rate).ceil() as usize).clamp(commit.samples, n);
+        type Attempt = ((usize, f64), Vec<f64>, Vec<f64>, usize);
+        let mut best: Option<Attempt> = None;
+        let mut attempt = 0;
+        loop {
+            attempt += 1;
+            if attempt > 1 {
+                self.sim.rewind(&commit.sim);
+                self.drums.rewind(&commit.drums);
+            }
+            self.place(cluster.clone(), &commit, until);
+            self.advance(until, stage)?;
+            self.attempts += 1;
+            let contacts = self.drums.contacts();
+            let matches =
+                strikes::match_range(strokes, cluster.clone(), contacts, commit.drums.contacts());
+            let mut missed = 0;
+            let mut worst = 0.0f64;
+            let mut on_force = true;
+            // Strokes whose force is off its aim by more than a factor of two.
+            let mut far_off = 0;
+            for (i, m) in cluster.clone().zip(&matches) {
+                match m {
+                    Some(c) => {
+                        worst = worst.max((contacts[*c].start_s - strokes[i].time_s).abs());
+                        let ratio = contacts[*c].peak_force_n / aims.force_n[i];
+                        on_force &= (ratio - 1.0).abs() <= aims.force_tolerance;
+                        if !(0.5..=2.0).contains(&ratio) {
+                            far_off += 1;
+                        }
+                    }
+                    None => missed += 1,
+                }
+            }
+            let key = (missed + far_off, worst);
+            if best.as_ref().is_none_or(|b| key <= b.0) {
+                best = Some((
+                    key,
+                    self.shift_s[cluster.clone()].to_vec(),
+                    cluster.clone().map(|i| self.targets.depth(i)).collect(),
+                    attempt,
+                ));
+            }
+            let on_time = missed == 0 && worst <= aims.tolerance_s;
+            let acceptable = missed + far_off == 0
+                && worst <= aims.acceptable_s
+                && attempt >= aims.settle_attempts;
+            if (on_time && on_force) || acceptable || attempt >= aims.max_attempts {
+                break;
+            }
+            let contacts = contacts.to_vec();
+            for (i, m) in cluster.clone().zip(matches) {
+                self.correct(i, m.map(|c| &contacts[c]), strokes[i].time_s, aims);
+            }
+        }
+        let (_, shifts, depths, kept) = best.expect("one attempt ran");
+        if kept != attempt {
+            for ((i, shift), depth) in cluster.clone().zip(shifts).zip(depths) {
+                self.shift_s[i] = shift;
+                self.targets.set_depth(i, depth);
+            }
+            self.sim.rewind(&commit.sim);
+            self.drums.rewind(&commit.drums);
+            self.place(cluster.clone(), &commit, until);
+            self.advance(until, stage)?;
+        }
+        self.settled = cluster.end;
+        Ok(())
+    }
+
+    /// Late contacts play their target earlier; weak strokes aim deeper (the felt's Hertz
+    /// force grows about as the square of how far the hand drives through). A deeper aim
+    /// reaches the head earlier, by about the extra depth over the impact speed: the shift
+    /// allows for that so the two corrections do not fight.
+    fn correct(
+        &mut self,
+        i: usize,
+        contact: Option<&crate::drum::ContactEvent>,
+        scheduled_s: f64,
+        aims: &Aims,
+    ) {
+        let aim = aims.force_n[i];
+        let mut shift = self.shift_s[i] + contact.map_or(0.0, |c| c.start_s - scheduled_s);
+        let force = contact.map(|c| c.peak_force_n);
+        if !force.is_some_and(|f| (f / aim - 1.0).abs() <= aims.force_tolerance) {
+            let old = self.targets.depth(i);
+            let ratio = force.map_or(2.0, |f| (aim / f.max(1e-3)).sqrt().clamp(0.6, 1.6));
+            let depth = (old * ratio).clamp(0.002, 0.06);
+            if let Some(c) = contact {
+                shift -= (depth - old) / c.impact_speed_mps.max(0.5);
+            }
+            self.targets.set_depth(i, depth);
+        }
+        self.shift_s[i] = shift.clamp(-MAX_SHIFT_S, MAX_SHIFT_S);
+    }
+}
+
+/// Where the lead-in to `cluster` ends, from `now` samples: shortly before its first dip.
+fn lead_in(targets: &Targets, cluster: Range<usize>, rate: f64, now: usize) -> usize {
+    let first_knot = cluster
+        .map(|i| targets.knots(i, 0.0)[0].0)
+        .fold(f64::INFINITY, f64::min);
+    (((first_knot - TRANSITION_S) * rate).floor().max(0.0) as usize).max(now)
+}
+
+/// The strokes (in time order) split where consecutive ones are at least
+/// [`CLUSTER_GAP_S`] apart.
+pub fn clusters(strokes: &[PlannedStroke]) -> Vec<Range<usize>> {
+    let mut out = Vec::new();
+    let mut start = 0;
+    for i in 1..=strokes.len() {
+        if i == strokes.len() || strokes[i].time_s - strokes[i - 1].time_s >= CLUSTER_GAP_S {
+            if i > start {
+                out.push(start..i);
+            }
+            start = i;
+        }
+    }
+    out
+}
