@@ -1,24 +1,60 @@
 //! The render pipeline off the UI thread: after each composition request the latest score
 //! is rendered (body + drums + sound, `crate::render`) on one long-lived worker; a newer
 //! request cancels the render in progress. The UI polls once per frame and hands the audio
-//! to playback and the simulated poses to the 3D view.
+//! to playback, the simulated poses to the 3D view and the whole rendering to the plots
+//! and to File > Export.
 
 use super::pose::Simulated;
 use crate::kit::Kit;
 use crate::mocap::db::MotionDb;
-use crate::render::{RenderParams, render};
+use crate::render::{RenderParams, Rendering, render};
 use crate::score::{LoadedScore, Score};
 use eframe::egui;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex, mpsc};
 
-/// A finished render, ready for playback and the view.
+/// A finished render, ready for playback, the view, the plots and export.
 pub struct Rendered {
-    /// Stereo interleaved 48 kHz audio from score time 0.
-    pub audio: Vec<f32>,
+    /// Everything the pipeline produced (shared with the plots and export).
+    pub rendering: Arc<Rendering>,
     pub simulated: Simulated,
     /// One line for the status bar.
     pub summary: String,
+}
+
+impl Rendered {
+    /// The parts of `rendering` the editor uses.
+    pub fn new(rendering: Arc<Rendering>) -> Rendered {
+        let r = &rendering;
+        let t = &r.timing;
+        let summary = format!(
+            "rendered: {} strokes, timing median {:.1} ms, worst {:.1} ms{}",
+            t.strokes,
+            t.median_abs_s * 1e3,
+            t.worst_abs_s * 1e3,
+            if t.missed > 0 {
+                format!(", {} missed", t.missed)
+            } else {
+                String::new()
+            }
+        );
+        let simulated = Simulated {
+            start_s: r.start_s,
+            rate_hz: r.motion.rate_hz,
+            poses: r.motion.poses.clone(),
+            tips: r.motion.tips.clone(),
+        };
+        Rendered {
+            rendering,
+            simulated,
+            summary,
+        }
+    }
+
+    /// Stereo interleaved 48 kHz audio from score time 0.
+    pub fn audio(&self) -> &[f32] {
+        &self.rendering.audio.samples
+    }
 }
 
 struct Request {
@@ -165,25 +201,5 @@ fn run(request: &Request, db: &MotionDb, latest: &AtomicU64) -> Result<Rendered,
         crate::render::RenderError::Cancelled => CANCELLED.to_string(),
         e => e.to_string(),
     })?;
-    let summary = format!(
-        "rendered: {} strokes, timing median {:.1} ms, worst {:.1} ms{}",
-        r.timing.strokes,
-        r.timing.median_abs_s * 1e3,
-        r.timing.worst_abs_s * 1e3,
-        if r.timing.missed > 0 {
-            format!(", {} missed", r.timing.missed)
-        } else {
-            String::new()
-        }
-    );
-    Ok(Rendered {
-        audio: r.audio.samples,
-        simulated: Simulated {
-            start_s: r.start_s,
-            rate_hz: r.motion.rate_hz,
-            poses: r.motion.poses,
-            tips: r.motion.tips,
-        },
-        summary,
-    })
+    Ok(Rendered::new(Arc::new(r)))
 }
