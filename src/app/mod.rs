@@ -1,20 +1,23 @@
 //! The eframe editor (issue #7): a timeline with a tempo lane, a 3D viewport with
-//! trajectory handles, an inspector and a tip-height plot over one document, the score.
+//! trajectory handles, an inspector and tabs of plots over one document, the score.
 //! Panels read the score and push [`Command`]s; the app drains them once per frame,
 //! applying every change through the undo history (one gesture, one step) and asking the
-//! composing worker for fresh trajectories. Files, recent files, drag and drop, the
-//! keyboard and the playback clock live in their own modules.
+//! composing and rendering workers for fresh trajectories, sound and motion. Files,
+//! recent files, drag and drop, the keyboard, the playback clock, the plots and export
+//! live in their own modules.
 
 mod camera;
 mod clipboard;
 mod command;
 mod composer;
+mod export;
 mod files;
 mod history;
 mod inspector;
 mod keys;
 pub mod picking;
 pub mod playback;
+mod plots;
 mod pose;
 mod recent;
 mod renderer;
@@ -23,12 +26,13 @@ mod settings_panel;
 mod tempo_lane;
 mod time_axis;
 mod timeline;
-mod tips_plot;
 mod viewport;
 
 pub use camera::Camera;
+pub use export::Export;
 pub use files::{FileKind, kind_of};
 pub use keys::Action;
+pub use plots::Tab as PlotTab;
 pub use pose::Simulated;
 pub use recent::RecentFiles;
 pub use selection::Selection;
@@ -37,6 +41,7 @@ pub use viewport::head_displacement;
 
 use crate::kit::Kit;
 use crate::motion::compose::Composition;
+use crate::render::Rendering;
 use crate::score::edit::ScoreEdit;
 use crate::score::{Hand, LoadedScore, Score};
 use clipboard::Clipboard;
@@ -46,6 +51,7 @@ use eframe::egui;
 use history::History;
 use playback::Playback;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// The demo score opened when no file is given (compiled in, so it opens anywhere).
 pub const DEMO_SCORE_PATH: &str = "scores/etude-modes.ron";
@@ -123,7 +129,13 @@ pub struct EditorApp {
     ik: pose::IkPose,
     /// The simulated performance, once the render pipeline provides one.
     simulated: Option<Simulated>,
-    plot: tips_plot::TipsPlot,
+    /// The latest rendering received (possibly of an older version while re-rendering).
+    rendering: Option<Arc<Rendering>>,
+    /// Counts renderings received (for the plots' caches).
+    rendering_id: u64,
+    /// Whether `rendering` is of the score as it is now (what File > Export needs).
+    rendering_current: bool,
+    plots: plots::Plots,
     recent: RecentFiles,
     show_help: bool,
     confirm: Option<AfterConfirm>,
@@ -167,7 +179,10 @@ impl EditorApp {
             viewport: viewport::Viewport::default(),
             ik: pose::IkPose::default(),
             simulated: None,
-            plot: tips_plot::TipsPlot::default(),
+            rendering: None,
+            rendering_id: 0,
+            rendering_current: false,
+            plots: plots::Plots::default(),
             recent: RecentFiles::load(options.recent_store),
             show_help: false,
             confirm: None,
@@ -285,6 +300,83 @@ impl EditorApp {
         self.simulated = simulated;
     }
 
+    /// Take `rendering` as the rendering of the score as it is now, as if the render
+    /// pipeline had just delivered it: its audio to playback, its body to the 3D view, all
+    /// of it to the plots and File > Export (the seam for tests and batch use).
+    pub fn set_rendering(&mut self, rendering: Arc<Rendering>) {
+        self.accept_rendering(renderer::Rendered::new(rendering), true);
+    }
+
+    /// The latest rendering received, if any (possibly of an older version of the score).
+    pub fn rendering(&self) -> Option<&Arc<Rendering>> {
+        self.rendering.as_ref()
+    }
+
+    /// Why File > Export is unavailable now, or `None` when the current rendering can be
+    /// exported.
+    pub fn export_blocked(&self) -> Option<String> {
+        if self.doc.is_none() {
+            return Some("no score is open".into());
+        }
+        export::RenderState {
+            rendering: self.rendering.as_deref(),
+            current: self.rendering_current,
+            busy: self.renderer.as_ref().is_some_and(|r| r.is_busy()),
+            enabled: self.renderer.is_some(),
+            error: self.render_error.as_deref(),
+        }
+        .blocked()
+    }
+
+    /// Export the current rendering's sound as a WAV at `path` (File > Export WAV without
+    /// the dialog); the outcome goes to the status bar, or the error to the window.
+    pub fn export_wav_to(&mut self, path: &Path) {
+        self.export_to(Export::Wav, path);
+    }
+
+    /// Export the current rendering's motion as CSV at `path` (File > Export motion CSV
+    /// without the dialog); the outcome goes to the status bar, or the error to the window.
+    pub fn export_motion_to(&mut self, path: &Path) {
+        self.export_to(Export::Motion, path);
+    }
+
+    fn export_to(&mut self, what: Export, path: &Path) {
+        if let Some(why) = self.export_blocked() {
+            self.error = Some(format!("cannot export: {why}"));
+            return;
+        }
+        let Some(r) = &self.rendering else { return };
+        match export::write(what, r, path) {
+            Ok(done) => self.status = done,
+            Err(e) => self.error = Some(e),
+        }
+    }
+
+    /// Ask where to export, then export.
+    fn export_dialog(&mut self, what: Export) {
+        let Some(doc) = &self.doc else { return };
+        if let Some(p) = export::ask_path(what, doc.path.as_deref(), &doc.loaded.score.title) {
+            self.export_to(what, &p);
+        }
+    }
+
+    /// The open plot tab.
+    pub fn plot_tab(&self) -> PlotTab {
+        self.plots.tab
+    }
+
+    /// Screen position of score time `t_s` on the open plot tab's first time plot, as drawn
+    /// last frame (none when the tab shows no time plot).
+    pub fn plot_point(&self, t_s: f64) -> Option<egui::Pos2> {
+        self.plots.screen_of(t_s)
+    }
+
+    /// The time window (s) of the open plot tab's first time plot, as drawn last frame: the
+    /// timeline's visible window (none when the tab shows no time plot).
+    pub fn plot_time_window(&self) -> Option<(f64, f64)> {
+        self.plots.time_window()
+    }
+
     fn open_demo(&mut self) {
         let on_disk = Path::new(DEMO_SCORE_PATH);
         if on_disk.exists() {
@@ -312,10 +404,14 @@ impl EditorApp {
         self.loop_ticks = None;
         self.timeline.fit();
         self.error = None;
+        self.simulated = None;
+        self.rendering = None;
+        self.render_error = None;
         self.recompose();
     }
 
     fn recompose(&mut self) {
+        self.rendering_current = false;
         match &self.doc {
             Some(d) => {
                 self.composer
@@ -328,23 +424,34 @@ impl EditorApp {
         }
     }
 
-    /// Take a finished render: its audio to playback, its body to the view.
+    /// Take a finished render: its audio to playback, its body to the view, all of it to
+    /// the plots and export.
     fn take_render(&mut self) {
-        let Some(done) = self.renderer.as_mut().and_then(|r| r.poll()) else {
+        let Some(renderer) = self.renderer.as_mut() else {
             return;
         };
+        let Some(done) = renderer.poll() else {
+            return;
+        };
+        // A newer request still running means this render is of an older version.
+        let current = !renderer.is_busy();
         match done {
-            Ok(r) => {
-                if let Err(e) = self.playback.set_audio(&r.audio) {
-                    self.render_error = Some(format!("playback: {e}"));
-                } else {
-                    self.render_error = None;
-                }
-                self.simulated = Some(r.simulated);
-                self.status = r.summary;
-            }
+            Ok(r) => self.accept_rendering(r, current),
             Err(e) => self.render_error = Some(format!("render: {e}")),
         }
+    }
+
+    fn accept_rendering(&mut self, r: renderer::Rendered, current: bool) {
+        if let Err(e) = self.playback.set_audio(r.audio()) {
+            self.render_error = Some(format!("playback: {e}"));
+        } else {
+            self.render_error = None;
+        }
+        self.simulated = Some(r.simulated);
+        self.rendering = Some(r.rendering);
+        self.rendering_id += 1;
+        self.rendering_current = current;
+        self.status = r.summary;
     }
 
     /// Open a score (`.ron`) or import a MIDI file (`.mid`); errors go to the window.
@@ -684,10 +791,18 @@ impl EditorApp {
                 item(ui, "Save  (Ctrl+S)", Action::Save);
                 item(ui, "Save As...  (Ctrl+Shift+S)", Action::SaveAs);
                 ui.separator();
-                ui.add_enabled(
-                    false,
-                    egui::Button::new("Export WAV / motion (needs the render pipeline)"),
-                );
+                let blocked = self.export_blocked();
+                for what in [Export::Wav, Export::Motion] {
+                    let button =
+                        ui.add_enabled(blocked.is_none(), egui::Button::new(what.menu_label()));
+                    let button = match &blocked {
+                        Some(why) => button.on_disabled_hover_text(format!("Unavailable: {why}")),
+                        None => button,
+                    };
+                    if button.clicked() {
+                        self.export_dialog(what);
+                    }
+                }
                 ui.separator();
                 if ui.button("Quit").clicked() {
                     ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
@@ -883,7 +998,7 @@ impl EditorApp {
         let loaded = &doc.loaded;
         let width = ui.available_width();
         let lanes_h = timeline::RULER_H + timeline::LANE_H * 3.0 + tempo_lane::TEMPO_H + 16.0;
-        let plot_h = 150.0;
+        let plot_h = 215.0;
         let view_h = (ui.available_height() - lanes_h - plot_h).max(220.0);
         let (rect, _) = ui.allocate_exact_size(egui::vec2(width, view_h), egui::Sense::hover());
         let comp = self.composer.composition();
@@ -911,7 +1026,9 @@ impl EditorApp {
                 generation: self.generation,
                 pose: pose.as_ref(),
                 simulated: self.simulated.as_ref().map(|s| &s.tips),
-                drums: self.simulated.as_ref().and_then(|s| s.drums.as_deref()),
+                drums: (self.simulated.as_ref())
+                    .and_then(|s| s.rendering.as_deref())
+                    .map(|r| &r.drums),
                 selection: &self.selection,
                 time_s: self.playhead_s,
             },
@@ -944,29 +1061,36 @@ impl EditorApp {
             );
         }
         ui.add_space(4.0);
-        match (comp, self.composer.error()) {
-            (_, Some(e)) => {
-                ui.label(format!("Composed stick tips unavailable: {e}"));
-            }
-            (Some(c), None) => {
-                let map = loaded.score.tempo_map();
-                let window = self.timeline.geometry.map(|g| {
-                    let t = |x: f32| map.seconds_at(g.axis.tick_of(f64::from(x)).max(0.0));
-                    (t(g.lanes.left()), t(g.lanes.right()))
-                });
-                if let Some(t) = self
-                    .plot
-                    .show(ui, c, self.generation, self.playhead_s, window)
-                {
-                    self.pending.push(Command::Seek(t));
-                }
-            }
-            (None, None) => {
-                ui.horizontal(|ui| {
-                    ui.spinner();
-                    ui.label("Composing stick-tip trajectories...");
-                });
-            }
+        let map = loaded.score.tempo_map();
+        let window = self.timeline.geometry.map(|g| {
+            let t = |x: f32| map.seconds_at(g.axis.tick_of(f64::from(x)).max(0.0));
+            (t(g.lanes.left()), t(g.lanes.right()))
+        });
+        let busy = self.renderer.as_ref().is_some_and(|r| r.is_busy());
+        let note = match (&self.render_error, busy, &self.renderer) {
+            (Some(e), _, _) => Some(e.clone()),
+            (None, true, _) => Some("rendering sound and motion...".to_string()),
+            (None, false, None) => Some("rendering is turned off".to_string()),
+            (None, false, Some(_)) => None,
+        };
+        let input = plots::PlotInput {
+            composition: match (comp, self.composer.error()) {
+                (_, Some(e)) => Err(e),
+                (Some(c), None) => Ok(Some((c, self.generation))),
+                (None, None) => Ok(None),
+            },
+            rendering: self.rendering.as_deref().map(|r| (r, self.rendering_id)),
+            rendering_current: self.rendering_current,
+            rendering_busy: busy,
+            rendering_note: note.as_deref(),
+            link: plots::linked::TimeLink {
+                window,
+                playhead_s: self.playhead_s,
+            },
+            selected_beats: &self.selection.beats,
+        };
+        if let Some(t) = self.plots.show(ui, &input) {
+            self.pending.push(Command::Seek(t));
         }
     }
 }

@@ -21,8 +21,8 @@ pub struct Simulated {
     pub poses: Vec<Pose>,
     /// Simulated stick tips per sample, [left, right], m (performer frame).
     pub tips: [Vec<DVec3>; 2],
-    /// The drums as struck, with their recorded membrane motion (score time).
-    pub drums: Option<std::sync::Arc<crate::drum::DrumSet>>,
+    /// The rendering it comes from: its drums recorded the membranes' motion.
+    pub rendering: Option<std::sync::Arc<crate::render::Rendering>>,
 }
 
 impl Simulated {
@@ -125,7 +125,7 @@ mod tests {
             rate_hz: 10.0,
             poses: vec![REST, second],
             tips: Default::default(),
-            drums: None,
+            rendering: None,
         };
         assert_eq!(sim.pose_at(0.0), Some(&REST));
         assert_eq!(sim.pose_at(1.08), Some(&second));

@@ -1,9 +1,11 @@
 //! The render pipeline off the UI thread: after each composition request the latest score
 //! is rendered (body + drums + sound, `crate::render`) on one long-lived worker; a newer
 //! request cancels the render in progress. Each rendering resumes the previous one's
-//! performance from its latest saved state before the edit (`render::render_after`), so
-//! an edit late in a score re-simulates only from there. The UI polls once per frame and hands the audio
-//! to playback and the simulated poses to the 3D view.
+//! performance from its latest saved state before the edit (`render::render_after`) and
+//! first renders only a second past it, so the edited part plays at once; the rest
+//! follows. The UI polls once per frame and hands the audio to playback, the simulated
+//! poses and membranes to the 3D view and the whole rendering to the plots and to
+//! File > Export.
 
 use super::pose::Simulated;
 use crate::kit::Kit;
@@ -15,16 +17,64 @@ use eframe::egui;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex, mpsc};
 
-/// A finished render, ready for playback and the view.
+/// A finished render, ready for playback, the view, the plots and export.
 pub struct Rendered {
-    /// Stereo interleaved 48 kHz audio from score time 0.
-    pub audio: Vec<f32>,
+    /// Everything the pipeline produced (shared with the plots and export).
+    pub rendering: Arc<Rendering>,
     pub simulated: Simulated,
     /// One line for the status bar.
     pub summary: String,
     /// Whether the whole score is rendered (else the audio is final up to a time the
     /// summary names, and the rest follows).
     pub complete: bool,
+}
+
+impl Rendered {
+    /// The parts of `rendering` the editor uses.
+    pub fn new(rendering: Arc<Rendering>) -> Rendered {
+        let r = &rendering;
+        let t = &r.timing;
+        let summary = if !r.complete {
+            format!("rendered up to {:.1} s; rendering the rest", r.ready_s)
+        } else {
+            format!(
+                "rendered: {} strokes, timing median {:.1} ms, worst {:.1} ms{}; {}",
+                t.strokes,
+                t.median_abs_s * 1e3,
+                t.worst_abs_s * 1e3,
+                if t.missed > 0 {
+                    format!(", {} missed", t.missed)
+                } else {
+                    String::new()
+                },
+                match r.stats.resumed_from_s {
+                    Some(from) => format!(
+                        "re-simulated from {from:.1} s in {:.2} s",
+                        r.stats.wall().as_secs_f64()
+                    ),
+                    None => format!("in {:.2} s", r.stats.wall().as_secs_f64()),
+                }
+            )
+        };
+        let simulated = Simulated {
+            start_s: r.start_s,
+            rate_hz: r.motion.rate_hz,
+            poses: r.motion.poses.clone(),
+            tips: r.motion.tips.clone(),
+            rendering: Some(Arc::clone(r)),
+        };
+        Rendered {
+            complete: r.complete,
+            rendering,
+            simulated,
+            summary,
+        }
+    }
+
+    /// Stereo interleaved 48 kHz audio from score time 0.
+    pub fn audio(&self) -> &[f32] {
+        &self.rendering.audio.samples
+    }
 }
 
 struct Request {
@@ -163,8 +213,8 @@ fn work(shared: &(Mutex<Slot>, Condvar), latest: &AtomicU64, tx: &mpsc::Sender<R
                 stop_after_s: quick.then_some(QUICK_AHEAD_S),
             });
             quick = false;
-            let result = run(&request, db, latest, from).map(|(rendered, r, sound)| {
-                previous = Some((r, sound));
+            let result = run(&request, db, latest, from).map(|(rendered, sound)| {
+                previous = Some((Arc::clone(&rendered.rendering), sound));
                 rendered
             });
             if result.as_ref().is_err_and(|e| e == CANCELLED) {
@@ -192,7 +242,7 @@ fn run(
     db: &MotionDb,
     latest: &AtomicU64,
     previous: Option<Previous>,
-) -> Result<(Rendered, Arc<Rendering>, SoundState), String> {
+) -> Result<(Rendered, SoundState), String> {
     let loaded = LoadedScore {
         score: request.score.clone(),
         kit: request.kit.clone(),
@@ -207,40 +257,6 @@ fn run(
         crate::render::RenderError::Cancelled => CANCELLED.to_string(),
         e => e.to_string(),
     })?;
-    let summary = if !r.complete {
-        format!("rendered up to {:.1} s; rendering the rest", r.ready_s)
-    } else {
-        format!(
-            "rendered: {} strokes, timing median {:.1} ms, worst {:.1} ms{}; {}",
-            r.timing.strokes,
-            r.timing.median_abs_s * 1e3,
-            r.timing.worst_abs_s * 1e3,
-            if r.timing.missed > 0 {
-                format!(", {} missed", r.timing.missed)
-            } else {
-                String::new()
-            },
-            match r.stats.resumed_from_s {
-                Some(t) => format!(
-                    "re-simulated from {t:.1} s in {:.2} s",
-                    r.stats.wall().as_secs_f64()
-                ),
-                None => format!("in {:.2} s", r.stats.wall().as_secs_f64()),
-            }
-        )
-    };
-    let rendered = Rendered {
-        audio: r.audio.samples.clone(),
-        simulated: Simulated {
-            start_s: r.start_s,
-            rate_hz: r.motion.rate_hz,
-            poses: r.motion.poses.clone(),
-            tips: r.motion.tips.clone(),
-            drums: Some(Arc::new(r.drums.clone())),
-        },
-        summary,
-        complete: r.complete,
-    };
     let sound = std::mem::take(&mut r.sound);
-    Ok((rendered, Arc::new(r), sound))
+    Ok((Rendered::new(Arc::new(r)), sound))
 }

@@ -1,0 +1,164 @@
+//! File > Export (issue 7 §7): the rendering of the score as it is now, written as a WAV
+//! (16-bit stereo 48 kHz, `sound::write_wav`) or as motion CSV (`io::motion_csv`, the
+//! same columns as `timpanist render --motion`), each atomically (a temporary file beside
+//! the target, renamed over it). Refused, with the reason, while the only rendering is of
+//! an older version of the score or there is none.
+
+use crate::io::{motion_csv, ron_file};
+use crate::render::Rendering;
+use std::path::{Path, PathBuf};
+
+/// What to export.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Export {
+    /// The rendered sound.
+    Wav,
+    /// Simulated and target tips and joint rotations per task sample.
+    Motion,
+}
+
+impl Export {
+    /// The File menu item.
+    pub fn menu_label(self) -> &'static str {
+        match self {
+            Export::Wav => "Export WAV...",
+            Export::Motion => "Export motion CSV...",
+        }
+    }
+
+    /// The dialog's filter: a name and the file extension.
+    pub fn filter(self) -> (&'static str, &'static str) {
+        match self {
+            Export::Wav => ("WAV audio", "wav"),
+            Export::Motion => ("motion CSV", "csv"),
+        }
+    }
+
+    /// A file name to suggest for a score whose file (or title) is `stem`.
+    pub fn suggested_name(self, stem: &str) -> String {
+        match self {
+            Export::Wav => format!("{stem}.wav"),
+            Export::Motion => format!("{stem}-motion.csv"),
+        }
+    }
+}
+
+/// Where the editor's rendering stands, to decide whether it can be exported.
+pub struct RenderState<'a> {
+    pub rendering: Option<&'a Rendering>,
+    /// Whether `rendering` is of the score as it is now.
+    pub current: bool,
+    /// Whether a render is running.
+    pub busy: bool,
+    /// Whether the editor renders at all.
+    pub enabled: bool,
+    /// Why the latest render failed.
+    pub error: Option<&'a str>,
+}
+
+impl RenderState<'_> {
+    /// Why there is nothing to export, or `None` when the current rendering can be.
+    pub fn blocked(&self) -> Option<String> {
+        match (self.rendering, self.current) {
+            (Some(_), true) => None,
+            _ if self.busy => Some("the score is still being rendered".into()),
+            _ if self.error.is_some() => Some(format!(
+                "the latest render failed ({})",
+                self.error.unwrap_or_default()
+            )),
+            (Some(_), false) => Some("the score changed since it was rendered".into()),
+            (None, _) if !self.enabled => Some("rendering is turned off".into()),
+            (None, _) => Some("the score has not been rendered yet".into()),
+        }
+    }
+}
+
+/// Write `what` of `rendering` to `path`; a line for the status bar, or why it failed.
+pub fn write(what: Export, rendering: &Rendering, path: &Path) -> Result<String, String> {
+    let failed = |e: &dyn std::fmt::Display| format!("cannot export to {}: {e}", path.display());
+    match what {
+        Export::Wav => {
+            crate::sound::write_wav(path, &rendering.audio).map_err(|e| failed(&e))?;
+            let a = &rendering.audio;
+            Ok(format!(
+                "exported {} ({:.1} s, {} Hz, {} channels)",
+                path.display(),
+                a.frames() as f64 / f64::from(a.rate_hz),
+                a.rate_hz,
+                a.channels
+            ))
+        }
+        Export::Motion => {
+            let text =
+                motion_csv::to_csv(&rendering.motion, &rendering.reference, rendering.start_s);
+            ron_file::write_atomic(path, text.as_bytes()).map_err(|e| failed(&e))?;
+            Ok(format!(
+                "exported {} ({} samples at {} Hz)",
+                path.display(),
+                rendering.motion.poses.len(),
+                rendering.motion.rate_hz
+            ))
+        }
+    }
+}
+
+/// Ask where to export `what`, starting beside `score_path` (when saved) with a name made
+/// from it or from `title`.
+pub fn ask_path(what: Export, score_path: Option<&Path>, title: &str) -> Option<PathBuf> {
+    let stem = score_path
+        .and_then(|p| p.file_stem())
+        .and_then(|s| s.to_str())
+        .unwrap_or(title);
+    let (name, ext) = what.filter();
+    let mut dialog = rfd::FileDialog::new()
+        .add_filter(name, &[ext])
+        .set_file_name(what.suggested_name(stem));
+    if let Some(dir) = score_path.and_then(Path::parent) {
+        dialog = dialog.set_directory(dir);
+    }
+    dialog.save_file()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Export is allowed only for a rendering of the current score; otherwise the reason
+    /// says what is going on.
+    #[test]
+    fn blocked_reasons() {
+        let state = |current, busy, enabled, error| RenderState {
+            rendering: None,
+            current,
+            busy,
+            enabled,
+            error,
+        };
+        assert!(
+            state(false, true, true, None)
+                .blocked()
+                .unwrap()
+                .contains("still being rendered")
+        );
+        assert!(
+            state(false, false, true, Some("diverged"))
+                .blocked()
+                .unwrap()
+                .contains("diverged")
+        );
+        assert!(
+            state(false, false, false, None)
+                .blocked()
+                .unwrap()
+                .contains("turned off")
+        );
+        assert!(
+            state(false, false, true, None)
+                .blocked()
+                .unwrap()
+                .contains("not been rendered")
+        );
+        assert_eq!(Export::Motion.suggested_name("etude"), "etude-motion.csv");
+        assert_eq!(Export::Wav.filter().1, "wav");
+    }
+}

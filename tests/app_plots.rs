@@ -1,0 +1,353 @@
+//! The editor's plot tabs and File > Export driven headless through egui_kittest, on a
+//! rendering of the improvisation score made once (synchronously, the editor's own
+//! pipeline) and handed to the app as the render worker would: every tab shows its plots
+//! and says so when there is no rendering, a click on a plot seeks, and export writes a
+//! WAV and a motion CSV of the current rendering or refuses with the reason.
+
+use eframe::egui;
+use egui_kittest::Harness;
+use egui_kittest::kittest::{NodeT, Queryable};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
+use timpanist::app::{EditorApp, EditorOptions, PlotTab};
+use timpanist::mocap::db::MotionDb;
+use timpanist::render::{RenderParams, Rendering, render};
+use timpanist::score::{Hand, LoadedScore};
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn score_path() -> PathBuf {
+    root().join("scores/improvisation.ron")
+}
+
+/// The improvisation score rendered with the default parameters, once per test run.
+fn rendering() -> Arc<Rendering> {
+    static RENDERING: OnceLock<Arc<Rendering>> = OnceLock::new();
+    Arc::clone(RENDERING.get_or_init(|| {
+        let loaded = LoadedScore::load(&score_path()).unwrap();
+        let db = MotionDb::load(&root().join("mocap")).unwrap();
+        Arc::new(render(&loaded, &db, &RenderParams::default(), &mut |_| true).unwrap())
+    }))
+}
+
+/// An editor on the improvisation score with the silent clock and `render` as given, in
+/// a window large enough for every panel; with `rendered`, the rendering is handed over.
+/// With the render worker on, a spinner keeps repainting: the UI runs a few frames only.
+fn harness(dir: &Path, render: bool, rendered: bool) -> Harness<'static, EditorApp> {
+    std::env::set_current_dir(root()).unwrap();
+    let options = EditorOptions {
+        score: Some(score_path()),
+        recent_store: Some(dir.join("recent.txt")),
+        audio_device: false,
+        render,
+    };
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1400.0, 900.0))
+        .with_max_steps(64)
+        .build_eframe(move |_cc| EditorApp::with_options(options));
+    if rendered {
+        h.state_mut().set_rendering(rendering());
+    }
+    if render {
+        h.step();
+        h.state_mut().wait_for_composition();
+        h.run_steps(4);
+    } else {
+        settle(&mut h);
+    }
+    h
+}
+
+/// Let the composing worker finish, then run the UI until it is idle.
+fn settle(h: &mut Harness<'static, EditorApp>) {
+    h.step();
+    h.state_mut().wait_for_composition();
+    h.run();
+}
+
+/// Open the plot tab titled `title`.
+fn open_tab(h: &mut Harness<'static, EditorApp>, title: &str) {
+    h.get_by_label(title).click();
+    settle(h);
+}
+
+/// Click at `pos` (press and release without moving).
+fn click(h: &mut Harness<'static, EditorApp>, pos: egui::Pos2) {
+    h.hover_at(pos);
+    h.step();
+    h.drag_at(pos);
+    h.step();
+    h.drop_at(pos);
+    settle(h);
+}
+
+/// Every tab shows its plots with the expected legends and labels, over the rendering's
+/// whole time, and the joints chosen above the joint plot are the ones drawn.
+#[test]
+fn every_tab_shows_its_plots() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(dir.path(), false, true);
+    assert_eq!(h.state().plot_tab(), PlotTab::Composed);
+    assert_eq!(
+        h.get_all_by_label("Right tip").count(),
+        2,
+        "height and depth"
+    );
+    assert_eq!(h.get_all_by_label("Left impacts").count(), 2);
+
+    open_tab(&mut h, "Simulated tips");
+    assert_eq!(h.state().plot_tab(), PlotTab::Tips);
+    for line in [
+        "Left target",
+        "Left simulated",
+        "Right target",
+        "Right simulated",
+    ] {
+        assert_eq!(h.get_all_by_label(line).count(), 2, "{line} in both plots");
+    }
+
+    open_tab(&mut h, "Contact force");
+    h.get_by_label("Left peaks");
+    h.get_by_label("Right force");
+
+    open_tab(&mut h, "Sound");
+    h.get_by_label("waveform");
+    h.get_by_label("spectrum");
+    h.get_by_label("analysed strike");
+    // The playhead is at 0: the first strike is analysed.
+    let first = &rendering().events[0];
+    h.get_by_label_contains(&format!(
+        "Spectrum of the strike at {:.3} s",
+        first.contact_s
+    ));
+
+    open_tab(&mut h, "Joint angles");
+    assert_eq!(
+        h.get_all_by_label("elbow_r").count(),
+        2,
+        "checkbox and legend"
+    );
+    assert_eq!(h.get_all_by_label("trunk").count(), 1, "checkbox only");
+    h.get_by_label("trunk").click();
+    settle(&mut h);
+    assert_eq!(h.get_all_by_label("trunk").count(), 2, "now drawn too");
+}
+
+const TABS: [&str; 5] = [
+    "Composed tips",
+    "Simulated tips",
+    "Contact force",
+    "Sound",
+    "Joint angles",
+];
+
+/// Every tab's time axis shows the timeline's visible window: the same on all tabs, and
+/// narrower on all of them after the timeline zooms in.
+#[test]
+fn time_axes_follow_the_timeline() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(dir.path(), false, true);
+    let windows = |h: &mut Harness<'static, EditorApp>| -> (f64, f64) {
+        let all: Vec<(f64, f64)> = TABS
+            .iter()
+            .map(|tab| {
+                open_tab(h, tab);
+                h.state().plot_time_window().expect(tab)
+            })
+            .collect();
+        for (w, tab) in all.iter().zip(TABS) {
+            assert!(
+                (w.0 - all[0].0).abs() < 1e-9 && (w.1 - all[0].1).abs() < 1e-9,
+                "{tab}: {w:?} vs {:?}",
+                all[0]
+            );
+        }
+        all[0]
+    };
+    let fit = windows(&mut h);
+    assert!(fit.0 <= 0.0 && fit.1 >= 3.0, "the whole score: {fit:?}");
+    h.get_by_label("Zoom in").click();
+    settle(&mut h);
+    let zoomed = windows(&mut h);
+    let ratio = (zoomed.1 - zoomed.0) / (fit.1 - fit.0);
+    assert!((ratio - 0.7).abs() < 0.01, "{fit:?} -> {zoomed:?}");
+}
+
+/// A click on a plot moves the playhead to the time under the pointer (within a pixel),
+/// on every tab; on the sound tab the strike analysed follows.
+#[test]
+fn click_on_a_plot_seeks() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(dir.path(), false, true);
+    let events = rendering().events.clone();
+    for (i, tab) in TABS.into_iter().enumerate() {
+        open_tab(&mut h, tab);
+        let target = 0.5 + 0.6 * i as f64;
+        let at = h.state().plot_point(target).expect(tab);
+        let px_per_s = f64::from(h.state().plot_point(target + 1.0).unwrap().x - at.x);
+        click(&mut h, at);
+        let playhead = h.state().playhead_s();
+        assert!(
+            (playhead - target).abs() <= 1.0 / px_per_s,
+            "{tab}: clicked at {target} s, playhead {playhead} s"
+        );
+    }
+    // The sound tab analyses the strike nearest the playhead.
+    open_tab(&mut h, "Sound");
+    let last = events.iter().rfind(|e| e.beat.is_some()).unwrap();
+    let at = h.state().plot_point(last.contact_s + 0.01).unwrap();
+    click(&mut h, at);
+    h.get_by_label_contains(&format!(
+        "Spectrum of the strike at {:.3} s",
+        last.contact_s
+    ));
+}
+
+/// Before any rendering the rendering tabs say why there is nothing to plot, while the
+/// composed tips still show; with the render worker on, they say it is rendering.
+#[test]
+fn tabs_say_when_there_is_no_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(dir.path(), false, false);
+    for tab in ["Simulated tips", "Contact force", "Sound", "Joint angles"] {
+        open_tab(&mut h, tab);
+        h.get_by_label("No rendering to plot: rendering is turned off");
+        assert!(h.state().plot_point(1.0).is_none());
+    }
+    open_tab(&mut h, "Composed tips");
+    assert_eq!(h.get_all_by_label("Right tip").count(), 2);
+
+    let mut h = harness(dir.path(), true, false);
+    h.get_by_label("Contact force").click();
+    h.run_steps(2);
+    h.get_by_label("No rendering to plot: rendering sound and motion...");
+}
+
+/// Export writes the current rendering: a 48 kHz stereo 16-bit WAV with every sample of
+/// the rendered audio, and a CSV with its header and one row per motion sample; no
+/// temporary file is left behind.
+#[test]
+fn export_writes_wav_and_motion() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    let mut h = harness(dir.path(), false, true);
+    assert_eq!(h.state().export_blocked(), None);
+    let r = rendering();
+
+    let wav = out.path().join("improvisation.wav");
+    h.state_mut().export_wav_to(&wav);
+    assert!(h.state().error().is_none(), "{:?}", h.state().error());
+    assert!(
+        h.state().status().contains("exported"),
+        "{}",
+        h.state().status()
+    );
+    let mut reader = hound::WavReader::open(&wav).unwrap();
+    let spec = reader.spec();
+    assert_eq!(
+        (spec.sample_rate, spec.channels, spec.bits_per_sample),
+        (48_000, 2, 16)
+    );
+    let samples: Vec<i16> = reader.samples::<i16>().map(Result::unwrap).collect();
+    assert_eq!(samples.len(), r.audio.samples.len());
+    assert!(samples.len() > 2 * 48_000, "seconds of sound");
+    let worst = samples
+        .iter()
+        .zip(&r.audio.samples)
+        .map(|(&s, &a)| (f64::from(s) / 32767.0 - f64::from(a)).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-4, "16-bit rounding only: {worst}");
+    assert!(samples.iter().any(|&s| s.abs() > 1000), "not silent");
+
+    let csv = out.path().join("improvisation-motion.csv");
+    h.state_mut().export_motion_to(&csv);
+    assert!(h.state().error().is_none(), "{:?}", h.state().error());
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(lines[0].starts_with("time_s,left_tip_x_m,left_tip_y_m,left_tip_z_m"));
+    let columns = lines[0].split(',').count();
+    assert_eq!(columns, 1 + 2 * 2 * 3 + 11 * 4);
+    assert_eq!(lines.len(), 1 + r.motion.poses.len());
+    let first: Vec<f64> = lines[1].split(',').map(|v| v.parse().unwrap()).collect();
+    assert_eq!(first.len(), columns);
+    assert!((first[0] - r.start_s).abs() < 1e-4);
+    assert!(
+        (first[3] - r.motion.tips[0][0].z).abs() < 1e-6,
+        "left tip z"
+    );
+    let names: Vec<_> = std::fs::read_dir(out.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names.len(), 2, "no temporary files: {names:?}");
+
+    // A failing write is an error in the window, not a panic.
+    h.state_mut().export_wav_to(Path::new("/no/such/dir/x.wav"));
+    assert!(h.state().error().unwrap().contains("/no/such/dir/x.wav"));
+    h.run();
+    h.get_by_label_contains("Error: cannot export to /no/such/dir/x.wav");
+}
+
+/// Export is refused with the reason while there is no rendering of the score as it is
+/// now — none yet, or the score edited since — and nothing is written; the File menu's
+/// export items are disabled meanwhile.
+#[test]
+fn export_is_refused_without_a_current_rendering() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    let wav = out.path().join("x.wav");
+
+    let mut h = harness(dir.path(), false, false);
+    h.get_by_label("File").click();
+    settle(&mut h);
+    assert!(
+        h.get_by_label("Export WAV...")
+            .accesskit_node()
+            .is_disabled()
+    );
+    assert!(
+        h.get_by_label("Export motion CSV...")
+            .accesskit_node()
+            .is_disabled()
+    );
+    h.state_mut().export_wav_to(&wav);
+    let error = h.state().error().unwrap().to_string();
+    assert!(
+        error.contains("cannot export: rendering is turned off"),
+        "{error}"
+    );
+    assert!(!wav.exists());
+
+    let mut h = harness(dir.path(), false, true);
+    h.get_by_label("File").click();
+    settle(&mut h);
+    assert!(
+        !h.get_by_label("Export WAV...")
+            .accesskit_node()
+            .is_disabled()
+    );
+    h.key_press(egui::Key::Escape);
+    settle(&mut h);
+    // An edit: the rendering no longer matches the score.
+    let at = h
+        .state()
+        .timeline_point(960 * 2 + 480, Hand::Right)
+        .unwrap();
+    h.hover_at(at);
+    h.step();
+    h.drag_at(at);
+    h.step();
+    h.drop_at(at);
+    settle(&mut h);
+    assert!(h.state().is_dirty());
+    h.state_mut().export_motion_to(&out.path().join("m.csv"));
+    let error = h.state().error().unwrap().to_string();
+    assert!(error.contains("changed since it was rendered"), "{error}");
+    assert_eq!(std::fs::read_dir(out.path()).unwrap().count(), 0);
+    // The plots still show the previous rendering, and say so.
+    open_tab(&mut h, "Contact force");
+    h.get_by_label("Left peaks");
+    h.get_by_label_contains("showing the previous rendering");
+}
