@@ -303,3 +303,50 @@ fn space_plays_on_the_silent_clock() {
     settle(&mut h);
     h.get_by_label("Keyboard and mouse");
 }
+
+/// The inspector's physics and sound settings: picking the ID pipeline and the sample
+/// model, and typing a drum's diameter, are undoable edits of the score's settings; undo
+/// and redo restore them; they are saved with the score and read back.
+#[test]
+fn inspector_edits_settings_undoably_and_saves_them() {
+    use timpanist::score::settings::{Control, Sound};
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(Some(demo()), dir.path());
+    h.get_by_label("Physics and sound").click();
+    settle(&mut h);
+    h.get_by_label("Control").click();
+    settle(&mut h);
+    h.get_by_label("ID (PD + inverse dynamics)").click();
+    settle(&mut h);
+    h.get_by_label("Sound model").click();
+    settle(&mut h);
+    h.get_by_label("sample replay").click();
+    settle(&mut h);
+    let s = &h.state().loaded().unwrap().score.settings;
+    assert_eq!((s.control, s.sound), (Control::Id, Sound::Sample));
+    assert_eq!(h.state().undo_steps(), 2);
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut h);
+    let s = &h.state().loaded().unwrap().score.settings;
+    assert_eq!((s.control, s.sound), (Control::Id, Sound::Modal));
+    h.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::Z,
+    );
+    settle(&mut h);
+    assert_eq!(
+        h.state().loaded().unwrap().score.settings.sound,
+        Sound::Sample
+    );
+    let path = dir.path().join("with-settings.ron");
+    h.state_mut().save_to(&path);
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(
+        text.contains("settings") && text.contains("Sample"),
+        "{text}"
+    );
+    let mut again = harness(Some(path), dir.path());
+    settle(&mut again);
+    let s = &again.state().loaded().unwrap().score.settings;
+    assert_eq!((s.control, s.sound), (Control::Id, Sound::Sample));
+}

@@ -351,3 +351,42 @@ fn export_is_refused_without_a_current_rendering() {
     h.get_by_label("Left peaks");
     h.get_by_label_contains("showing the previous rendering");
 }
+
+/// Space where only part of the audio is ready (a rendering that stopped early, as the
+/// worker hands over right after an edit) waits and says so; playback starts by itself
+/// when a rendering with the audio there arrives. Where the audio is ready it plays at
+/// once.
+#[test]
+fn space_waits_for_audio_that_is_not_ready() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(dir.path(), false, false);
+    let whole = rendering();
+    let mut partial = (*whole).clone();
+    partial.complete = false;
+    partial.ready_s = 2.0;
+    h.state_mut().set_rendering(Arc::new(partial));
+    h.state_mut().seek(3.0);
+    h.key_press(egui::Key::Space);
+    h.step();
+    assert!(!h.state().playback().is_playing());
+    assert!(h.state().is_waiting_to_play());
+    assert!(
+        h.state().status().contains("waiting for the audio"),
+        "{}",
+        h.state().status()
+    );
+    h.state_mut().set_rendering(whole);
+    h.step();
+    assert!(h.state().playback().is_playing() && !h.state().is_waiting_to_play());
+    // Before the ready point a partial rendering plays at once.
+    h.key_press(egui::Key::Space);
+    h.step();
+    let mut partial = (*rendering()).clone();
+    partial.complete = false;
+    partial.ready_s = 2.0;
+    h.state_mut().set_rendering(Arc::new(partial));
+    h.state_mut().seek(1.0);
+    h.key_press(egui::Key::Space);
+    h.step();
+    assert!(h.state().playback().is_playing());
+}

@@ -26,6 +26,22 @@ fn frame_times(h: &mut Harness<'static, EditorApp>, n: usize) -> (f64, f64) {
     (frames[n / 2], frames[n - 1])
 }
 
+/// The editor on `score` (recent files in `dir`, no sound device), rendering if
+/// `render`.
+fn editor(score: std::path::PathBuf, dir: &Path, render: bool) -> Harness<'static, EditorApp> {
+    std::env::set_current_dir(env!("CARGO_MANIFEST_DIR")).unwrap();
+    let options = EditorOptions {
+        score: Some(score),
+        recent_store: Some(dir.join("recent.txt")),
+        audio_device: false,
+        render,
+    };
+    Harness::builder()
+        .with_size(egui::vec2(1400.0, 900.0))
+        .with_max_steps(64)
+        .build_eframe(move |_cc| EditorApp::with_options(options))
+}
+
 /// A 60-second score: eighth notes at 100 bpm over all four drums.
 fn sixty_seconds(dir: &Path) -> std::path::PathBuf {
     let mut s = Score::new("sixty seconds");
@@ -42,17 +58,8 @@ fn sixty_seconds(dir: &Path) -> std::path::PathBuf {
 #[test]
 fn edit_to_composition_and_frame_times() {
     let dir = tempfile::tempdir().unwrap();
-    std::env::set_current_dir(env!("CARGO_MANIFEST_DIR")).unwrap();
-    let options = EditorOptions {
-        score: Some(sixty_seconds(dir.path())),
-        recent_store: Some(dir.path().join("recent.txt")),
-        audio_device: false,
-        render: false,
-    };
-    let mut h = Harness::builder()
-        .with_size(egui::vec2(1400.0, 900.0))
-        .with_max_steps(64)
-        .build_eframe(move |_cc| EditorApp::with_options(options));
+    let score = sixty_seconds(dir.path());
+    let mut h = editor(score, dir.path(), false);
     h.step();
     assert!(h.state_mut().wait_for_composition().is_some());
     h.run();
@@ -133,4 +140,105 @@ fn edit_to_composition_and_frame_times() {
             println!("plot tab Sound: a frame analysing a new strike {spent:.1} ms");
         }
     }
+}
+
+/// Percentile `p` (0–1) of `values` (sorted in place).
+fn percentile(values: &mut [f64], p: f64) -> f64 {
+    values.sort_by(f64::total_cmp);
+    values[((values.len() - 1) as f64 * p).round() as usize]
+}
+
+/// Step the editor until it holds a rendering other than `old` (complete if `complete`),
+/// recording each frame's time, ms. Panics after `limit_s`.
+fn step_until_rendering(
+    h: &mut Harness<'static, EditorApp>,
+    old: Option<*const timpanist::render::Rendering>,
+    complete: bool,
+    frames: &mut Vec<f64>,
+    limit_s: f64,
+) {
+    let began = Instant::now();
+    loop {
+        let t = Instant::now();
+        h.step();
+        frames.push(t.elapsed().as_secs_f64() * 1e3);
+        if let Some(r) = h.state().rendering()
+            && Some(std::sync::Arc::as_ptr(r)) != old
+            && (r.complete || !complete)
+        {
+            return;
+        }
+        assert!(
+            began.elapsed().as_secs_f64() < limit_s,
+            "no rendering after {limit_s} s: {} / {:?}",
+            h.state().status(),
+            h.state().render_error()
+        );
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+}
+
+/// With the real render worker on the one-minute demo study: the editor's frames while
+/// the whole score renders, and after a one-beat edit near 30 s the time until audio
+/// past the edit is ready (the worker resumes from its saved state before the edit and
+/// first renders one second past it) and until the whole score is rendered again.
+#[test]
+fn render_worker_frames_and_edit_to_ready_audio() {
+    let dir = tempfile::tempdir().unwrap();
+    let score = Path::new(env!("CARGO_MANIFEST_DIR")).join("scores/minute-study.ron");
+    let mut h = editor(score, dir.path(), true);
+    let mut during_render = Vec::new();
+    let began = Instant::now();
+    step_until_rendering(&mut h, None, true, &mut during_render, 120.0);
+    let first = began.elapsed().as_secs_f64();
+    let frames = during_render.len();
+    let (median, p99, max) = (
+        percentile(&mut during_render, 0.5),
+        percentile(&mut during_render, 0.99),
+        percentile(&mut during_render, 1.0),
+    );
+    println!(
+        "one-minute study with the render worker: first whole rendering after {first:.1} s; \
+         {frames} frames meanwhile: median {median:.1} ms, 99th percentile {p99:.1} ms, \
+         max {max:.1} ms"
+    );
+    let before = h.state().rendering().map(std::sync::Arc::as_ptr);
+    // The vertical accent at 30 s (bar 13) becomes a tenuto: select it, press 2.
+    let at = h.state().timeline_point(46080, Hand::Auto).unwrap();
+    h.hover_at(at);
+    h.step();
+    h.drag_at(at);
+    h.step();
+    h.drop_at(at);
+    h.step();
+    assert_eq!(h.state().selection().beats.len(), 1, "the beat is selected");
+    h.key_press(egui::Key::Num2);
+    let edited = Instant::now();
+    let mut after_edit = Vec::new();
+    step_until_rendering(&mut h, before, false, &mut after_edit, 120.0);
+    let ready = edited.elapsed().as_secs_f64() * 1e3;
+    let partial = h.state().rendering().unwrap().clone();
+    let quick = !partial.complete;
+    let from = partial.stats.resumed_from_s;
+    let ready_s = partial.ready_s;
+    let before = h.state().rendering().map(std::sync::Arc::as_ptr);
+    if quick {
+        step_until_rendering(&mut h, before, true, &mut after_edit, 120.0);
+    }
+    let whole = edited.elapsed().as_secs_f64() * 1e3;
+    let rest = h.state().rendering().unwrap();
+    assert!(from.is_some(), "the edit resumes from a saved state");
+    assert!(rest.complete && rest.stats.resumed_from_s.is_some());
+    assert!(
+        h.state().status().contains("re-simulated from"),
+        "{}",
+        h.state().status()
+    );
+    let max_frame = percentile(&mut after_edit, 1.0);
+    println!(
+        "one-beat edit at 30.0 s (mode changed): audio ready to {ready_s:.1} s (resumed at {:.2} s) after \
+         {ready:.0} ms; whole score rendered again after {whole:.0} ms; longest frame \
+         meanwhile {max_frame:.1} ms",
+        from.unwrap_or(0.0)
+    );
 }

@@ -99,6 +99,9 @@ enum AfterConfirm {
     Open(PathBuf),
 }
 
+/// Space plays at once only if this much audio past the playhead is ready, s.
+const PLAY_AHEAD_S: f64 = 0.3;
+
 /// The editor application state.
 pub struct EditorApp {
     doc: Option<Document>,
@@ -135,6 +138,11 @@ pub struct EditorApp {
     rendering_id: u64,
     /// Whether `rendering` is of the score as it is now (what File > Export needs).
     rendering_current: bool,
+    /// Score time up to which the audio given to playback is final, s (infinite once a
+    /// whole rendering, or none, is in).
+    audio_ready_s: f64,
+    /// Space was pressed where the audio is not ready yet: play once it is.
+    waiting_to_play: bool,
     plots: plots::Plots,
     recent: RecentFiles,
     show_help: bool,
@@ -182,6 +190,8 @@ impl EditorApp {
             rendering: None,
             rendering_id: 0,
             rendering_current: false,
+            audio_ready_s: f64::INFINITY,
+            waiting_to_play: false,
             plots: plots::Plots::default(),
             recent: RecentFiles::load(options.recent_store),
             show_help: false,
@@ -205,6 +215,11 @@ impl EditorApp {
     /// Where the open score is saved, if anywhere.
     pub fn path(&self) -> Option<&Path> {
         self.doc.as_ref().and_then(|d| d.path.as_deref())
+    }
+
+    /// Why the latest rendering failed, if it did.
+    pub fn render_error(&self) -> Option<&str> {
+        self.render_error.as_deref()
     }
 
     /// The error shown in the window, if any.
@@ -407,6 +422,7 @@ impl EditorApp {
         self.simulated = None;
         self.rendering = None;
         self.render_error = None;
+        self.waiting_to_play = false;
         self.recompose();
     }
 
@@ -448,10 +464,25 @@ impl EditorApp {
             self.render_error = None;
         }
         self.simulated = Some(r.simulated);
+        self.audio_ready_s = if r.rendering.complete {
+            f64::INFINITY
+        } else {
+            r.rendering.ready_s
+        };
         self.rendering = Some(r.rendering);
         self.rendering_id += 1;
         self.rendering_current = current;
         self.status = r.summary;
+        if self.waiting_to_play && self.playhead_s + PLAY_AHEAD_S <= self.audio_ready_s {
+            self.waiting_to_play = false;
+            self.playback.play_from(self.playhead_s);
+        }
+    }
+
+    /// Whether Space was pressed where the audio is not ready yet (playback starts once
+    /// it is).
+    pub fn is_waiting_to_play(&self) -> bool {
+        self.waiting_to_play
     }
 
     /// Open a score (`.ron`) or import a MIDI file (`.mid`); errors go to the window.
@@ -645,6 +676,15 @@ impl EditorApp {
                 if self.playback.is_playing() {
                     self.playback.pause();
                     self.playhead_s = self.playback.position_s();
+                } else if self.waiting_to_play {
+                    self.waiting_to_play = false;
+                    self.status = "playback cancelled".into();
+                } else if self.playhead_s + PLAY_AHEAD_S > self.audio_ready_s {
+                    self.waiting_to_play = true;
+                    self.status = format!(
+                        "waiting for the audio at {:.1} s (ready to {:.1} s)",
+                        self.playhead_s, self.audio_ready_s
+                    );
                 } else {
                     self.playback.play_from(self.playhead_s);
                 }

@@ -84,7 +84,7 @@ pub fn show(ui: &mut egui::Ui, doc: &LoadedScore, out: &mut Vec<Command>) {
             ui.end_row();
             started |= choose(
                 ui,
-                "Sound",
+                "Sound model",
                 &mut after.sound,
                 &[
                     (Sound::Modal, "modal (simulated force)"),

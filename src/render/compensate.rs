@@ -28,6 +28,8 @@ const LOOKAHEAD_S: f64 = 0.035;
 /// The most a stroke's target is played earlier or later, s (with the gap and the
 /// look-ahead, it keeps the next cluster's dips out of a cluster's targets).
 const MAX_SHIFT_S: f64 = 0.035;
+/// The deepest a stroke aims below the head, m.
+const MAX_DEPTH_M: f64 = 0.06;
 /// The shift moves to a cluster's over at most this long before its first dip, s.
 const TRANSITION_S: f64 = 0.06;
 
@@ -293,6 +295,7 @@ impl Performance {
         type Attempt = ((usize, f64), Vec<f64>, Vec<f64>, usize);
         let mut best: Option<Attempt> = None;
         let mut attempt = 0;
+        let mut diverged = false;
         loop {
             attempt += 1;
             if attempt > 1 {
@@ -300,8 +303,23 @@ impl Performance {
                 self.drums.rewind(&commit.drums);
             }
             self.place(cluster.clone(), &commit, until);
-            self.advance(until, stage)?;
             self.attempts += 1;
+            match self.advance(until, stage) {
+                // A correction that makes the body diverge is dropped for the best so far;
+                // a warm start that does is replaced by no shift and the first depth.
+                Err(SimError::Diverged(_)) if best.is_some() => {
+                    diverged = true;
+                    break;
+                }
+                Err(SimError::Diverged(_)) if attempt == 1 && attempt < aims.max_attempts => {
+                    for i in cluster.clone() {
+                        self.shift_s[i] = 0.0;
+                        self.targets.set_depth(i, aims.first_depth_m);
+                    }
+                    continue;
+                }
+                outcome => outcome?,
+            }
             let contacts = self.drums.contacts();
             let matches =
                 strikes::match_range(strokes, cluster.clone(), contacts, commit.drums.contacts());
@@ -345,7 +363,7 @@ impl Performance {
             }
         }
         let (_, shifts, depths, kept) = best.expect("one attempt ran");
-        if kept != attempt {
+        if kept != attempt || diverged {
             for ((i, shift), depth) in cluster.clone().zip(shifts).zip(depths) {
                 self.shift_s[i] = shift;
                 self.targets.set_depth(i, depth);
@@ -376,7 +394,7 @@ impl Performance {
         if !force.is_some_and(|f| (f / aim - 1.0).abs() <= aims.force_tolerance) {
             let old = self.targets.depth(i);
             let ratio = force.map_or(2.0, |f| (aim / f.max(1e-3)).sqrt().clamp(0.6, 1.6));
-            let depth = (old * ratio).clamp(0.002, 0.06);
+            let depth = (old * ratio).clamp(0.002, MAX_DEPTH_M);
             if let Some(c) = contact {
                 shift -= (depth - old) / c.impact_speed_mps.max(0.5);
             }
