@@ -4,16 +4,16 @@
 //!
 //! * a full `timpanist render` (≈ 6 s per iteration, so this takes a few minutes);
 //! * after a one-beat edit near 30 s (its dynamic changed), the rendering that resumes
-//!   the previous performance from its saved state before the edit and stops 1 s past it
-//!   (what the editor plays at once: its audio is final up to there), and the resumed
-//!   rendering of the whole rest.
+//!   the previous performance from its saved state before the edit and stops
+//!   `FIRST_STEP_S` (0.4 s) past the edited stroke (what the editor plays at once: its audio is final up
+//!   to there), and the resumed rendering of the whole rest.
 //!
 //! `cargo bench --bench render`.
 
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use std::path::Path;
 use timpanist::mocap::db::MotionDb;
-use timpanist::render::{Previous, RenderParams, render, render_after};
+use timpanist::render::{FIRST_STEP_S, Previous, RenderParams, render, render_after};
 use timpanist::score::{Dynamic, LoadedScore};
 
 fn bench(c: &mut Criterion) {
@@ -41,8 +41,8 @@ fn bench(c: &mut Criterion) {
     };
     for (name, stop_after_s) in [
         (
-            "one-beat edit at 30 s: audio ready 1 s past the resume point",
-            Some(1.0),
+            "one-beat edit at 30 s: audio ready past the edited stroke",
+            Some(FIRST_STEP_S),
         ),
         ("one-beat edit at 30 s: the whole rest re-rendered", None),
     ] {

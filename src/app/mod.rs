@@ -101,6 +101,9 @@ enum AfterConfirm {
 
 /// Space plays at once only if this much audio past the playhead is ready, s.
 const PLAY_AHEAD_S: f64 = 0.3;
+/// While playing, the rendering's further audio is swapped in this long before the
+/// playing audio runs out, s.
+const AUDIO_SWAP_LEAD_S: f64 = 0.5;
 
 /// The editor application state.
 pub struct EditorApp {
@@ -143,6 +146,9 @@ pub struct EditorApp {
     audio_ready_s: f64,
     /// Space was pressed where the audio is not ready yet: play once it is.
     waiting_to_play: bool,
+    /// The rendering has audio playback does not have yet (a later part of the version
+    /// playing).
+    audio_behind: bool,
     plots: plots::Plots,
     recent: RecentFiles,
     show_help: bool,
@@ -192,6 +198,7 @@ impl EditorApp {
             rendering_current: false,
             audio_ready_s: f64::INFINITY,
             waiting_to_play: false,
+            audio_behind: false,
             plots: plots::Plots::default(),
             recent: RecentFiles::load(options.recent_store),
             show_help: false,
@@ -458,24 +465,44 @@ impl EditorApp {
     }
 
     fn accept_rendering(&mut self, r: renderer::Rendered, current: bool) {
-        if let Err(e) = self.playback.set_audio(r.audio()) {
-            self.render_error = Some(format!("playback: {e}"));
-        } else {
-            self.render_error = None;
-        }
+        self.render_error = None;
         self.simulated = Some(r.simulated);
-        self.audio_ready_s = if r.rendering.complete {
-            f64::INFINITY
-        } else {
-            r.rendering.ready_s
-        };
         self.rendering = Some(r.rendering);
         self.rendering_id += 1;
         self.rendering_current = current;
         self.status = r.summary;
+        self.audio_behind = true;
+        // A new version is heard at once; more of the same version only when the
+        // playing audio is about to run out (each swap restarts the sound).
+        if !r.continues || !self.playback.is_playing() {
+            self.load_audio();
+        }
+    }
+
+    /// Give playback the current rendering's audio.
+    fn load_audio(&mut self) {
+        let Some(r) = &self.rendering else {
+            return;
+        };
+        if let Err(e) = self.playback.set_audio(&r.audio.samples) {
+            self.render_error = Some(format!("playback: {e}"));
+        }
+        self.audio_ready_s = if r.complete { f64::INFINITY } else { r.ready_s };
+        self.audio_behind = false;
         if self.waiting_to_play && self.playhead_s + PLAY_AHEAD_S <= self.audio_ready_s {
             self.waiting_to_play = false;
             self.playback.play_from(self.playhead_s);
+        }
+    }
+
+    /// While playing, swap in the rendering's further audio before the playing audio
+    /// runs out.
+    fn extend_audio(&mut self) {
+        if self.audio_behind
+            && self.playback.is_playing()
+            && self.playback.position_s() + AUDIO_SWAP_LEAD_S > self.audio_ready_s
+        {
+            self.load_audio();
         }
     }
 
@@ -1145,6 +1172,7 @@ impl eframe::App for EditorApp {
             self.generation += 1;
         }
         self.take_render();
+        self.extend_audio();
         if self.composer.is_busy() {
             ctx.request_repaint_after(std::time::Duration::from_millis(30));
         }

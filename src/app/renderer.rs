@@ -10,7 +10,7 @@
 use super::pose::Simulated;
 use crate::kit::Kit;
 use crate::mocap::db::MotionDb;
-use crate::render::{Previous, RenderParams, Rendering, render_after};
+use crate::render::{FIRST_STEP_S, Previous, RESUME_STEP_S, RenderParams, Rendering, render_after};
 use crate::score::{LoadedScore, Score};
 use crate::sound::SoundState;
 use eframe::egui;
@@ -27,6 +27,9 @@ pub struct Rendered {
     /// Whether the whole score is rendered (else the audio is final up to a time the
     /// summary names, and the rest follows).
     pub complete: bool,
+    /// Whether it continues the previous rendering of the same score version (a later
+    /// step after an edit) rather than showing a new version.
+    pub continues: bool,
 }
 
 impl Rendered {
@@ -65,15 +68,11 @@ impl Rendered {
         };
         Rendered {
             complete: r.complete,
+            continues: false,
             rendering,
             simulated,
             summary,
         }
-    }
-
-    /// Stereo interleaved 48 kHz audio from score time 0.
-    pub fn audio(&self) -> &[f32] {
-        &self.rendering.audio.samples
     }
 }
 
@@ -203,18 +202,20 @@ fn work(shared: &(Mutex<Slot>, Condvar), latest: &AtomicU64, tx: &mpsc::Sender<R
             }
             continue;
         };
-        // First the edited part (quick, to play at once), then the rest.
+        // First the edited part (quick, to play at once), then the rest in steps.
         let mut complete = false;
-        let mut quick = true;
+        let mut first = true;
         while !complete {
             let from = previous.as_mut().map(|(r, sound)| Previous {
                 rendering: r,
                 sound,
-                stop_after_s: quick.then_some(QUICK_AHEAD_S),
+                stop_after_s: Some(if first { FIRST_STEP_S } else { RESUME_STEP_S }),
             });
-            quick = false;
-            let result = run(&request, db, latest, from).map(|(rendered, sound)| {
+            let continues = !first;
+            first = false;
+            let result = run(&request, db, latest, from).map(|(mut rendered, sound)| {
                 previous = Some((Arc::clone(&rendered.rendering), sound));
+                rendered.continues = continues;
                 rendered
             });
             if result.as_ref().is_err_and(|e| e == CANCELLED) {
@@ -230,10 +231,6 @@ fn work(shared: &(Mutex<Slot>, Condvar), latest: &AtomicU64, tx: &mpsc::Sender<R
         }
     }
 }
-
-/// After an edit, the first rendering stops this long past where it resumed, s; the rest
-/// follows in one more.
-const QUICK_AHEAD_S: f64 = 1.0;
 
 const CANCELLED: &str = "cancelled";
 

@@ -260,15 +260,23 @@ pub fn render(
     render_after(None, loaded, db, params, progress)
 }
 
+/// After an edit the editor first renders this far past the edited stroke, s, ready to
+/// play at once...
+pub const FIRST_STEP_S: f64 = 0.4;
+/// ...then the rest in steps of this, s (each several times faster than real time, so
+/// playback started at once never runs out).
+pub const RESUME_STEP_S: f64 = 4.0;
+
 /// A rendering to resume from, with its sound state kept apart (it is large): the state
 /// is moved into the new rendering once its sound is being made, and left as it was if
 /// the rendering stops before.
 pub struct Previous<'a> {
     pub rendering: &'a Rendering,
     pub sound: &'a mut SoundState,
-    /// When resuming, stop about this long past the resume point, s: a partial rendering
-    /// whose audio is final up to [`Rendering::ready_s`], to play at once while the rest
-    /// is rendered (resuming from it).
+    /// When resuming, stop about this long past the first change (the first stroke that
+    /// differs, else the first target sample; for the same score, the resume point), s:
+    /// a partial rendering whose audio is final up to [`Rendering::ready_s`], to play at
+    /// once while the rest is rendered (resuming from it).
     pub stop_after_s: Option<f64>,
 }
 
@@ -327,10 +335,23 @@ pub fn render_after(
         let at = p
             .performance
             .resumable(&old.strokes, &composition.strokes, &targets, same_until);
-        same.then_some(at).flatten().map(|at| (p, at))
+        // Where the change is heard: the first stroke that differs, else the first
+        // target sample that does (none for the same score: a rendering continued).
+        let (new, old_strokes) = (&composition.strokes, &old.strokes);
+        let changed_s = (0..new.len().max(old_strokes.len()))
+            .find(|&i| new.get(i) != old_strokes.get(i))
+            .and_then(|i| new.get(i).or(old_strokes.get(i)))
+            .map(|s| s.time_s)
+            .or_else(|| {
+                (same_until < old.len().max(composition.len()))
+                    .then(|| start_s + same_until as f64 / rate)
+            });
+        same.then_some(at).flatten().map(|at| (p, at, changed_s))
     });
+    let mut changed_s = None;
     let mut performance = match resumed {
-        Some((p, at)) => {
+        Some((p, at, changed)) => {
+            changed_s = changed;
             let mut performance = p.performance.clone();
             performance.resume_at(at, targets, strokes);
             stats.resumed_from_s = Some(start_s + performance.sim.samples() as f64 / rate);
@@ -382,10 +403,10 @@ pub fn render_after(
         drum_time: Duration::ZERO,
         report: &mut report,
     };
-    let horizon = stats
-        .resumed_from_s
-        .zip(stop_after_s)
-        .map(|(from, after)| ((from + after - start_s) * rate).ceil().max(0.0) as usize);
+    let horizon = stats.resumed_from_s.zip(stop_after_s).map(|(from, after)| {
+        let at = changed_s.map_or(from, |c: f64| c.max(from));
+        ((at + after - start_s) * rate).ceil().max(0.0) as usize
+    });
     let outcome = performance.run(&composition.strokes, &aims, &mut stage, horizon);
     stats.drums = stage.drum_time;
     stats.simulate = began.elapsed();
