@@ -34,7 +34,7 @@ pub const SIMULATED_COLOURS: [Color32; 2] = [
 
 /// How much the membranes' motion is magnified in the view (a loud strike moves the
 /// head a millimetre or two).
-pub const MEMBRANE_MAGNIFICATION: f64 = 25.0;
+pub const MEMBRANE_MAGNIFICATION: f64 = 150.0;
 
 /// Vertical displacement of drum `index`'s head at `point` (performer frame) at score
 /// time `time_s`, m, as recorded by the rendering in `drums`; zero without one.
@@ -642,7 +642,7 @@ fn draw_drum(
     let r = 0.5 * drum.diameter_m;
     let on_head = |a: f64, scale: f64| {
         let mut p = centre + DVec3::new(a.cos(), a.sin(), 0.0) * r * scale;
-        p.z += (MEMBRANE_MAGNIFICATION * membrane(p)).clamp(-0.1, 0.1);
+        p.z += (MEMBRANE_MAGNIFICATION * membrane(p)).clamp(-0.05, 0.05);
         proj.project(p).map(|(q, _)| to_pos(rect, q))
     };
     let ring = |z_drop: f64, scale: f64| -> Option<Vec<Pos2>> {
