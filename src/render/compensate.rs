@@ -8,8 +8,8 @@
 //! cluster starts from its predecessors' settled shifts and depths (same hand, mode and
 //! dynamic), so repeated material settles at once.
 //!
-//! Every cluster start is a [`Commit`]: the performance can rewind there and resume with
-//! a changed score — bit for bit what a whole rendering of it would give, as long as
+//! Every cluster's start and end is a [`Commit`]: the performance can rewind there and
+//! resume with a changed score — bit for bit what a whole rendering of it would give, as long as
 //! nothing before the commit changed (the editor's re-simulation after an edit).
 
 use super::reference::{Targets, Warp};
@@ -52,15 +52,16 @@ pub struct Aims {
     pub first_depth_m: f64,
 }
 
-/// A cluster start the performance can resume from.
+/// A cluster's start or end: a state the performance can resume from.
 #[derive(Clone, Debug)]
 pub struct Commit {
     /// Strokes settled before it.
     pub strokes: usize,
     /// Task-rate samples simulated before it.
     pub samples: usize,
-    /// Samples simulated before its lead-in.
-    lead_from: usize,
+    /// At a cluster's start, the samples simulated before its lead-in; `None` at a
+    /// cluster's end.
+    lead_from: Option<usize>,
     sim: Checkpoint,
     drums: DrumCheckpoint,
     warp: [usize; 2],
@@ -132,6 +133,14 @@ impl Performance {
         }
     }
 
+    /// Stroke clusters settled.
+    pub fn clusters_settled(&self) -> usize {
+        self.commits
+            .iter()
+            .filter(|c| c.lead_from.is_some())
+            .count()
+    }
+
     /// Go back to commit `index` and continue with `targets` (of a changed score whose
     /// strokes before the commit, and targets up to its samples, are unchanged).
     pub fn resume_at(&mut self, index: usize, mut targets: Targets, strokes: usize) {
@@ -177,7 +186,9 @@ impl Performance {
                 && old[..k] == new[..k]
                 && targets.same_dips(&self.targets, k)
                 && clusters.iter().find(|r| r.start == k).is_some_and(|r| {
-                    lead_in(targets, r.clone(), rate, commit.lead_from) == commit.samples
+                    commit.lead_from.is_none_or(|from| {
+                        lead_in(targets, r.clone(), rate, from) == commit.samples
+                    })
                 })
         })
     }
@@ -283,7 +294,7 @@ impl Performance {
         }
         let commit = Commit {
             strokes: cluster.start,
-            lead_from: now,
+            lead_from: Some(now),
             samples: self.sim.samples(),
             sim: self.sim.checkpoint(),
             drums: self.drums.checkpoint(),
@@ -374,6 +385,14 @@ impl Performance {
             self.advance(until, stage)?;
         }
         self.settled = cluster.end;
+        self.commits.push(Commit {
+            strokes: cluster.end,
+            samples: self.sim.samples(),
+            lead_from: None,
+            sim: self.sim.checkpoint(),
+            drums: self.drums.checkpoint(),
+            warp: self.warp.lens(),
+        });
         Ok(())
     }
 

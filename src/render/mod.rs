@@ -413,7 +413,7 @@ pub fn render_after(
     let complete = outcome.map_err(|e| RenderError::of_simulation(e, start_s))?;
     let simulated_to_s = start_s + (performance.sim.samples().max(1) - 1) as f64 / rate;
     stats.simulated_s = performance.simulated_samples as f64 / rate;
-    stats.clusters = performance.commits.len();
+    stats.clusters = performance.clusters_settled();
     stats.attempts = performance.attempts;
     let drums = performance.drums.clone();
     let matches = strikes::match_strokes(&composition.strokes, drums.contacts());
