@@ -149,6 +149,8 @@ pub struct EditorApp {
     /// The rendering has audio playback does not have yet (a later part of the version
     /// playing).
     audio_behind: bool,
+    /// The latest rendering's audio as playback frames.
+    rendered_frames: Option<Arc<[kira::Frame]>>,
     plots: plots::Plots,
     recent: RecentFiles,
     show_help: bool,
@@ -199,6 +201,7 @@ impl EditorApp {
             audio_ready_s: f64::INFINITY,
             waiting_to_play: false,
             audio_behind: false,
+            rendered_frames: None,
             plots: plots::Plots::default(),
             recent: RecentFiles::load(options.recent_store),
             show_help: false,
@@ -472,6 +475,7 @@ impl EditorApp {
         self.rendering_current = current;
         self.status = r.summary;
         self.audio_behind = true;
+        self.rendered_frames = Some(r.frames);
         // A new version is heard at once; more of the same version only when the
         // playing audio is about to run out (each swap restarts the sound).
         if !r.continues || !self.playback.is_playing() {
@@ -481,12 +485,10 @@ impl EditorApp {
 
     /// Give playback the current rendering's audio.
     fn load_audio(&mut self) {
-        let Some(r) = &self.rendering else {
+        let (Some(r), Some(frames)) = (&self.rendering, &self.rendered_frames) else {
             return;
         };
-        if let Err(e) = self.playback.set_audio(&r.audio.samples) {
-            self.render_error = Some(format!("playback: {e}"));
-        }
+        self.playback.set_frames(Arc::clone(frames));
         self.audio_ready_s = if r.complete { f64::INFINITY } else { r.ready_s };
         self.audio_behind = false;
         if self.waiting_to_play && self.playhead_s + PLAY_AHEAD_S <= self.audio_ready_s {

@@ -25,6 +25,20 @@ pub enum PlaybackError {
     OddSampleCount(usize),
 }
 
+/// Stereo interleaved samples at [`AUDIO_RATE_HZ`] as playback frames.
+pub fn frames_of(interleaved: &[f32]) -> Result<Arc<[Frame]>, PlaybackError> {
+    if !interleaved.len().is_multiple_of(2) {
+        return Err(PlaybackError::OddSampleCount(interleaved.len()));
+    }
+    Ok(interleaved
+        .chunks_exact(2)
+        .map(|c| Frame {
+            left: c[0],
+            right: c[1],
+        })
+        .collect())
+}
+
 /// The playback clock and, when a device exists, the audio output.
 pub struct Playback {
     manager: Option<AudioManager<DefaultBackend>>,
@@ -83,16 +97,13 @@ impl Playback {
     /// Set the audio to play (stereo interleaved samples at [`AUDIO_RATE_HZ`]); if
     /// playing, it continues from the current position with the new audio.
     pub fn set_audio(&mut self, interleaved: &[f32]) -> Result<(), PlaybackError> {
-        if !interleaved.len().is_multiple_of(2) {
-            return Err(PlaybackError::OddSampleCount(interleaved.len()));
-        }
-        let frames: Arc<[Frame]> = interleaved
-            .chunks_exact(2)
-            .map(|c| Frame {
-                left: c[0],
-                right: c[1],
-            })
-            .collect();
+        self.set_frames(frames_of(interleaved)?);
+        Ok(())
+    }
+
+    /// [`set_audio`](Playback::set_audio) with the frames already made (e.g. on a worker
+    /// thread, sparing the UI thread the copy).
+    pub fn set_frames(&mut self, frames: Arc<[Frame]>) {
         self.audio = Some(StaticSoundData {
             sample_rate: AUDIO_RATE_HZ,
             frames,
@@ -103,7 +114,6 @@ impl Playback {
             let at = self.position_s();
             self.play_from(at);
         }
-        Ok(())
     }
 
     /// Start playing at `t_s` seconds.

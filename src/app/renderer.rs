@@ -30,6 +30,8 @@ pub struct Rendered {
     /// Whether it continues the previous rendering of the same score version (a later
     /// step after an edit) rather than showing a new version.
     pub continues: bool,
+    /// The audio as playback frames (made where the rendering is, not on the UI thread).
+    pub frames: Arc<[kira::Frame]>,
 }
 
 impl Rendered {
@@ -66,7 +68,10 @@ impl Rendered {
             tips: r.motion.tips.clone(),
             rendering: Some(Arc::clone(r)),
         };
+        let frames = super::playback::frames_of(&r.audio.samples)
+            .expect("rendered audio is stereo: an even number of samples");
         Rendered {
+            frames,
             complete: r.complete,
             continues: false,
             rendering,
