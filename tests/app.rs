@@ -309,7 +309,8 @@ fn space_plays_on_the_silent_clock() {
 /// and redo restore them; they are saved with the score and read back.
 #[test]
 fn inspector_edits_settings_undoably_and_saves_them() {
-    use timpanist::score::settings::{Control, Sound};
+    use timpanist::body::sim::Pipeline;
+    use timpanist::sound::SoundModel;
     let dir = tempfile::tempdir().unwrap();
     let mut h = harness(Some(demo()), dir.path());
     h.get_by_label("Physics and sound").click();
@@ -323,12 +324,12 @@ fn inspector_edits_settings_undoably_and_saves_them() {
     h.get_by_label("sample replay").click();
     settle(&mut h);
     let s = &h.state().loaded().unwrap().score.settings;
-    assert_eq!((s.control, s.sound), (Control::Id, Sound::Sample));
+    assert_eq!((s.control, s.sound), (Pipeline::Id, SoundModel::Sample));
     assert_eq!(h.state().undo_steps(), 2);
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
     settle(&mut h);
     let s = &h.state().loaded().unwrap().score.settings;
-    assert_eq!((s.control, s.sound), (Control::Id, Sound::Modal));
+    assert_eq!((s.control, s.sound), (Pipeline::Id, SoundModel::Modal));
     h.key_press_modifiers(
         egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
         egui::Key::Z,
@@ -336,7 +337,7 @@ fn inspector_edits_settings_undoably_and_saves_them() {
     settle(&mut h);
     assert_eq!(
         h.state().loaded().unwrap().score.settings.sound,
-        Sound::Sample
+        SoundModel::Sample
     );
     let path = dir.path().join("with-settings.ron");
     h.state_mut().save_to(&path);
@@ -348,5 +349,5 @@ fn inspector_edits_settings_undoably_and_saves_them() {
     let mut again = harness(Some(path), dir.path());
     settle(&mut again);
     let s = &again.state().loaded().unwrap().score.settings;
-    assert_eq!((s.control, s.sound), (Control::Id, Sound::Sample));
+    assert_eq!((s.control, s.sound), (Pipeline::Id, SoundModel::Sample));
 }

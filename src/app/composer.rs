@@ -68,7 +68,7 @@ impl Composer {
         slot.request = Some(Request {
             generation: self.generation,
             score: score.clone(),
-            kit: score.settings.kit(kit),
+            kit: score.settings.kit(kit).into_owned(),
             ctx,
         });
         cv.notify_one();

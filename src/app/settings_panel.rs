@@ -4,12 +4,16 @@
 //! the score's settings (a drag is one step) and the editor re-renders.
 
 use super::command::Command;
+use crate::body::ik::IkMethod;
+use crate::body::sim::Pipeline;
+use crate::drum::FrequencySource;
 use crate::score::LoadedScore;
 use crate::score::edit::ScoreEdit;
 use crate::score::settings::{
-    Control, DIAMETER_RANGE_M, DrumChange, Frequencies, GAIN_SCALE_RANGE, IkSolver,
-    MODE_COUNT_RANGE, Settings, Sound, TENSION_RANGE_N_PER_M,
+    DIAMETER_RANGE_M, DrumChange, GAIN_SCALE_RANGE, MODE_COUNT_RANGE, Settings,
+    TENSION_RANGE_N_PER_M,
 };
+use crate::sound::SoundModel;
 use eframe::egui;
 
 /// A combo box over `options` bound to `value`; whether it changed.
@@ -56,9 +60,9 @@ pub fn show(ui: &mut egui::Ui, doc: &LoadedScore, out: &mut Vec<Command>) {
                 "Control",
                 &mut after.control,
                 &[
-                    (Control::Himc, "HIMC (IK nested in PD)"),
-                    (Control::Id, "ID (PD + inverse dynamics)"),
-                    (Control::Ik, "IK (kinematic)"),
+                    (Pipeline::Himc, "HIMC (IK nested in PD)"),
+                    (Pipeline::Id, "ID (PD + inverse dynamics)"),
+                    (Pipeline::Ik, "IK (kinematic)"),
                 ],
             );
             started |= choose(
@@ -66,9 +70,9 @@ pub fn show(ui: &mut egui::Ui, doc: &LoadedScore, out: &mut Vec<Command>) {
                 "IK method",
                 &mut after.ik,
                 &[
-                    (IkSolver::DampedLeastSquares, "damped least squares"),
-                    (IkSolver::PseudoInverse, "pseudo-inverse"),
-                    (IkSolver::Transpose, "Jacobian transpose"),
+                    (IkMethod::DampedLeastSquares, "damped least squares"),
+                    (IkMethod::PseudoInverse, "pseudo-inverse"),
+                    (IkMethod::Transpose, "Jacobian transpose"),
                 ],
             );
             let name = ui.label("PD gains");
@@ -87,9 +91,9 @@ pub fn show(ui: &mut egui::Ui, doc: &LoadedScore, out: &mut Vec<Command>) {
                 "Sound model",
                 &mut after.sound,
                 &[
-                    (Sound::Modal, "modal (simulated force)"),
-                    (Sound::Sample, "sample replay"),
-                    (Sound::Signal, "signal (partials + noise)"),
+                    (SoundModel::Modal, "modal (simulated force)"),
+                    (SoundModel::Sample, "sample replay"),
+                    (SoundModel::Signal, "signal (partials + noise)"),
                 ],
             );
             let name = ui.label("Membrane modes");
@@ -103,8 +107,8 @@ pub fn show(ui: &mut egui::Ui, doc: &LoadedScore, out: &mut Vec<Command>) {
                 "Frequencies",
                 &mut after.frequencies,
                 &[
-                    (Frequencies::Measured, "measured kettledrum ratios"),
-                    (Frequencies::Membrane, "ideal membrane (tension)"),
+                    (FrequencySource::Measured, "measured kettledrum ratios"),
+                    (FrequencySource::Membrane, "ideal membrane (tension)"),
                 ],
             );
         });

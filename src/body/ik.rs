@@ -13,7 +13,7 @@ use crate::kit::Side;
 use glam::{DMat3, DQuat, DVec3};
 
 /// How each iteration turns the tip error into joint steps.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum IkMethod {
     /// Δθ = α·Jᵀe (α chosen by the optimal step along Jᵀe).
     Transpose,

@@ -25,7 +25,7 @@ use crate::kit::Side;
 use glam::DVec3;
 
 /// A control pipeline.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Pipeline {
     Ik,
     Id,

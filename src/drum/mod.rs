@@ -21,7 +21,7 @@ pub const DEFAULT_MODE_COUNT: usize = 24;
 pub const MAX_MODE_COUNT: usize = 200;
 
 /// Where mode frequencies come from.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum FrequencySource {
     /// The kit's measured ratios to the (1,1) for the modes it lists (kettledrum
     /// 1.50, 1.98, 2.44, 2.94 by default), the in-vacuo membrane for the others.

@@ -368,9 +368,13 @@ impl Performance {
             if (on_time && on_force) || acceptable || attempt >= aims.max_attempts {
                 break;
             }
-            let contacts = contacts.to_vec();
-            for (i, m) in cluster.clone().zip(matches) {
-                self.correct(i, m.map(|c| &contacts[c]), strokes[i].time_s, aims);
+            // Only the cluster's own contacts (the record is borrowed from the drums).
+            let found: Vec<_> = matches
+                .iter()
+                .map(|m| m.map(|c| contacts[c].clone()))
+                .collect();
+            for (i, contact) in cluster.clone().zip(found) {
+                self.correct(i, contact.as_ref(), strokes[i].time_s, aims);
             }
         }
         let (_, shifts, depths, kept) = best.expect("one attempt ran");

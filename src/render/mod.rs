@@ -15,11 +15,11 @@ pub mod compensate;
 pub mod reference;
 pub mod strikes;
 
-use crate::body::ik::{self, IkMethod, IkParams};
+use crate::body::ik::{self, IkParams};
 use crate::body::model::BodyModel;
 use crate::body::sim::{Motion, Pipeline, Reference, SimError, SimParams, Simulator};
 use crate::body::skeleton::{Pose, REST, Skeleton};
-use crate::drum::{DrumError, DrumSet, FrequencySource, ModeConfig};
+use crate::drum::{DrumError, DrumSet, ModeConfig};
 use crate::kit::Kit;
 use crate::kit::Side;
 use crate::mocap::db::MotionDb;
@@ -77,37 +77,21 @@ pub struct RenderParams {
 impl RenderParams {
     /// The defaults with a score's settings (control, IK, gains, sound, modes).
     pub fn for_score(settings: &Settings) -> RenderParams {
-        use crate::score::settings::{Control, Frequencies, IkSolver, Sound};
         let sim = SimParams::default();
         RenderParams {
-            control: match settings.control {
-                Control::Himc => Pipeline::Himc,
-                Control::Id => Pipeline::Id,
-                Control::Ik => Pipeline::Ik,
-            },
+            control: settings.control,
             sim: SimParams {
                 ik: IkParams {
-                    method: match settings.ik {
-                        IkSolver::Transpose => IkMethod::Transpose,
-                        IkSolver::PseudoInverse => IkMethod::PseudoInverse,
-                        IkSolver::DampedLeastSquares => IkMethod::DampedLeastSquares,
-                    },
+                    method: settings.ik,
                     ..sim.ik.clone()
                 },
                 ..sim
             },
             gain_scale: settings.gain_scale,
-            sound: match settings.sound {
-                Sound::Modal => SoundModel::Modal,
-                Sound::Sample => SoundModel::Sample,
-                Sound::Signal => SoundModel::Signal,
-            },
+            sound: settings.sound,
             modes: ModeConfig {
                 count: settings.modes,
-                source: match settings.frequencies {
-                    Frequencies::Measured => FrequencySource::Measured,
-                    Frequencies::Membrane => FrequencySource::Membrane,
-                },
+                source: settings.frequencies,
             },
             ..RenderParams::default()
         }
@@ -291,7 +275,7 @@ pub fn render_after(
     progress: &mut dyn FnMut(Progress) -> bool,
 ) -> Result<Rendering, RenderError> {
     let mut stats = Stats::default();
-    let kit = &loaded.score.settings.kit(&loaded.kit);
+    let kit: &Kit = &loaded.score.settings.kit(&loaded.kit);
     let mallet = kit
         .mallets
         .get(params.mallet)

@@ -3,52 +3,14 @@
 //! of the kit (head diameter, tension). Absent from a file means the defaults; a score
 //! with default settings is written without them.
 
+use crate::body::ik::IkMethod;
+use crate::body::sim::Pipeline;
+use crate::drum::FrequencySource;
 use crate::kit::Kit;
 use crate::problem::Problem;
+use crate::sound::SoundModel;
 use serde::{Deserialize, Serialize};
-
-/// The control pipeline that drives the simulated body.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Control {
-    /// IK nested in PD control (seed 000 Alg. 2).
-    #[default]
-    Himc,
-    /// PD inverse dynamics tracking the joint targets.
-    Id,
-    /// Kinematic IK only (no dynamics).
-    Ik,
-}
-
-/// How the IK solves for the joint angles.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum IkSolver {
-    Transpose,
-    PseudoInverse,
-    #[default]
-    DampedLeastSquares,
-}
-
-/// Which sound model renders.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Sound {
-    /// Modal voices driven by the simulated contact force.
-    #[default]
-    Modal,
-    /// A recorded note per drum.
-    Sample,
-    /// Decaying partials plus a noise burst.
-    Signal,
-}
-
-/// Where the membrane's mode frequencies come from.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Frequencies {
-    /// The kit's measured kettledrum ratios.
-    #[default]
-    Measured,
-    /// The ideal membrane from tension, density and air loading.
-    Membrane,
-}
+use std::borrow::Cow;
 
 /// A change to one drum of the kit.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -77,14 +39,14 @@ pub const TENSION_RANGE_N_PER_M: std::ops::RangeInclusive<f64> = 500.0..=20_000.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Settings {
-    pub control: Control,
-    pub ik: IkSolver,
+    pub control: Pipeline,
+    pub ik: IkMethod,
     /// Every PD gain multiplied by this (1 = nominal).
     pub gain_scale: f64,
-    pub sound: Sound,
+    pub sound: SoundModel,
     /// Membrane modes per head (both orientations of a pair count).
     pub modes: usize,
-    pub frequencies: Frequencies,
+    pub frequencies: FrequencySource,
     /// Changes to the kit's drums, at most one per drum.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub drums: Vec<DrumChange>,
@@ -93,12 +55,12 @@ pub struct Settings {
 impl Default for Settings {
     fn default() -> Self {
         Settings {
-            control: Control::Himc,
-            ik: IkSolver::DampedLeastSquares,
+            control: Pipeline::Himc,
+            ik: IkMethod::DampedLeastSquares,
             gain_scale: 1.0,
-            sound: Sound::Modal,
+            sound: SoundModel::Modal,
             modes: crate::drum::ModeConfig::default().count,
-            frequencies: Frequencies::Measured,
+            frequencies: FrequencySource::Measured,
             drums: Vec::new(),
         }
     }
@@ -124,8 +86,12 @@ impl Settings {
         }
     }
 
-    /// `kit` with the drum changes applied.
-    pub fn kit(&self, kit: &Kit) -> Kit {
+    /// `kit` with the drum changes applied (borrowed as it is when there are none: the
+    /// 3D view asks every frame).
+    pub fn kit<'k>(&self, kit: &'k Kit) -> Cow<'k, Kit> {
+        if self.drums.is_empty() {
+            return Cow::Borrowed(kit);
+        }
         let mut kit = kit.clone();
         for change in &self.drums {
             if let Some(drum) = kit.drums.get_mut(change.drum) {
@@ -137,7 +103,7 @@ impl Settings {
                 }
             }
         }
-        kit
+        Cow::Owned(kit)
     }
 
     /// Every problem with these settings for `kit`, named by their place in the file.

@@ -35,7 +35,9 @@ pub const REFERENCE_SPEED_MPS: f64 = 4.94;
 pub const REFERENCE_LEVEL: f64 = 0.5;
 
 /// Which sound model renders.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
 pub enum SoundModel {
     /// Modal voices driven by the simulated contact force.
     #[default]
