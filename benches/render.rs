@@ -13,7 +13,7 @@
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use std::path::Path;
 use timpanist::mocap::db::MotionDb;
-use timpanist::render::{FIRST_STEP_S, Previous, RenderParams, render, render_after};
+use timpanist::render::{FIRST_STEP_S, RenderParams, render, render_after};
 use timpanist::score::{Dynamic, LoadedScore};
 
 fn bench(c: &mut Criterion) {
@@ -24,7 +24,9 @@ fn bench(c: &mut Criterion) {
     c.bench_function("render the one-minute study (HIMC, modal)", |b| {
         b.iter(|| render(&loaded, &db, &params, &mut |_| true).expect("renders"))
     });
-    let before = render(&loaded, &db, &params, &mut |_| true).expect("renders");
+    let mut resume = None;
+    let before =
+        render_after(&mut resume, None, &loaded, &db, &params, &mut |_| true).expect("renders");
     let mut edited = loaded.clone();
     let beat = before
         .composition
@@ -48,15 +50,17 @@ fn bench(c: &mut Criterion) {
     ] {
         c.bench_function(name, |b| {
             b.iter_batched(
-                || before.sound.clone(),
-                |mut sound| {
-                    let previous = Previous {
-                        rendering: &before,
-                        sound: &mut sound,
+                || resume.clone(),
+                |mut resume| {
+                    let r = render_after(
+                        &mut resume,
                         stop_after_s,
-                    };
-                    let r = render_after(Some(previous), &edited, &db, &params, &mut |_| true)
-                        .expect("renders");
+                        &edited,
+                        &db,
+                        &params,
+                        &mut |_| true,
+                    )
+                    .expect("renders");
                     assert!(r.stats.resumed_from_s.is_some(), "the edit resumes");
                     r
                 },

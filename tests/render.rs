@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use timpanist::kit::Kit;
 use timpanist::mocap::db::MotionDb;
-use timpanist::render::{Previous, RenderError, RenderParams, Rendering, render, render_after};
+use timpanist::render::{RenderError, RenderParams, Rendering, Resume, render, render_after};
 use timpanist::rng::Rng;
 use timpanist::score::{Beat, Dynamic, Hand, ImpactLocation, LoadedScore, PlayingMode, Score};
 
@@ -97,7 +97,11 @@ fn resumed_render_after_an_edit_equals_a_whole_render() {
     let db = db();
     let loaded = LoadedScore::load(&root().join("scores/tempo-change.ron")).unwrap();
     let params = RenderParams::default();
-    let before = render(&loaded, &db, &params, &mut |_| true).unwrap();
+    let mut after_before: Option<Resume> = None;
+    let before = render_after(&mut after_before, None, &loaded, &db, &params, &mut |_| {
+        true
+    })
+    .unwrap();
     let late = loaded.score.beats.len() * 3 / 4;
     for (beat, resumes) in [(late, true), (0, false)] {
         let mut edited = loaded.clone();
@@ -108,12 +112,9 @@ fn resumed_render_after_an_edit_equals_a_whole_render() {
             Dynamic::Ff
         };
         let whole = render(&edited, &db, &params, &mut |_| true).unwrap();
-        let previous = Previous {
-            rendering: &before,
-            sound: &mut before.sound.clone(),
-            stop_after_s: None,
-        };
-        let resumed = render_after(Some(previous), &edited, &db, &params, &mut |_| true).unwrap();
+        let mut resume = after_before.clone();
+        let resumed =
+            render_after(&mut resume, None, &edited, &db, &params, &mut |_| true).unwrap();
         assert!(resumed.complete);
         let edit_s = whole
             .composition
@@ -149,17 +150,14 @@ fn partial_render_then_rest_equals_a_whole_render() {
     let db = db();
     let loaded = LoadedScore::load(&root().join("scores/tempo-change.ron")).unwrap();
     let params = RenderParams::default();
-    let before = render(&loaded, &db, &params, &mut |_| true).unwrap();
+    let mut resume = None;
+    render_after(&mut resume, None, &loaded, &db, &params, &mut |_| true).unwrap();
     let mut edited = loaded.clone();
     let beat = edited.score.beats.len() / 2;
     edited.score.beats[beat].mode = PlayingMode::Staccato;
     let whole = render(&edited, &db, &params, &mut |_| true).unwrap();
-    let previous = Previous {
-        rendering: &before,
-        sound: &mut before.sound.clone(),
-        stop_after_s: Some(0.3),
-    };
-    let mut partial = render_after(Some(previous), &edited, &db, &params, &mut |_| true).unwrap();
+    let partial =
+        render_after(&mut resume, Some(0.3), &edited, &db, &params, &mut |_| true).unwrap();
     let from = partial.stats.resumed_from_s.expect("resumes");
     assert!(!partial.complete);
     assert!(
@@ -169,17 +167,43 @@ fn partial_render_then_rest_equals_a_whole_render() {
     );
     let ready = 2 * (partial.ready_s * 48_000.0) as usize;
     assert_eq!(partial.audio.samples[..ready], whole.audio.samples[..ready]);
-    let mut sound = std::mem::take(&mut partial.sound);
-    let rest = Previous {
-        rendering: &partial,
-        sound: &mut sound,
-        stop_after_s: None,
-    };
-    let rest = render_after(Some(rest), &edited, &db, &params, &mut |_| true).unwrap();
+    let rest = render_after(&mut resume, None, &edited, &db, &params, &mut |_| true).unwrap();
     assert!(rest.complete && rest.stats.resumed_from_s.is_some());
     assert_eq!(rest.audio.samples, whole.audio.samples);
     assert_eq!(rest.motion, whole.motion);
     assert_eq!(rest.events, whole.events);
+}
+
+/// A rendering cancelled part way (the editor cancels one at each newer edit) leaves a
+/// state the next rendering resumes from: after it, rendering another edit gives bit for
+/// bit what rendering that edit whole gives.
+#[test]
+fn rendering_after_a_cancelled_one_equals_a_whole_render() {
+    let db = db();
+    let loaded = LoadedScore::load(&root().join("scores/tempo-change.ron")).unwrap();
+    let params = RenderParams::default();
+    let mut resume = None;
+    render_after(&mut resume, None, &loaded, &db, &params, &mut |_| true).unwrap();
+    let beats = loaded.score.beats.len();
+    let mut first = loaded.clone();
+    first.score.beats[beats / 2].mode = PlayingMode::Staccato;
+    let mut calls = 0;
+    let cancelled = render_after(&mut resume, None, &first, &db, &params, &mut |p| {
+        calls += 1;
+        p.stage != "simulating" || calls < 40
+    });
+    assert!(
+        matches!(cancelled, Err(RenderError::Cancelled)),
+        "{cancelled:?}"
+    );
+    let mut second = first.clone();
+    second.score.beats[beats * 3 / 4].dynamic = Dynamic::Pp;
+    let whole = render(&second, &db, &params, &mut |_| true).unwrap();
+    let resumed = render_after(&mut resume, None, &second, &db, &params, &mut |_| true).unwrap();
+    assert!(resumed.stats.resumed_from_s.is_some(), "it resumes");
+    assert_eq!(resumed.audio.samples, whole.audio.samples);
+    assert_eq!(resumed.motion, whole.motion);
+    assert_eq!(resumed.events, whole.events);
 }
 
 fn below(rng: &mut Rng, n: u64) -> u64 {

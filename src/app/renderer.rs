@@ -10,9 +10,8 @@
 use super::pose::Simulated;
 use crate::kit::Kit;
 use crate::mocap::db::MotionDb;
-use crate::render::{FIRST_STEP_S, Previous, RESUME_STEP_S, RenderParams, Rendering, render_after};
+use crate::render::{FIRST_STEP_S, RESUME_STEP_S, RenderParams, Rendering, Resume, render_after};
 use crate::score::{LoadedScore, Score};
-use crate::sound::SoundState;
 use eframe::egui;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex, mpsc};
@@ -179,9 +178,8 @@ impl Drop for Renderer {
 
 fn work(shared: &(Mutex<Slot>, Condvar), latest: &AtomicU64, tx: &mpsc::Sender<Reply>) {
     let mut db: Option<Result<MotionDb, String>> = None;
-    // The latest finished rendering and its sound state: the next one resumes from them
-    // where it can.
-    let mut previous: Option<(Arc<Rendering>, SoundState)> = None;
+    // What the renderings so far left: the next one resumes from it where it can.
+    let mut resume: Option<Resume> = None;
     loop {
         let request = {
             let (lock, cv) = shared;
@@ -211,17 +209,12 @@ fn work(shared: &(Mutex<Slot>, Condvar), latest: &AtomicU64, tx: &mpsc::Sender<R
         let mut complete = false;
         let mut first = true;
         while !complete {
-            let from = previous.as_mut().map(|(r, sound)| Previous {
-                rendering: r,
-                sound,
-                stop_after_s: Some(if first { FIRST_STEP_S } else { RESUME_STEP_S }),
-            });
+            let stop_after_s = if first { FIRST_STEP_S } else { RESUME_STEP_S };
             let continues = !first;
             first = false;
-            let result = run(&request, db, latest, from).map(|(mut rendered, sound)| {
-                previous = Some((Arc::clone(&rendered.rendering), sound));
-                rendered.continues = continues;
-                rendered
+            let result = run(&request, db, latest, &mut resume, stop_after_s).map(|mut r| {
+                r.continues = continues;
+                r
             });
             if result.as_ref().is_err_and(|e| e == CANCELLED) {
                 break;
@@ -243,8 +236,9 @@ fn run(
     request: &Request,
     db: &MotionDb,
     latest: &AtomicU64,
-    previous: Option<Previous>,
-) -> Result<(Rendered, SoundState), String> {
+    resume: &mut Option<Resume>,
+    stop_after_s: f64,
+) -> Result<Rendered, String> {
     let loaded = LoadedScore {
         score: request.score.clone(),
         kit: request.kit.clone(),
@@ -252,13 +246,17 @@ fn run(
         notices: Vec::new(),
     };
     let params = RenderParams::for_score(&loaded.score.settings);
-    let mut r = render_after(previous, &loaded, db, &params, &mut |_| {
-        latest.load(Ordering::SeqCst) == request.generation
-    })
+    let r = render_after(
+        resume,
+        Some(stop_after_s),
+        &loaded,
+        db,
+        &params,
+        &mut |_| latest.load(Ordering::SeqCst) == request.generation,
+    )
     .map_err(|e| match e {
         crate::render::RenderError::Cancelled => CANCELLED.to_string(),
         e => e.to_string(),
     })?;
-    let sound = std::mem::take(&mut r.sound);
-    Ok((Rendered::new(Arc::new(r)), sound))
+    Ok(Rendered::new(Arc::new(r)))
 }

@@ -32,6 +32,9 @@ const MAX_SHIFT_S: f64 = 0.035;
 const MAX_DEPTH_M: f64 = 0.06;
 /// The shift moves to a cluster's over at most this long before its first dip, s.
 const TRANSITION_S: f64 = 0.06;
+/// Within a lead-in, a state is saved every this many seconds (so an edit there resumes
+/// close to it).
+pub const LEAD_COMMIT_EVERY_S: f64 = 0.05;
 
 /// What each stroke aims for and when a cluster is settled.
 #[derive(Clone, Debug, PartialEq)]
@@ -52,16 +55,17 @@ pub struct Aims {
     pub first_depth_m: f64,
 }
 
-/// A cluster's start or end: a state the performance can resume from.
+/// A cluster's start or end, or a point in a lead-in: a state the performance can resume
+/// from.
 #[derive(Clone, Debug)]
 pub struct Commit {
     /// Strokes settled before it.
     pub strokes: usize,
     /// Task-rate samples simulated before it.
     pub samples: usize,
-    /// At a cluster's start, the samples simulated before its lead-in; `None` at a
-    /// cluster's end.
-    lead_from: Option<usize>,
+    /// In or at the end of a lead-in (a cluster's start), the samples simulated before
+    /// the lead-in and at its end; `None` at a cluster's end.
+    lead: Option<(usize, usize)>,
     sim: Checkpoint,
     drums: DrumCheckpoint,
     warp: [usize; 2],
@@ -113,6 +117,8 @@ pub struct Performance {
     /// Simulation attempts over clusters, and task-rate samples simulated in all.
     pub attempts: usize,
     pub simulated_samples: usize,
+    /// Resumed within a lead-in: where that lead-in began (samples).
+    lead_from: Option<usize>,
 }
 
 impl Performance {
@@ -130,6 +136,7 @@ impl Performance {
             commits: Vec::new(),
             attempts: 0,
             simulated_samples: 0,
+            lead_from: None,
         }
     }
 
@@ -137,7 +144,7 @@ impl Performance {
     pub fn clusters_settled(&self) -> usize {
         self.commits
             .iter()
-            .filter(|c| c.lead_from.is_some())
+            .filter(|c| c.lead.is_some_and(|(_, to)| to == c.samples))
             .count()
     }
 
@@ -158,6 +165,7 @@ impl Performance {
         self.targets
             .write(&self.warp, &mut self.reference, 0..commit.samples + 1);
         self.settled = commit.strokes;
+        self.lead_from = commit.lead.map(|(from, _)| from);
         self.attempts = 0;
         self.simulated_samples = 0;
     }
@@ -186,9 +194,9 @@ impl Performance {
                 && old[..k] == new[..k]
                 && targets.same_dips(&self.targets, k)
                 && clusters.iter().find(|r| r.start == k).is_some_and(|r| {
-                    commit.lead_from.is_none_or(|from| {
-                        lead_in(targets, r.clone(), rate, from) == commit.samples
-                    })
+                    commit
+                        .lead
+                        .is_none_or(|(from, to)| lead_in(targets, r.clone(), rate, from) == to)
                 })
         })
     }
@@ -208,15 +216,11 @@ impl Performance {
             if cluster.start < self.settled {
                 continue;
             }
-            let now = self.sim.samples();
-            let lead = lead_in(&self.targets, cluster.clone(), rate, now);
+            let from = self.lead_from.unwrap_or(self.sim.samples());
+            let lead = lead_in(&self.targets, cluster.clone(), rate, from);
             if let Some(h) = horizon.filter(|&h| lead > h) {
                 // Up to the horizon the shifts are held as the lead-in would hold them.
-                if h > now {
-                    self.targets
-                        .write(&self.warp, &mut self.reference, now..h + 1);
-                    self.advance(h, stage)?;
-                }
+                self.lead_into(cluster.start, (from, lead), h, stage)?;
                 return Ok(false);
             }
             self.settle(cluster, strokes, aims, stage)?;
@@ -226,6 +230,38 @@ impl Performance {
         self.targets.write(&self.warp, &mut self.reference, now..n);
         self.advance(n, stage)?;
         Ok(true)
+    }
+
+    /// Simulate the lead-in `from..to` to the cluster starting at stroke `first` as far
+    /// as `until`, saving a state every [`LEAD_COMMIT_EVERY_S`] within it.
+    fn lead_into(
+        &mut self,
+        first: usize,
+        (from, to): (usize, usize),
+        until: usize,
+        stage: &mut Stage,
+    ) -> Result<(), SimError> {
+        let now = self.sim.samples();
+        if until <= now {
+            return Ok(());
+        }
+        self.targets
+            .write(&self.warp, &mut self.reference, now..until + 1);
+        let every = ((LEAD_COMMIT_EVERY_S * self.reference.rate_hz).round() as usize).max(1);
+        let mut next = (now / every + 1) * every;
+        while next < until.min(to) {
+            self.advance(next, stage)?;
+            self.commits.push(Commit {
+                strokes: first,
+                samples: next,
+                lead: Some((from, to)),
+                sim: self.sim.checkpoint(),
+                drums: self.drums.checkpoint(),
+                warp: self.warp.lens(),
+            });
+            next += every;
+        }
+        self.advance(until, stage)
     }
 
     fn advance(&mut self, until: usize, stage: &mut Stage) -> Result<(), SimError> {
@@ -284,17 +320,13 @@ impl Performance {
         self.warm_start(cluster.clone(), strokes, aims.first_depth_m);
         // Lead-in: hold the shifts until shortly before the cluster's first dip, simulated
         // once.
-        let now = self.sim.samples();
-        let lead = lead_in(&self.targets, cluster.clone(), rate, now);
+        let from = self.lead_from.take().unwrap_or(self.sim.samples());
+        let lead = lead_in(&self.targets, cluster.clone(), rate, from);
         self.warp.anchor(lead as f64 / rate);
-        if lead > now {
-            self.targets
-                .write(&self.warp, &mut self.reference, now..lead + 1);
-            self.advance(lead, stage)?;
-        }
+        self.lead_into(cluster.start, (from, lead), lead, stage)?;
         let commit = Commit {
             strokes: cluster.start,
-            lead_from: Some(now),
+            lead: Some((from, lead)),
             samples: self.sim.samples(),
             sim: self.sim.checkpoint(),
             drums: self.drums.checkpoint(),
@@ -392,7 +424,7 @@ impl Performance {
         self.commits.push(Commit {
             strokes: cluster.end,
             samples: self.sim.samples(),
-            lead_from: None,
+            lead: None,
             sim: self.sim.checkpoint(),
             drums: self.drums.checkpoint(),
             warp: self.warp.lens(),

@@ -25,10 +25,11 @@ use crate::kit::Side;
 use crate::mocap::db::MotionDb;
 use crate::motion::compose::{ComposeParams, Composition};
 use crate::motion::perform;
-use crate::motion::plan::PlanParams;
+use crate::motion::plan::{PlanParams, PlannedStroke};
 use crate::score::{LoadedScore, Settings};
 use crate::sound::{Audio, SoundError, SoundModel, SoundState};
 use compensate::{Aims, Performance, Stage};
+use glam::DVec3;
 use reference::{StrikeShape, Targets, Warp};
 use std::time::{Duration, Instant};
 use strikes::{StrikeEvent, Timing};
@@ -192,11 +193,8 @@ pub struct Rendering {
     /// Stereo audio from score time 0.
     pub audio: Audio,
     pub stats: Stats,
-    /// The settled performance, to resume from after an edit.
-    pub performance: Performance,
-    /// What re-synthesis after an edit needs (large: take it out to keep it apart).
-    pub sound: SoundState,
-    /// Whether the whole score is rendered (else see [`Previous::stop_after_s`]).
+    /// Whether the whole score is rendered (else it stopped as [`render_after`] was
+    /// told).
     pub complete: bool,
     /// Score time up to which the audio is final, s (the end of the audio when
     /// complete).
@@ -241,7 +239,7 @@ pub fn render(
     params: &RenderParams,
     progress: &mut dyn FnMut(Progress) -> bool,
 ) -> Result<Rendering, RenderError> {
-    render_after(None, loaded, db, params, progress)
+    render_after(&mut None, None, loaded, db, params, progress)
 }
 
 /// After an edit the editor first renders this far past the edited stroke, s, ready to
@@ -251,24 +249,33 @@ pub const FIRST_STEP_S: f64 = 0.4;
 /// playback started at once never runs out).
 pub const RESUME_STEP_S: f64 = 4.0;
 
-/// A rendering to resume from, with its sound state kept apart (it is large): the state
-/// is moved into the new rendering once its sound is being made, and left as it was if
-/// the rendering stops before.
-pub struct Previous<'a> {
-    pub rendering: &'a Rendering,
-    pub sound: &'a mut SoundState,
-    /// When resuming, stop about this long past the first change (the first stroke that
-    /// differs, else the first target sample; for the same score, the resume point), s:
-    /// a partial rendering whose audio is final up to [`Rendering::ready_s`], to play at
-    /// once while the rest is rendered (resuming from it).
-    pub stop_after_s: Option<f64>,
+/// What renderings leave behind to resume from after an edit: the settled performance,
+/// the sound's synthesis state and what they were made from. Whoever renders again keeps
+/// it (the editor's worker) and each rendering updates it in place, without copying it;
+/// also one that is cancelled or fails leaves a state a later rendering can resume from.
+#[derive(Clone, Debug)]
+pub struct Resume {
+    performance: Performance,
+    sound: SoundState,
+    /// The composition performed: its strokes and target tips, its start and rate.
+    strokes: Vec<PlannedStroke>,
+    tips: [Vec<DVec3>; 2],
+    start_s: f64,
+    rate_hz: f64,
+    params: RenderParams,
+    kit: Kit,
 }
 
-/// [`render`], resuming `previous`'s performance from the latest point before the score
-/// changed when it can (same kit and parameters), and its sound from there: bit for bit
-/// the same result, faster.
+/// [`render`], resuming from `resume` (when given, and for the same kit and parameters)
+/// at the latest saved state before the score changed, and its sound from there: bit
+/// for bit the same result, faster. Given `stop_after_s`, a resumed rendering stops
+/// about that long past the first change (the first stroke that differs, else the first
+/// target sample; for the same score, the resume point), s: a partial rendering whose
+/// audio is final up to [`Rendering::ready_s`], to play at once while the rest is
+/// rendered (resuming from it). `resume` is left describing this rendering.
 pub fn render_after(
-    previous: Option<Previous>,
+    resume: &mut Option<Resume>,
+    stop_after_s: Option<f64>,
     loaded: &LoadedScore,
     db: &MotionDb,
     params: &RenderParams,
@@ -303,43 +310,44 @@ pub fn render_after(
     };
     let targets = Targets::new(&composition, &shape, params.strike_depth_m);
     let strokes = composition.strokes.len();
-    let (previous, previous_sound, stop_after_s) = match previous {
-        Some(p) => (Some(p.rendering), Some(p.sound), p.stop_after_s),
-        None => (None, None, None),
-    };
-    let resumed = previous.and_then(|p| {
-        let same = p.params == *params
-            && p.kit == *kit
-            && p.composition.start_s == start_s
-            && p.composition.rate_hz == rate;
-        let old = &p.composition;
-        let same_until = (0..old.len().min(composition.len()))
-            .find(|&k| (0..2).any(|h| old.tips[h][k] != composition.tips[h][k]))
-            .unwrap_or(old.len().min(composition.len()));
+    let same_heads = resume
+        .as_ref()
+        .is_some_and(|r| r.kit == *kit && r.params.modes == params.modes);
+    let resumed = resume.as_ref().and_then(|p| {
+        let same =
+            p.params == *params && p.kit == *kit && p.start_s == start_s && p.rate_hz == rate;
+        let old_len = p.tips[0].len();
+        let same_until = (0..old_len.min(composition.len()))
+            .find(|&k| (0..2).any(|h| p.tips[h][k] != composition.tips[h][k]))
+            .unwrap_or(old_len.min(composition.len()));
         let at = p
             .performance
-            .resumable(&old.strokes, &composition.strokes, &targets, same_until);
+            .resumable(&p.strokes, &composition.strokes, &targets, same_until);
         // Where the change is heard: the first stroke that differs, else the first
         // target sample that does (none for the same score: a rendering continued).
-        let (new, old_strokes) = (&composition.strokes, &old.strokes);
-        let changed_s = (0..new.len().max(old_strokes.len()))
-            .find(|&i| new.get(i) != old_strokes.get(i))
-            .and_then(|i| new.get(i).or(old_strokes.get(i)))
+        let (new, old) = (&composition.strokes, &p.strokes);
+        let changed_s = (0..new.len().max(old.len()))
+            .find(|&i| new.get(i) != old.get(i))
+            .and_then(|i| new.get(i).or(old.get(i)))
             .map(|s| s.time_s)
             .or_else(|| {
-                (same_until < old.len().max(composition.len()))
+                (same_until < old_len.max(composition.len()))
                     .then(|| start_s + same_until as f64 / rate)
             });
-        same.then_some(at).flatten().map(|at| (p, at, changed_s))
+        same.then_some(at).flatten().map(|at| (at, changed_s))
     });
     let mut changed_s = None;
-    let mut performance = match resumed {
-        Some((p, at, changed)) => {
+    let (performance, sound) = match resumed {
+        Some((at, changed)) => {
             changed_s = changed;
-            let mut performance = p.performance.clone();
+            let Resume {
+                mut performance,
+                sound,
+                ..
+            } = resume.take().expect("resuming");
             performance.resume_at(at, targets, strokes);
             stats.resumed_from_s = Some(start_s + performance.sim.samples() as f64 / rate);
-            performance
+            (performance, sound)
         }
         None => {
             let model = BodyModel::new(
@@ -359,9 +367,27 @@ pub fn render_after(
             .map_err(|e| RenderError::of_simulation(e, start_s))?;
             let dt = 1.0 / (rate * (params.sim.sim_hz / rate).round().max(1.0));
             let drums = DrumSet::new(kit, mallet, &params.modes, dt)?;
-            Performance::new(targets, sim, drums, strokes)
+            // The sound compares each drum's record itself: it resumes whenever the
+            // heads are the same.
+            let sound = resume
+                .take()
+                .filter(|_| same_heads)
+                .map(|r| r.sound)
+                .unwrap_or_default();
+            (Performance::new(targets, sim, drums, strokes), sound)
         }
     };
+    let state = resume.insert(Resume {
+        performance,
+        sound,
+        strokes: composition.strokes.clone(),
+        tips: composition.tips.clone(),
+        start_s,
+        rate_hz: rate,
+        params: params.clone(),
+        kit: kit.clone(),
+    });
+    let performance = &mut state.performance;
     let aims = Aims {
         force_n: composition
             .strokes
@@ -399,7 +425,7 @@ pub fn render_after(
     stats.simulated_s = performance.simulated_samples as f64 / rate;
     stats.clusters = performance.clusters_settled();
     stats.attempts = performance.attempts;
-    let drums = performance.drums.clone();
+    let drums = &performance.drums;
     let matches = strikes::match_strokes(&composition.strokes, drums.contacts());
     let timing = strikes::timing(&strikes::errors(
         &composition.strokes,
@@ -423,28 +449,34 @@ pub fn render_after(
             simulated_to_s - 2.0 * performance.drums.dt_s(),
         )
     };
-    let resume_sound = previous_sound.map(std::mem::take).zip(stats.resumed_from_s);
-    let (audio, sound) =
-        crate::sound::render_resuming(kit, &drums, end_s.max(0.0), params.sound, resume_sound)?;
+    // The sound resumes whatever the performance did when the heads are the same: it
+    // compares each drum's record itself.
+    let previous_sound = std::mem::take(&mut state.sound);
+    let (audio, sound) = crate::sound::render_resuming(
+        kit,
+        drums,
+        end_s.max(0.0),
+        params.sound,
+        Some(previous_sound),
+    )?;
+    state.sound = sound;
     stats.sound = began.elapsed();
     let events = strikes::events(&composition.strokes, drums.contacts(), &matches);
     progress(Progress {
         stage: "done",
         fraction: 1.0,
     });
-    let reference = performance.targets.reference(&performance.warp);
+    let performance = &state.performance;
     Ok(Rendering {
-        reference,
+        reference: performance.targets.reference(&performance.warp),
         motion: performance.sim.motion().clone(),
         composition,
         start_s,
-        drums,
+        drums: performance.drums.clone(),
         events,
         timing,
         audio,
         stats,
-        performance,
-        sound,
         complete,
         ready_s: ready_s.max(0.0),
         params: params.clone(),

@@ -153,16 +153,20 @@ pub fn pan_gains(x_m: f64) -> (f64, f64) {
     (angle.cos(), angle.sin())
 }
 
-/// What a rendering of sound keeps to re-synthesise only from a change on: each drum's
-/// mono output and saved synthesis states (modal model), and the mix before
-/// normalisation.
+/// Frames per block over which a rendering keeps the mix's peak (0.1 s).
+const PEAK_BLOCK: usize = 4800;
+
+/// What a rendering of sound keeps to re-synthesise only what changed: each drum's mono
+/// output and synthesis state (modal model), the mix before normalisation and its peak
+/// per [`PEAK_BLOCK`].
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SoundState {
     model: SoundModel,
-    /// Per drum: mono output, saved states, whether anything touched it.
-    drums: Vec<(Vec<f32>, Vec<modal::Saved>, bool)>,
+    /// Per drum: mono output, synthesis state, whether anything touched it.
+    drums: Vec<(Vec<f32>, modal::DrumSynth, bool)>,
     /// Interleaved stereo mix before the normalisation gain.
     mix: Vec<f32>,
+    peaks: Vec<f32>,
 }
 
 /// Render `duration_s` of sound from what `drums` recorded (excitation, contacts).
@@ -175,16 +179,16 @@ pub fn render(
     render_resuming(kit, drums, duration_s, model, None).map(|(audio, _)| audio)
 }
 
-/// [`render`], re-synthesising only from `changed_s` on when `previous` (of the same kit
-/// and model) is given: `drums` must have recorded the same excitation before
-/// `changed_s` (score seconds) as the rendering that left `previous`. Bit for bit a whole
-/// render. Only the modal model resumes; the others render whole.
+/// [`render`], re-synthesising only what changed when `previous` (a rendering's state of
+/// the same kit and mode configuration) is given: each drum's record is compared with
+/// the one it heard then, and synthesis resumes before the first difference. Bit for
+/// bit a whole render. Only the modal model resumes; the others render whole.
 pub fn render_resuming(
     kit: &Kit,
     drums: &DrumSet,
     duration_s: f64,
     model: SoundModel,
-    previous: Option<(SoundState, f64)>,
+    previous: Option<SoundState>,
 ) -> Result<(Audio, SoundState), SoundError> {
     if !(duration_s.is_finite() && (0.0..=86_400.0).contains(&duration_s)) {
         return Err(SoundError::Duration(duration_s));
@@ -197,47 +201,37 @@ pub fn render_resuming(
     }
     let fs = f64::from(SAMPLE_RATE_HZ);
     let frames = (duration_s * fs).round() as usize;
-    // Frames before `from` hear only unchanged excitation (an entry's kernel reaches one
-    // simulation step before its time).
-    let (mut state, from) = match previous {
-        Some((state, changed_s))
+    let mut state = match previous {
+        Some(state)
             if model == SoundModel::Modal
                 && state.model == model
                 && state.drums.len() == kit.drums.len() =>
         {
-            let from = ((changed_s - 2.0 * drums.dt_s()) * fs).floor().max(0.0) as usize;
-            (state, from)
+            state
         }
-        _ => (
-            SoundState {
-                model,
-                drums: vec![(Vec::new(), Vec::new(), false); kit.drums.len()],
-                mix: Vec::new(),
-            },
-            0,
-        ),
+        _ => SoundState {
+            model,
+            drums: vec![Default::default(); kit.drums.len()],
+            ..SoundState::default()
+        },
     };
     // The first frame any drum re-synthesises from.
-    let mut start = frames;
+    let mut start = state.mix.len() / 2;
     for (j, drum) in kit.drums.iter().enumerate() {
-        let (mono, saved, heard) = &mut state.drums[j];
-        mono.resize(frames, 0.0);
-        *heard = match model {
-            SoundModel::Modal => {
-                start = start.min(modal::resume_frame(saved, from));
-                modal::render_drum_from(drums, j, mono, saved, from)
-            }
+        let (mono, synth, heard) = &mut state.drums[j];
+        let (touched, from) = match model {
+            SoundModel::Modal => modal::resynthesise(drums, j, mono, frames, synth),
             SoundModel::Sample => {
-                mono.fill(0.0);
-                start = 0;
-                sample::render_drum(drum, drums, j, mono)?
+                *mono = vec![0.0; frames];
+                (sample::render_drum(drum, drums, j, mono)?, 0)
             }
             SoundModel::Signal => {
-                mono.fill(0.0);
-                start = 0;
-                signal::render_drum(drums, j, mono)
+                *mono = vec![0.0; frames];
+                (signal::render_drum(drums, j, mono), 0)
             }
         };
+        *heard = touched;
+        start = start.min(from);
     }
     let start = start.min(frames);
     let mix = &mut state.mix;
@@ -254,16 +248,23 @@ pub fn render_resuming(
             frame[1] += r * s;
         }
     }
-    let mut peak = 0.0f32;
-    for (i, s) in mix.iter().enumerate() {
-        if !s.is_finite() {
-            return Err(SoundError::NonFinite {
-                model,
-                frame: i / 2,
-            });
+    // Peaks of the blocks from the one `start` is in: the earlier ones are as they were.
+    let first_block = start / PEAK_BLOCK;
+    state.peaks.truncate(first_block);
+    for (b, block) in mix.chunks(2 * PEAK_BLOCK).enumerate().skip(first_block) {
+        let mut peak = 0.0f32;
+        for (i, s) in block.iter().enumerate() {
+            if !s.is_finite() {
+                return Err(SoundError::NonFinite {
+                    model,
+                    frame: b * PEAK_BLOCK + i / 2,
+                });
+            }
+            peak = peak.max(s.abs());
         }
-        peak = peak.max(s.abs());
+        state.peaks.push(peak);
     }
+    let peak = state.peaks.iter().copied().fold(0.0f32, f32::max);
     let gain = if f64::from(peak) > PEAK_LIMIT {
         PEAK_LIMIT / f64::from(peak)
     } else {

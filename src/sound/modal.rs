@@ -13,6 +13,7 @@
 use super::SAMPLE_RATE_HZ;
 use super::voices::{BankState, Voice, VoiceBank};
 use crate::drum::{DrumSet, HeadModes, Orientation};
+use glam::DVec2;
 
 /// Output per unit of Σ gain × modal velocity, 1/(m/s): an ff strike (3.5 m/s) at the
 /// playing spot of the standard 26-inch drum peaks near −6 dBFS.
@@ -66,47 +67,42 @@ pub fn resume_frame(saved: &[Saved], from: usize) -> usize {
         .map_or(0, |s| s.frame)
 }
 
+/// What a drum's synthesis keeps to re-synthesise only what a changed record changes:
+/// the states saved as it went and what it was rendered from.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DrumSynth {
+    saved: Vec<Saved>,
+    /// The drum's excitation it heard, in time order: time (s), contact point (m), force
+    /// (N).
+    heard: Vec<(f64, DVec2, f64)>,
+    voices: Vec<Voice>,
+}
+
 /// Render drum `j`'s sound into `out` (mono, 48 kHz, from t = 0). Returns whether anything
 /// touched the drum.
 pub fn render_drum(drums: &DrumSet, j: usize, out: &mut [f32]) -> bool {
-    render_drum_from(drums, j, out, &mut Vec::new(), 0)
+    let mut synth = DrumSynth::default();
+    let mut mono = Vec::new();
+    let (heard, _) = resynthesise(drums, j, &mut mono, out.len(), &mut synth);
+    out.copy_from_slice(&mono);
+    heard
 }
 
-/// [`render_drum`] again after the drum's record changed from frame `from` on: `out`
-/// holds the previous output and `saved` its saved states; synthesis resumes from the
-/// latest state at or before `from` (the output before it is kept) and saves new states
-/// as it goes. The result is bit for bit a whole [`render_drum`].
-pub fn render_drum_from(
+/// [`render_drum`] again, `frames` long, into `out` that holds the output `synth` was
+/// rendered with: the record is compared with the one heard then, and synthesis resumes
+/// from the latest saved state before the first frame a changed entry (or the end of the
+/// previous output) reaches; the output before it is kept. Bit for bit a whole
+/// [`render_drum`]. Returns whether anything touched the drum and the first frame
+/// rewritten (`frames` when nothing changed).
+pub fn resynthesise(
     drums: &DrumSet,
     j: usize,
-    out: &mut [f32],
-    saved: &mut Vec<Saved>,
-    from: usize,
-) -> bool {
-    let start = resume_frame(saved, from).min(out.len());
-    saved.retain(|s| s.frame <= start);
-    out[start..].fill(0.0);
-    let Some(head) = drums.head(j) else {
-        return false;
-    };
-    let mut entries: Vec<_> = drums.excitation().iter().filter(|e| e.drum == j).collect();
-    if entries.is_empty() {
-        return false;
-    }
-    entries.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
-    let (index, voices) = voices_for(head, MODAL_CALIBRATION);
-    let mut bank = VoiceBank::new(&voices, f64::from(SAMPLE_RATE_HZ));
-    let mut silent = true;
-    if let Some(s) = saved.pop() {
-        bank.restore(&s.bank);
-        silent = s.silent;
-    }
-    let stride = bank.stride();
+    out: &mut Vec<f32>,
+    frames: usize,
+    synth: &mut DrumSynth,
+) -> (bool, usize) {
     let fs = f64::from(SAMPLE_RATE_HZ);
     let dt = drums.dt_s();
-    let mut shapes = vec![0.0; head.modes().len()];
-    let mut row = vec![0.0f32; stride];
-    let mut input = vec![0.0f32; BLOCK * stride];
     // Sample span of an entry's kernel: centre c = t + dt/2, support (c − dt, c + dt).
     let span = |t: f64| {
         let c = (t + 0.5 * dt) * fs;
@@ -114,6 +110,62 @@ pub fn render_drum_from(
         let hi = (c + dt * fs).ceil().max(0.0) as usize; // exclusive
         (c, lo, hi)
     };
+    let head = drums.head(j);
+    let mut entries: Vec<_> = drums.excitation().iter().filter(|e| e.drum == j).collect();
+    entries.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+    let heard: Vec<(f64, DVec2, f64)> = entries
+        .iter()
+        .map(|e| (e.time_s, e.point, e.force_n))
+        .collect();
+    let voices = head.map_or(Vec::new(), |h| voices_for(h, MODAL_CALIBRATION).1);
+    // The first frame a difference reaches: none before the end of the previous output
+    // when the drum is silent now and was then, or heard the same entries with the same
+    // voices.
+    let first_difference = (0..heard.len().max(synth.heard.len()))
+        .find(|&d| heard.get(d) != synth.heard.get(d))
+        .map(|d| {
+            let t = [heard.get(d), synth.heard.get(d)]
+                .into_iter()
+                .flatten()
+                .map(|e| e.0)
+                .fold(f64::INFINITY, f64::min);
+            span(t).1
+        });
+    let silent_both = heard.is_empty() && synth.heard.is_empty();
+    let from = if voices != synth.voices && !silent_both {
+        0
+    } else {
+        first_difference.unwrap_or(usize::MAX).min(out.len())
+    };
+    let touched = !entries.is_empty();
+    // A silent drum's output is zero: only what it held since `from` is cleared.
+    let start = if touched {
+        resume_frame(&synth.saved, from)
+    } else {
+        from
+    }
+    .min(frames);
+    synth.saved.retain(|s| s.frame <= start);
+    synth.heard = heard;
+    synth.voices = voices;
+    out.resize(frames, 0.0);
+    out[start..].fill(0.0);
+    let Some(head) = head.filter(|_| touched) else {
+        synth.saved.clear();
+        return (false, start);
+    };
+    let (index, voices) = voices_for(head, MODAL_CALIBRATION);
+    let mut bank = VoiceBank::new(&voices, f64::from(SAMPLE_RATE_HZ));
+    let saved = &mut synth.saved;
+    let mut silent = true;
+    if let Some(s) = saved.pop() {
+        bank.restore(&s.bank);
+        silent = s.silent;
+    }
+    let stride = bank.stride();
+    let mut shapes = vec![0.0; head.modes().len()];
+    let mut row = vec![0.0f32; stride];
+    let mut input = vec![0.0f32; BLOCK * stride];
     let mut first = 0;
     for n0 in (start..out.len()).step_by(BLOCK) {
         if n0.is_multiple_of(SAVE_EVERY_BLOCKS * BLOCK) {
@@ -159,5 +211,5 @@ pub fn render_drum_from(
             silent = bank.flush(FLUSH_FLOOR);
         }
     }
-    true
+    (true, start)
 }
