@@ -23,6 +23,7 @@ mod recent;
 mod renderer;
 mod selection;
 mod settings_panel;
+pub mod tape;
 mod tempo_lane;
 mod time_axis;
 mod timeline;
@@ -101,9 +102,6 @@ enum AfterConfirm {
 
 /// Space plays at once only if this much audio past the playhead is ready, s.
 const PLAY_AHEAD_S: f64 = 0.3;
-/// While playing, the rendering's further audio is swapped in this long before the
-/// playing audio runs out, s.
-const AUDIO_SWAP_LEAD_S: f64 = 0.5;
 
 /// The editor application state.
 pub struct EditorApp {
@@ -146,11 +144,6 @@ pub struct EditorApp {
     audio_ready_s: f64,
     /// Space was pressed where the audio is not ready yet: play once it is.
     waiting_to_play: bool,
-    /// The rendering has audio playback does not have yet (a later part of the version
-    /// playing).
-    audio_behind: bool,
-    /// The latest rendering's audio as playback frames.
-    rendered_frames: Option<Arc<[kira::Frame]>>,
     plots: plots::Plots,
     recent: RecentFiles,
     show_help: bool,
@@ -200,8 +193,6 @@ impl EditorApp {
             rendering_current: false,
             audio_ready_s: f64::INFINITY,
             waiting_to_play: false,
-            audio_behind: false,
-            rendered_frames: None,
             plots: plots::Plots::default(),
             recent: RecentFiles::load(options.recent_store),
             show_help: false,
@@ -307,10 +298,13 @@ impl EditorApp {
         self.viewport.screen_of(p)
     }
 
-    /// Set the audio that playback plays (stereo interleaved, 48 kHz): the seam for the
-    /// render pipeline.
-    pub fn set_audio(&mut self, interleaved: &[f32]) -> Result<(), playback::PlaybackError> {
-        self.playback.set_audio(interleaved)
+    /// Set the audio that playback plays (stereo interleaved, 48 kHz, e.g. an
+    /// `Arc<Vec<f32>>`): the seam for the render pipeline.
+    pub fn set_audio(
+        &mut self,
+        audio: Arc<dyn tape::StereoSource>,
+    ) -> Result<(), playback::PlaybackError> {
+        self.playback.set_audio(audio)
     }
 
     /// Move the playhead to `t_s` seconds.
@@ -474,37 +468,29 @@ impl EditorApp {
         self.rendering_id += 1;
         self.rendering_current = current;
         self.status = r.summary;
-        self.audio_behind = true;
-        self.rendered_frames = Some(r.frames);
-        // A new version is heard at once; more of the same version only when the
-        // playing audio is about to run out (each swap restarts the sound).
-        if !r.continues || !self.playback.is_playing() {
-            self.load_audio();
-        }
+        // Swaps are seamless (a crossfade under the playhead), so every rendering is
+        // heard at once, a new version or more of the one playing.
+        self.load_audio();
     }
 
-    /// Give playback the current rendering's audio.
+    /// Give playback the current rendering's audio (shared, not copied), and start
+    /// playing if Space waits for audio that is now ready.
     fn load_audio(&mut self) {
-        let (Some(r), Some(frames)) = (&self.rendering, &self.rendered_frames) else {
+        let Some(r) = &self.rendering else {
             return;
         };
-        self.playback.set_frames(Arc::clone(frames));
-        self.audio_ready_s = if r.complete { f64::INFINITY } else { r.ready_s };
-        self.audio_behind = false;
+        let ready_s = if r.complete { f64::INFINITY } else { r.ready_s };
+        if let Err(e) = self
+            .playback
+            .set_audio(Arc::clone(r) as Arc<dyn tape::StereoSource>)
+        {
+            self.render_error = Some(format!("playback: {e}"));
+            return;
+        }
+        self.audio_ready_s = ready_s;
         if self.waiting_to_play && self.playhead_s + PLAY_AHEAD_S <= self.audio_ready_s {
             self.waiting_to_play = false;
             self.playback.play_from(self.playhead_s);
-        }
-    }
-
-    /// While playing, swap in the rendering's further audio before the playing audio
-    /// runs out.
-    fn extend_audio(&mut self) {
-        if self.audio_behind
-            && self.playback.is_playing()
-            && self.playback.position_s() + AUDIO_SWAP_LEAD_S > self.audio_ready_s
-        {
-            self.load_audio();
         }
     }
 
@@ -1174,7 +1160,6 @@ impl eframe::App for EditorApp {
             self.generation += 1;
         }
         self.take_render();
-        self.extend_audio();
         if self.composer.is_busy() {
             ctx.request_repaint_after(std::time::Duration::from_millis(30));
         }

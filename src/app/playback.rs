@@ -3,15 +3,18 @@
 //! window). The playhead, the 3D view and the plots read [`Playback::position_s`].
 //! With no audio set, the clock still runs (the render pipeline supplies audio later via
 //! [`Playback::set_audio`]).
+//!
+//! With a device, one [tape](super::tape) sound is played for the whole session and
+//! controlled through its handle: new audio is swapped in under the playhead without
+//! restarting (a 5 ms crossfade), and play, pause and seek ramp over 5 ms.
 
-use kira::sound::PlaybackState;
-use kira::sound::static_sound::{StaticSoundData, StaticSoundHandle, StaticSoundSettings};
-use kira::{AudioManager, AudioManagerSettings, DefaultBackend, Frame, Tween};
+use super::tape::{StereoSource, TapeData, TapeHandle};
+use kira::{AudioManager, AudioManagerSettings, DefaultBackend};
 use std::sync::Arc;
 use std::time::Instant;
 
 /// Sample rate of the audio given to [`Playback::set_audio`], Hz.
-pub const AUDIO_RATE_HZ: u32 = 48_000;
+pub const AUDIO_RATE_HZ: u32 = super::tape::SOURCE_RATE_HZ;
 
 /// The notice shown when there is no sound device.
 pub const SILENT_NOTICE: &str = "No sound device: silent playback";
@@ -25,26 +28,13 @@ pub enum PlaybackError {
     OddSampleCount(usize),
 }
 
-/// Stereo interleaved samples at [`AUDIO_RATE_HZ`] as playback frames.
-pub fn frames_of(interleaved: &[f32]) -> Result<Arc<[Frame]>, PlaybackError> {
-    if !interleaved.len().is_multiple_of(2) {
-        return Err(PlaybackError::OddSampleCount(interleaved.len()));
-    }
-    Ok(interleaved
-        .chunks_exact(2)
-        .map(|c| Frame {
-            left: c[0],
-            right: c[1],
-        })
-        .collect())
-}
-
 /// The playback clock and, when a device exists, the audio output.
 pub struct Playback {
+    /// The tape playing on the device (`None` without one).
+    tape: Option<TapeHandle>,
     manager: Option<AudioManager<DefaultBackend>>,
     notice: Option<String>,
-    audio: Option<StaticSoundData>,
-    sound: Option<StaticSoundHandle>,
+    has_audio: bool,
     /// Position when the clock last started or stopped, s.
     anchor_s: f64,
     /// When the clock last started; `None` when paused.
@@ -52,28 +42,31 @@ pub struct Playback {
 }
 
 impl Playback {
-    /// Open the default sound device, or fall back to a silent clock if there is none.
+    /// Open the default sound device and start the tape on it (paused), or fall back to a
+    /// silent clock if there is no device.
     pub fn new() -> Playback {
+        let mut p = Playback::silent();
         match AudioManager::<DefaultBackend>::new(AudioManagerSettings::default()) {
-            Ok(manager) => Playback {
-                manager: Some(manager),
-                ..Playback::silent()
+            Ok(mut manager) => match manager.play(TapeData::new()) {
+                Ok(tape) => {
+                    p.tape = Some(tape);
+                    p.manager = Some(manager);
+                    p.notice = None;
+                }
+                Err(e) => p.notice = Some(format!("{SILENT_NOTICE} (could not play: {e})")),
             },
-            Err(e) => {
-                let mut p = Playback::silent();
-                p.notice = Some(format!("{SILENT_NOTICE} ({e})"));
-                p
-            }
+            Err(e) => p.notice = Some(format!("{SILENT_NOTICE} ({e})")),
         }
+        p
     }
 
     /// A silent clock without trying any device.
     pub fn silent() -> Playback {
         Playback {
+            tape: None,
             manager: None,
             notice: Some(SILENT_NOTICE.to_string()),
-            audio: None,
-            sound: None,
+            has_audio: false,
             anchor_s: 0.0,
             started: None,
         }
@@ -86,47 +79,36 @@ impl Playback {
 
     /// Whether a sound device is in use.
     pub fn has_device(&self) -> bool {
-        self.manager.is_some()
+        self.tape.is_some()
     }
 
     /// Whether audio has been set.
     pub fn has_audio(&self) -> bool {
-        self.audio.is_some()
+        self.has_audio
     }
 
-    /// Set the audio to play (stereo interleaved samples at [`AUDIO_RATE_HZ`]); if
-    /// playing, it continues from the current position with the new audio.
-    pub fn set_audio(&mut self, interleaved: &[f32]) -> Result<(), PlaybackError> {
-        self.set_frames(frames_of(interleaved)?);
-        Ok(())
-    }
-
-    /// [`set_audio`](Playback::set_audio) with the frames already made (e.g. on a worker
-    /// thread, sparing the UI thread the copy).
-    pub fn set_frames(&mut self, frames: Arc<[Frame]>) {
-        self.audio = Some(StaticSoundData {
-            sample_rate: AUDIO_RATE_HZ,
-            frames,
-            settings: StaticSoundSettings::default(),
-            slice: None,
-        });
-        if self.is_playing() {
-            let at = self.position_s();
-            self.play_from(at);
+    /// Set the audio to play (stereo interleaved samples at [`AUDIO_RATE_HZ`], shared, not
+    /// copied); if playing, it goes on from the current position with the new audio,
+    /// crossfaded over 5 ms. The audio replaced is dropped on a later call, on this
+    /// thread.
+    pub fn set_audio(&mut self, audio: Arc<dyn StereoSource>) -> Result<(), PlaybackError> {
+        let n = audio.interleaved().len();
+        if !n.is_multiple_of(2) {
+            return Err(PlaybackError::OddSampleCount(n));
         }
+        if let Some(tape) = &mut self.tape {
+            tape.set_source(audio);
+        }
+        self.has_audio = true;
+        Ok(())
     }
 
     /// Start playing at `t_s` seconds.
     pub fn play_from(&mut self, t_s: f64) {
-        self.stop_sound();
         self.anchor_s = t_s.max(0.0);
         self.started = Some(Instant::now());
-        if let (Some(manager), Some(audio)) = (&mut self.manager, &self.audio) {
-            let data = audio.start_position(self.anchor_s);
-            match manager.play(data) {
-                Ok(handle) => self.sound = Some(handle),
-                Err(e) => self.notice = Some(format!("could not play the audio: {e}")),
-            }
+        if let Some(tape) = &mut self.tape {
+            tape.play_from(self.anchor_s);
         }
     }
 
@@ -134,7 +116,9 @@ impl Playback {
     pub fn pause(&mut self) {
         self.anchor_s = self.position_s();
         self.started = None;
-        self.stop_sound();
+        if let Some(tape) = &mut self.tape {
+            tape.pause();
+        }
     }
 
     /// Move the clock to `t_s`, keeping it playing or paused.
@@ -143,6 +127,9 @@ impl Playback {
             self.play_from(t_s);
         } else {
             self.anchor_s = t_s.max(0.0);
+            if let Some(tape) = &mut self.tape {
+                tape.seek(self.anchor_s);
+            }
         }
     }
 
@@ -151,22 +138,13 @@ impl Playback {
         self.started.is_some()
     }
 
-    /// The current position, s: the audio's while it plays, else the wall clock's.
+    /// The current position, s: the tape's while it plays on a device, else the wall
+    /// clock's.
     pub fn position_s(&self) -> f64 {
-        if let Some(sound) = &self.sound
-            && matches!(sound.state(), PlaybackState::Playing)
-        {
-            return sound.position();
-        }
-        match self.started {
-            Some(t0) => self.anchor_s + t0.elapsed().as_secs_f64(),
-            None => self.anchor_s,
-        }
-    }
-
-    fn stop_sound(&mut self) {
-        if let Some(mut s) = self.sound.take() {
-            s.stop(Tween::default());
+        match (self.started, &self.tape) {
+            (Some(_), Some(tape)) => tape.position_s(),
+            (Some(t0), None) => self.anchor_s + t0.elapsed().as_secs_f64(),
+            (None, _) => self.anchor_s,
         }
     }
 }
@@ -210,7 +188,7 @@ mod tests {
         if !p.has_device() {
             assert!(p.notice().unwrap().starts_with(SILENT_NOTICE));
         }
-        p.set_audio(&vec![0.0; 2 * 4800]).unwrap();
+        p.set_audio(Arc::new(vec![0.0; 2 * 4800])).unwrap();
         assert!(p.has_audio());
         p.play_from(0.0);
         assert!(p.is_playing());
@@ -223,7 +201,7 @@ mod tests {
     fn odd_audio_is_refused() {
         let mut p = Playback::silent();
         assert!(matches!(
-            p.set_audio(&[0.0; 3]),
+            p.set_audio(Arc::new(vec![0.0; 3])),
             Err(PlaybackError::OddSampleCount(3))
         ));
     }

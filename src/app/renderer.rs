@@ -3,11 +3,13 @@
 //! request cancels the render in progress. Each rendering resumes the previous one's
 //! performance from its latest saved state before the edit (`render::render_after`) and
 //! first renders only a second past it, so the edited part plays at once; the rest
-//! follows. The UI polls once per frame and hands the audio to playback, the simulated
+//! follows. The UI polls once per frame and hands the rendering to playback (which plays
+//! its audio in place), the simulated
 //! poses and membranes to the 3D view and the whole rendering to the plots and to
 //! File > Export.
 
 use super::pose::Simulated;
+use super::tape::StereoSource;
 use crate::kit::Kit;
 use crate::mocap::db::MotionDb;
 use crate::render::{FIRST_STEP_S, RESUME_STEP_S, RenderParams, Rendering, Resume, render_after};
@@ -26,11 +28,6 @@ pub struct Rendered {
     /// Whether the whole score is rendered (else the audio is final up to a time the
     /// summary names, and the rest follows).
     pub complete: bool,
-    /// Whether it continues the previous rendering of the same score version (a later
-    /// step after an edit) rather than showing a new version.
-    pub continues: bool,
-    /// The audio as playback frames (made where the rendering is, not on the UI thread).
-    pub frames: Arc<[kira::Frame]>,
 }
 
 impl Rendered {
@@ -67,16 +64,19 @@ impl Rendered {
             tips: r.motion.tips.clone(),
             rendering: Some(Arc::clone(r)),
         };
-        let frames = super::playback::frames_of(&r.audio.samples)
-            .expect("rendered audio is stereo: an even number of samples");
         Rendered {
-            frames,
             complete: r.complete,
-            continues: false,
             rendering,
             simulated,
             summary,
         }
+    }
+}
+
+/// Playback plays the rendering's audio in place (`Arc<Rendering>`, no copy).
+impl StereoSource for Rendering {
+    fn interleaved(&self) -> &[f32] {
+        &self.audio.samples
     }
 }
 
@@ -210,12 +210,8 @@ fn work(shared: &(Mutex<Slot>, Condvar), latest: &AtomicU64, tx: &mpsc::Sender<R
         let mut first = true;
         while !complete {
             let stop_after_s = if first { FIRST_STEP_S } else { RESUME_STEP_S };
-            let continues = !first;
             first = false;
-            let result = run(&request, db, latest, &mut resume, stop_after_s).map(|mut r| {
-                r.continues = continues;
-                r
-            });
+            let result = run(&request, db, latest, &mut resume, stop_after_s);
             if result.as_ref().is_err_and(|e| e == CANCELLED) {
                 break;
             }
