@@ -1080,9 +1080,9 @@ impl EditorApp {
                 composition: comp,
                 generation: self.generation,
                 pose: pose.as_ref(),
-                simulated: self.simulated.as_ref().map(|s| &s.tips),
+                simulated: self.simulated.as_ref().map(|s| &s.motion().tips),
                 drums: (self.simulated.as_ref())
-                    .and_then(|s| s.rendering.as_deref())
+                    .and_then(|s| s.rendering())
                     .map(|r| &r.drums),
                 selection: &self.selection,
                 time_s: self.playhead_s,

@@ -4,33 +4,69 @@
 //! and pulled toward a ready posture, recomputed only when the time or composition changes.
 
 use crate::body::ik::{IkParams, solve};
+use crate::body::sim::Motion;
 use crate::body::skeleton::{Joint, Pose, REST, Skeleton};
 use crate::kit::Side;
 use crate::motion::compose::Composition;
+use crate::render::Rendering;
 use glam::{DQuat, DVec3};
+use std::sync::Arc;
 
 /// A simulated performance for the viewport: body poses and stick tips sampled at a fixed
-/// rate (the render pipeline's output, handed to [`super::EditorApp::set_simulation`]).
-#[derive(Clone, Debug, Default)]
+/// rate, read in place from the render pipeline's output (or given whole, through
+/// [`super::EditorApp::set_simulation`]).
+#[derive(Clone, Debug)]
 pub struct Simulated {
     /// Time of sample 0, s.
     pub start_s: f64,
-    /// Sample rate, Hz.
-    pub rate_hz: f64,
-    /// Body pose per sample.
-    pub poses: Vec<Pose>,
-    /// Simulated stick tips per sample, [left, right], m (performer frame).
-    pub tips: [Vec<DVec3>; 2],
-    /// The rendering it comes from: its drums recorded the membranes' motion.
-    pub rendering: Option<std::sync::Arc<crate::render::Rendering>>,
+    source: Source,
+}
+
+#[derive(Clone, Debug)]
+enum Source {
+    Motion(Motion),
+    Rendering(Arc<Rendering>),
 }
 
 impl Simulated {
+    /// `motion` with its sample 0 at `start_s` seconds.
+    pub fn of_motion(start_s: f64, motion: Motion) -> Simulated {
+        Simulated {
+            start_s,
+            source: Source::Motion(motion),
+        }
+    }
+
+    /// A rendering's motion (not copied).
+    pub fn of_rendering(rendering: Arc<Rendering>) -> Simulated {
+        Simulated {
+            start_s: rendering.start_s,
+            source: Source::Rendering(rendering),
+        }
+    }
+
+    /// The poses and tips, at the task rate.
+    pub fn motion(&self) -> &Motion {
+        match &self.source {
+            Source::Motion(m) => m,
+            Source::Rendering(r) => &r.motion,
+        }
+    }
+
+    /// The rendering it comes from, if any: its drums recorded the membranes' motion.
+    pub fn rendering(&self) -> Option<&Rendering> {
+        match &self.source {
+            Source::Motion(_) => None,
+            Source::Rendering(r) => Some(r),
+        }
+    }
+
     /// The pose at `t_s` (nearest sample, clamped), if there are any.
     pub fn pose_at(&self, t_s: f64) -> Option<&Pose> {
-        let last = self.poses.len().checked_sub(1)?;
-        let k = ((t_s - self.start_s) * self.rate_hz).round().max(0.0) as usize;
-        self.poses.get(k.min(last))
+        let m = self.motion();
+        let last = m.poses.len().checked_sub(1)?;
+        let k = ((t_s - self.start_s) * m.rate_hz).round().max(0.0) as usize;
+        m.poses.get(k.min(last))
     }
 }
 
@@ -120,17 +156,20 @@ mod tests {
     fn simulated_pose_lookup() {
         let mut second = REST;
         second[0] = DQuat::from_rotation_z(0.1);
-        let sim = Simulated {
-            start_s: 1.0,
+        let motion = |poses: Vec<Pose>| Motion {
             rate_hz: 10.0,
-            poses: vec![REST, second],
             tips: Default::default(),
-            rendering: None,
+            poses,
         };
+        let sim = Simulated::of_motion(1.0, motion(vec![REST, second]));
         assert_eq!(sim.pose_at(0.0), Some(&REST));
         assert_eq!(sim.pose_at(1.08), Some(&second));
         assert_eq!(sim.pose_at(50.0), Some(&second));
-        assert!(Simulated::default().pose_at(1.0).is_none());
+        assert!(
+            Simulated::of_motion(0.0, motion(vec![]))
+                .pose_at(1.0)
+                .is_none()
+        );
     }
 
     /// In the ready pose the sticks are in front of the body, below the shoulders.

@@ -57,13 +57,7 @@ impl Rendered {
                 }
             )
         };
-        let simulated = Simulated {
-            start_s: r.start_s,
-            rate_hz: r.motion.rate_hz,
-            poses: r.motion.poses.clone(),
-            tips: r.motion.tips.clone(),
-            rendering: Some(Arc::clone(r)),
-        };
+        let simulated = Simulated::of_rendering(Arc::clone(r));
         Rendered {
             complete: r.complete,
             rendering,
