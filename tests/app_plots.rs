@@ -277,11 +277,35 @@ fn export_writes_wav_and_motion() {
         (first[3] - r.motion.tips[0][0].z).abs() < 1e-6,
         "left tip z"
     );
+    // The motion as C3D: every joint and tip, read back by the C3D reader.
+    let c3d = out.path().join("improvisation-motion.c3d");
+    h.state_mut().export_c3d_to(&c3d);
+    assert!(h.state().error().is_none(), "{:?}", h.state().error());
+    let take =
+        timpanist::mocap::import::c3d::read(&c3d, &std::fs::read(&c3d).unwrap(), None).unwrap();
+    assert_eq!(take.frames, r.motion.poses.len());
+    assert_eq!(take.rate_hz, r.motion.rate_hz);
+    assert_eq!(take.tracks.len(), 11 + 4, "{:?}", take.labels());
+    let tip = take.track("RTIP").unwrap().positions[0].unwrap();
+    assert!((tip - r.motion.tips[1][0]).length() < 1e-6, "{tip}");
+
+    // The score as MIDI: imported again, the same beats at the same ticks.
+    let mid = out.path().join("improvisation.mid");
+    h.state_mut().export_midi_to(&mid);
+    assert!(h.state().error().is_none(), "{:?}", h.state().error());
+    let loaded = LoadedScore::load(&score_path()).unwrap();
+    let (back, _) =
+        timpanist::io::midi_import::import_file(&mid, &loaded.kit, &Default::default()).unwrap();
+    let ticks = |beats: &[timpanist::score::Beat]| beats.iter().map(|b| b.tick).collect::<Vec<_>>();
+    let score = loaded.score;
+    assert_eq!(back.beats.len(), score.beats.len());
+    assert_eq!(ticks(&back.beats), ticks(&score.beats));
+
     let names: Vec<_> = std::fs::read_dir(out.path())
         .unwrap()
         .map(|e| e.unwrap().file_name())
         .collect();
-    assert_eq!(names.len(), 2, "no temporary files: {names:?}");
+    assert_eq!(names.len(), 4, "no temporary files: {names:?}");
 
     // A failing write is an error in the window, not a panic.
     h.state_mut().export_wav_to(Path::new("/no/such/dir/x.wav"));

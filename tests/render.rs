@@ -289,8 +289,8 @@ fn randomised_scores_never_explode() {
     assert!(rendered > 900, "only {rendered} of 1000 rendered");
 }
 
-/// `timpanist render` writes a WAV, the motion CSV, the events JSON with the issue's
-/// fields and a PNG plot, and prints its statistics.
+/// `timpanist render` writes a WAV, the motion CSV and C3D, the events JSON with the
+/// issue's fields and a PNG plot, and prints its statistics.
 #[test]
 fn cli_render_writes_wav_motion_and_events() {
     let dir = tempfile::tempdir().unwrap();
@@ -306,6 +306,8 @@ fn cli_render_writes_wav_motion_and_events() {
         .arg(&wav)
         .arg("--motion")
         .arg(&csv)
+        .arg("--c3d")
+        .arg(dir.path().join("motion.c3d"))
         .arg("--events")
         .arg(&json)
         .arg("--plot")
@@ -347,6 +349,15 @@ fn cli_render_writes_wav_motion_and_events() {
     let motion = std::fs::read_to_string(&csv).unwrap();
     assert!(motion.starts_with("time_s,left_tip_x_m"));
     assert!(motion.lines().count() > 250);
+    let c3d = dir.path().join("motion.c3d");
+    let take =
+        timpanist::mocap::import::c3d::read(&c3d, &std::fs::read(&c3d).unwrap(), None).unwrap();
+    assert_eq!(
+        take.frames,
+        motion.lines().count() - 1,
+        "a frame per CSV row"
+    );
+    assert!(take.track("LTIP_TARGET").is_some() && take.track("ELBOW_R").is_some());
     assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
 }
 

@@ -1,11 +1,16 @@
 //! File > Export (issue 7 §7): the rendering of the score as it is now, written as a WAV
-//! (16-bit stereo 48 kHz, `sound::write_wav`) or as motion CSV (`io::motion_csv`, the
-//! same columns as `timpanist render --motion`), each atomically (a temporary file beside
-//! the target, renamed over it). Refused, with the reason, while the only rendering is of
-//! an older version of the score or there is none.
+//! (16-bit stereo 48 kHz, `sound::write_wav`), as motion CSV (`io::motion_csv`, the same
+//! columns as `timpanist render --motion`) or as motion C3D (`io::motion_c3d`, joints and
+//! tips for motion-capture tools); and the score itself as a Standard MIDI File
+//! (`io::midi_export`, as `timpanist export-midi`). Each is written atomically (a
+//! temporary file beside the target, renamed over it). The rendered exports are refused,
+//! with the reason, while the only rendering is of an older version of the score or there
+//! is none.
 
-use crate::io::{motion_csv, ron_file};
+use crate::io::{midi_export, motion_c3d, motion_csv, ron_file};
+use crate::kit::Kit;
 use crate::render::Rendering;
+use crate::score::Score;
 use std::path::{Path, PathBuf};
 
 /// What to export.
@@ -15,14 +20,23 @@ pub enum Export {
     Wav,
     /// Simulated and target tips and joint rotations per task sample.
     Motion,
+    /// Joint positions and tips per task sample, as C3D points.
+    MotionC3d,
+    /// The score (no rendering needed).
+    Midi,
 }
 
 impl Export {
+    /// Every export, in menu order.
+    pub const ALL: [Export; 4] = [Export::Wav, Export::Motion, Export::MotionC3d, Export::Midi];
+
     /// The File menu item.
     pub fn menu_label(self) -> &'static str {
         match self {
             Export::Wav => "Export WAV...",
             Export::Motion => "Export motion CSV...",
+            Export::MotionC3d => "Export motion C3D...",
+            Export::Midi => "Export MIDI...",
         }
     }
 
@@ -31,6 +45,8 @@ impl Export {
         match self {
             Export::Wav => ("WAV audio", "wav"),
             Export::Motion => ("motion CSV", "csv"),
+            Export::MotionC3d => ("C3D motion capture", "c3d"),
+            Export::Midi => ("Standard MIDI File", "mid"),
         }
     }
 
@@ -39,7 +55,14 @@ impl Export {
         match self {
             Export::Wav => format!("{stem}.wav"),
             Export::Motion => format!("{stem}-motion.csv"),
+            Export::MotionC3d => format!("{stem}-motion.c3d"),
+            Export::Midi => format!("{stem}.mid"),
         }
+    }
+
+    /// Whether it writes the rendering (else the score).
+    pub fn needs_rendering(self) -> bool {
+        self != Export::Midi
     }
 }
 
@@ -73,10 +96,47 @@ impl RenderState<'_> {
     }
 }
 
-/// Write `what` of `rendering` to `path`; a line for the status bar, or why it failed.
-pub fn write(what: Export, rendering: &Rendering, path: &Path) -> Result<String, String> {
+/// Write `what` of the score (played on `kit`) or of its `rendering` to `path`; a line
+/// for the status bar, or why it failed.
+pub fn write(
+    what: Export,
+    (score, kit): (&Score, &Kit),
+    rendering: Option<&Rendering>,
+    path: &Path,
+) -> Result<String, String> {
     let failed = |e: &dyn std::fmt::Display| format!("cannot export to {}: {e}", path.display());
+    if what == Export::Midi {
+        let bytes = midi_export::export(score, kit);
+        ron_file::write_atomic(path, &bytes).map_err(|e| failed(&e))?;
+        return Ok(format!(
+            "exported {} ({} beats, {} bytes)",
+            path.display(),
+            score.beats.len(),
+            bytes.len()
+        ));
+    }
+    let Some(rendering) = rendering else {
+        return Err(failed(&"the score has not been rendered"));
+    };
+    let samples = |r: &Rendering| {
+        format!(
+            "exported {} ({} samples at {} Hz)",
+            path.display(),
+            r.motion.poses.len(),
+            r.motion.rate_hz
+        )
+    };
     match what {
+        Export::Midi => unreachable!("written from the score above"),
+        Export::MotionC3d => {
+            let bytes = motion_c3d::to_c3d(
+                &rendering.motion,
+                &rendering.reference,
+                &rendering.skeleton(),
+            );
+            ron_file::write_atomic(path, &bytes).map_err(|e| failed(&e))?;
+            Ok(samples(rendering))
+        }
         Export::Wav => {
             crate::sound::write_wav(path, &rendering.audio).map_err(|e| failed(&e))?;
             let a = &rendering.audio;
@@ -92,12 +152,7 @@ pub fn write(what: Export, rendering: &Rendering, path: &Path) -> Result<String,
             let text =
                 motion_csv::to_csv(&rendering.motion, &rendering.reference, rendering.start_s);
             ron_file::write_atomic(path, text.as_bytes()).map_err(|e| failed(&e))?;
-            Ok(format!(
-                "exported {} ({} samples at {} Hz)",
-                path.display(),
-                rendering.motion.poses.len(),
-                rendering.motion.rate_hz
-            ))
+            Ok(samples(rendering))
         }
     }
 }

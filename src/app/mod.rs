@@ -359,13 +359,32 @@ impl EditorApp {
         self.export_to(Export::Motion, path);
     }
 
+    /// Export the score as a Standard MIDI File at `path` (File > Export MIDI without the
+    /// dialog).
+    pub fn export_midi_to(&mut self, path: &Path) {
+        self.export_to(Export::Midi, path);
+    }
+
+    /// Export the current rendering's motion as C3D at `path` (File > Export motion C3D
+    /// without the dialog).
+    pub fn export_c3d_to(&mut self, path: &Path) {
+        self.export_to(Export::MotionC3d, path);
+    }
+
     fn export_to(&mut self, what: Export, path: &Path) {
-        if let Some(why) = self.export_blocked() {
+        let blocked = match (&self.doc, what.needs_rendering()) {
+            (None, _) => Some("no score is open".to_string()),
+            (Some(_), true) => self.export_blocked(),
+            (Some(_), false) => None,
+        };
+        if let Some(why) = blocked {
             self.error = Some(format!("cannot export: {why}"));
             return;
         }
-        let Some(r) = &self.rendering else { return };
-        match export::write(what, r, path) {
+        let Some(doc) = &self.doc else { return };
+        let kit = doc.loaded.score.settings.kit(&doc.loaded.kit);
+        let score = (&doc.loaded.score, kit.as_ref());
+        match export::write(what, score, self.rendering.as_deref(), path) {
             Ok(done) => self.status = done,
             Err(e) => self.error = Some(e),
         }
@@ -847,7 +866,8 @@ impl EditorApp {
                 item(ui, "Save As...  (Ctrl+Shift+S)", Action::SaveAs);
                 ui.separator();
                 let blocked = self.export_blocked();
-                for what in [Export::Wav, Export::Motion] {
+                for what in Export::ALL {
+                    let blocked = blocked.as_ref().filter(|_| what.needs_rendering());
                     let button =
                         ui.add_enabled(blocked.is_none(), egui::Button::new(what.menu_label()));
                     let button = match &blocked {

@@ -111,6 +111,9 @@ pub enum Command {
         /// Also write the simulated motion as CSV (tips, targets, joint rotations, 250 Hz).
         #[arg(long)]
         motion: Option<PathBuf>,
+        /// Also write the simulated motion as C3D (joints, tips and targets, mm, 250 Hz).
+        #[arg(long)]
+        c3d: Option<PathBuf>,
         /// Also write one JSON object per stick-head contact.
         #[arg(long)]
         events: Option<PathBuf>,
@@ -277,6 +280,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             score,
             wav,
             motion,
+            c3d,
             events,
             plot,
             control,
@@ -290,6 +294,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             &render::Outputs {
                 wav: &wav,
                 motion: motion.as_deref(),
+                c3d: c3d.as_deref(),
                 events: events.as_deref(),
                 plot: plot.as_deref(),
             },

@@ -6,7 +6,7 @@
 use super::compose::HAND_COLOURS;
 use crate::body::sim::Pipeline;
 use crate::io::plot::{Figure, Panel, Series};
-use crate::io::{motion_csv, ron_file};
+use crate::io::{motion_c3d, motion_csv, ron_file};
 use crate::mocap::db::MotionDb;
 use crate::motion::plan::PlanParams;
 use crate::render::{Progress, RenderParams, Rendering, render};
@@ -20,6 +20,7 @@ use std::path::Path;
 pub struct Outputs<'a> {
     pub wav: &'a Path,
     pub motion: Option<&'a Path>,
+    pub c3d: Option<&'a Path>,
     pub events: Option<&'a Path>,
     pub plot: Option<&'a Path>,
 }
@@ -65,6 +66,13 @@ pub fn run(
     let motion = outputs
         .motion
         .map(|_| motion_csv::to_csv(&rendering.motion, &rendering.reference, rendering.start_s));
+    let c3d = outputs.c3d.map(|_| {
+        motion_c3d::to_c3d(
+            &rendering.motion,
+            &rendering.reference,
+            &rendering.skeleton(),
+        )
+    });
     let figure = outputs
         .plot
         .map(|_| figure(&rendering, &loaded.score.title));
@@ -74,6 +82,9 @@ pub fn run(
     }
     if let (Some(path), Some(text)) = (outputs.motion, motion) {
         ron_file::write_atomic(path, text.as_bytes())?;
+    }
+    if let (Some(path), Some(bytes)) = (outputs.c3d, c3d) {
+        ron_file::write_atomic(path, &bytes)?;
     }
     if let (Some(path), Some(text)) = (outputs.events, events) {
         ron_file::write_atomic(path, text.as_bytes())?;

@@ -1,8 +1,9 @@
 //! File adapters: strict RON files with atomic saving, Standard MIDI Files in and out,
-//! and CSV of composed and simulated motion.
+//! and composed and simulated motion as CSV and C3D.
 
 pub mod midi_export;
 pub mod midi_import;
+pub mod motion_c3d;
 pub mod motion_csv;
 pub mod plot;
 pub mod ron_file;

@@ -484,6 +484,14 @@ pub fn render_after(
     })
 }
 
+impl Rendering {
+    /// The body that played it (the player's height and the mallet's length).
+    pub fn skeleton(&self) -> Skeleton {
+        let mallet = self.kit.mallets.get(self.params.mallet);
+        Skeleton::new(self.params.height_m, mallet.map_or(0.0, |m| m.length_m))
+    }
+}
+
 impl RenderError {
     /// A simulation failure, its time moved to score time (the simulation starts at
     /// `start_s`).
