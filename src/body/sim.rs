@@ -60,6 +60,10 @@ pub struct SimParams {
     pub nested_iterations: usize,
     /// Angular speed beyond which the simulation counts as diverged, rad/s.
     pub max_angular_speed: f64,
+    /// A stick tip farther than this from its target counts as control lost (the arm
+    /// flailing, typically at the edge of its reach), m: the demo scores stay within
+    /// 0.16 m.
+    pub max_tracking_error_m: f64,
 }
 
 impl Default for SimParams {
@@ -79,6 +83,7 @@ impl Default for SimParams {
             },
             nested_iterations: 1,
             max_angular_speed: 500.0,
+            max_tracking_error_m: 0.5,
         }
     }
 }
@@ -522,6 +527,27 @@ impl Simulator {
         }
         let q = self.state.q;
         self.record(&q);
+        self.check_tracking(reference, k)
+    }
+
+    /// Stop when a tip at task sample `k` is farther than the limit from its target.
+    fn check_tracking(&self, reference: &Reference, k: usize) -> Result<(), SimError> {
+        for (h, side) in ["left", "right"].into_iter().enumerate() {
+            let error = self.motion.tips[h][k].distance(reference.tips[h][k]);
+            if error > self.params.max_tracking_error_m {
+                let time_s = k as f64 / reference.rate_hz;
+                return Err(Diverged {
+                    time_s,
+                    beat: reference.beat_at(time_s),
+                    what: format!(
+                        "lost control of the {side} stick ({error:.2} m from its target: a \
+                         reach the body cannot make, try the other hand, a nearer drum or a \
+                         slower tempo)"
+                    ),
+                }
+                .into());
+            }
+        }
         Ok(())
     }
 }
@@ -585,6 +611,43 @@ mod tests {
         };
         assert!(err.time_s > 0.0 && err.beat.is_some(), "{err}");
         assert!(err.to_string().contains("during beat"), "{err}");
+    }
+
+    /// A target moving out of reach (the right tip's, to 2 m ahead in 0.4 s) with the
+    /// nominal gains: the tip cannot follow, and the simulation stops saying control of
+    /// that stick was lost, when and during which beat.
+    #[test]
+    fn lost_control_is_reported_with_the_beat() {
+        let model = BodyModel::default();
+        let here = model.skeleton.forward(&REST);
+        let tips = |side: Side, far: f64| {
+            (0..150)
+                .map(|k| here.tip(side) + DVec3::new(0.0, far * (k as f64 / 100.0).min(1.0), 0.0))
+                .collect()
+        };
+        let reference = Reference {
+            rate_hz: 250.0,
+            tips: [tips(Side::Left, 0.0), tips(Side::Right, 2.0)],
+            poses: None,
+            beats: vec![(0.5, 7)],
+        };
+        let run = |limit: f64| {
+            let params = SimParams {
+                max_tracking_error_m: limit,
+                ..SimParams::default()
+            };
+            let ones = [1.0; JOINT_COUNT];
+            simulate(&model, &reference, Pipeline::Himc, &params, &REST, &ones)
+        };
+        let Err(SimError::Diverged(err)) = run(0.5) else {
+            panic!("no loss of control reported")
+        };
+        assert!(
+            err.what.contains("lost control of the right stick"),
+            "{err}"
+        );
+        assert_eq!(err.beat, Some(7));
+        assert!(err.time_s > 0.1, "{err}");
     }
 
     /// Rewinding to a checkpoint and advancing along a reference changed after it gives

@@ -93,9 +93,10 @@ pub enum Command {
         /// Also draw tip height and depth against time, beats marked, as a PNG.
         #[arg(long)]
         plot: Option<PathBuf>,
-        /// The motion database folder.
-        #[arg(long, default_value = "mocap")]
-        db: PathBuf,
+        /// The motion database folder [default: ./mocap if there is one, else the shipped
+        /// database].
+        #[arg(long)]
+        db: Option<PathBuf>,
         /// Seed of the choice among near-equal motion units.
         #[arg(long, default_value_t = 1)]
         seed: u64,
@@ -129,9 +130,10 @@ pub enum Command {
         /// Print simulated seconds per wall second and where the time went.
         #[arg(long)]
         stats: bool,
-        /// The motion database folder.
-        #[arg(long, default_value = "mocap")]
-        db: PathBuf,
+        /// The motion database folder [default: ./mocap if there is one, else the shipped
+        /// database].
+        #[arg(long)]
+        db: Option<PathBuf>,
         /// Seed of the choice among near-equal motion units.
         #[arg(long, default_value_t = 1)]
         seed: u64,
@@ -148,9 +150,10 @@ pub enum Command {
         /// Draw the Fig. 5 comparison per mode as PNGs into this folder.
         #[arg(long)]
         plot: Option<PathBuf>,
-        /// The motion database folder.
-        #[arg(long, default_value = "mocap")]
-        db: PathBuf,
+        /// The motion database folder [default: ./mocap if there is one, else the shipped
+        /// database].
+        #[arg(long)]
+        db: Option<PathBuf>,
     },
     /// Motion-capture database: build, inspect, import.
     #[command(subcommand)]
@@ -244,10 +247,29 @@ pub fn main() -> ExitCode {
     match run(cli) {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", report(&e));
             ExitCode::FAILURE
         }
     }
+}
+
+fn db_or_default(db: Option<PathBuf>) -> PathBuf {
+    db.unwrap_or_else(crate::mocap::db::default_dir)
+}
+
+/// An error and its causes, each said once: a cause whose text its effect already
+/// quotes (as `path: cause` errors do) is not repeated.
+fn report(e: &anyhow::Error) -> String {
+    let mut text = String::new();
+    for cause in e.chain().map(ToString::to_string) {
+        if !text.contains(&cause) {
+            if !text.is_empty() {
+                text.push_str(": ");
+            }
+            text.push_str(&cause);
+        }
+    }
+    text
 }
 
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
@@ -275,7 +297,8 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             plot,
             db,
             seed,
-        }) => compose::run(&score, &db, &output, plot.as_deref(), seed).map(|()| ExitCode::SUCCESS),
+        }) => compose::run(&score, &db_or_default(db), &output, plot.as_deref(), seed)
+            .map(|()| ExitCode::SUCCESS),
         Some(Command::Render {
             score,
             wav,
@@ -290,7 +313,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             seed,
         }) => render::run(
             &score,
-            &db,
+            &db_or_default(db),
             &render::Outputs {
                 wav: &wav,
                 motion: motion.as_deref(),
@@ -309,9 +332,8 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             json,
             plot,
             db,
-        }) => {
-            evaluate::run(&db, trials, json.as_deref(), plot.as_deref()).map(|()| ExitCode::SUCCESS)
-        }
+        }) => evaluate::run(&db_or_default(db), trials, json.as_deref(), plot.as_deref())
+            .map(|()| ExitCode::SUCCESS),
         Some(Command::Mocap(MocapCommand::Synth { output, seed })) => {
             mocap::synth(&output, seed).map(|()| ExitCode::SUCCESS)
         }
@@ -351,5 +373,25 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Some(Command::ExportMidi { score, output }) => {
             midi::export(&score, &output).map(|()| ExitCode::SUCCESS)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A cause the error's own text already quotes is not repeated; contexts are kept.
+    #[test]
+    fn report_says_each_cause_once() {
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
+        let e = anyhow::Error::new(crate::io::FileError::Io {
+            path: PathBuf::from("mocap/index.ron"),
+            source: io,
+        })
+        .context("loading the database");
+        assert_eq!(
+            report(&e),
+            "loading the database: mocap/index.ron: no such file"
+        );
     }
 }

@@ -387,9 +387,16 @@ impl Channels<'_> {
     }
 }
 
-/// Where the shipped database lives in the source tree.
+/// The database to use when none is named: `./mocap` when the working directory has
+/// one, else the one shipped in the source tree the program was built from (so the
+/// command works from any directory), else `./mocap` (whose absence is then reported).
 pub fn default_dir() -> PathBuf {
-    PathBuf::from("mocap")
+    let here = PathBuf::from("mocap");
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("mocap");
+    [here.clone(), shipped]
+        .into_iter()
+        .find(|d| d.join("index.ron").is_file())
+        .unwrap_or(here)
 }
 
 #[cfg(test)]
