@@ -203,7 +203,7 @@ fn render_worker_frames_and_edit_to_ready_audio() {
          max {max:.1} ms"
     );
     let before = h.state().rendering().map(std::sync::Arc::as_ptr);
-    // The vertical accent at 30 s (bar 13) becomes a tenuto: select it, press 2.
+    // The beat at tick 46080 (30.625 s) becomes a tenuto: select it, press 2.
     let at = h.state().timeline_point(46080, Hand::Auto).unwrap();
     h.hover_at(at);
     h.step();
@@ -236,9 +236,11 @@ fn render_worker_frames_and_edit_to_ready_audio() {
     );
     let max_frame = percentile(&mut after_edit, 1.0);
     println!(
-        "one-beat edit at 30.0 s (mode changed): audio ready to {ready_s:.1} s (resumed at {:.2} s) after \
-         {ready:.0} ms; whole score rendered again after {whole:.0} ms; longest frame \
-         meanwhile {max_frame:.1} ms",
-        from.unwrap_or(0.0)
+        "one-beat edit at 30.6 s (mode changed): audio ready to {ready_s:.1} s (resumed at {:.2} s, \
+         {:.2} s simulated in {} attempts) after {ready:.0} ms; whole score rendered again after \
+         {whole:.0} ms; longest frame meanwhile {max_frame:.1} ms",
+        from.unwrap_or(0.0),
+        partial.stats.simulated_s,
+        partial.stats.attempts
     );
 }
