@@ -17,6 +17,7 @@ use crate::score::{LoadedScore, Score};
 use eframe::egui;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex, mpsc};
+use std::time::{Duration, Instant};
 
 /// A finished render, ready for playback, the view, the plots and export.
 pub struct Rendered {
@@ -33,6 +34,14 @@ pub struct Rendered {
 impl Rendered {
     /// The parts of `rendering` the editor uses.
     pub fn new(rendering: Arc<Rendering>) -> Rendered {
+        let origin = (rendering.stats.resumed_from_s, rendering.stats.wall());
+        Rendered::of_request(rendering, origin)
+    }
+
+    /// [`Rendered::new`] for the last of the steps that rendered one request: the status
+    /// names where the first step resumed from (`None`: rendered whole) and the wall time
+    /// of all the steps.
+    fn of_request(rendering: Arc<Rendering>, (from, wall): (Option<f64>, Duration)) -> Rendered {
         let r = &rendering;
         let t = &r.timing;
         let summary = if !r.complete {
@@ -48,12 +57,12 @@ impl Rendered {
                 } else {
                     String::new()
                 },
-                match r.stats.resumed_from_s {
+                match from {
                     Some(from) => format!(
                         "re-simulated from {from:.1} s in {:.2} s",
-                        r.stats.wall().as_secs_f64()
+                        wall.as_secs_f64()
                     ),
-                    None => format!("in {:.2} s", r.stats.wall().as_secs_f64()),
+                    None => format!("in {:.2} s", wall.as_secs_f64()),
                 }
             )
         };
@@ -201,11 +210,19 @@ fn work(shared: &(Mutex<Slot>, Condvar), latest: &AtomicU64, tx: &mpsc::Sender<R
         };
         // First the edited part (quick, to play at once), then the rest in steps.
         let mut complete = false;
-        let mut first = true;
+        let began = Instant::now();
+        // Where the first step resumed from.
+        let mut origin: Option<Option<f64>> = None;
         while !complete {
-            let stop_after_s = if first { FIRST_STEP_S } else { RESUME_STEP_S };
-            first = false;
-            let result = run(&request, db, latest, &mut resume, stop_after_s);
+            let stop_after_s = if origin.is_none() {
+                FIRST_STEP_S
+            } else {
+                RESUME_STEP_S
+            };
+            let result = run(&request, db, latest, &mut resume, stop_after_s).map(|r| {
+                let from = *origin.get_or_insert(r.stats.resumed_from_s);
+                Rendered::of_request(Arc::new(r), (from, began.elapsed()))
+            });
             if result.as_ref().is_err_and(|e| e == CANCELLED) {
                 break;
             }
@@ -228,7 +245,7 @@ fn run(
     latest: &AtomicU64,
     resume: &mut Option<Resume>,
     stop_after_s: f64,
-) -> Result<Rendered, String> {
+) -> Result<Rendering, String> {
     let loaded = LoadedScore {
         score: request.score.clone(),
         kit: request.kit.clone(),
@@ -236,7 +253,7 @@ fn run(
         notices: Vec::new(),
     };
     let params = RenderParams::for_score(&loaded.score.settings);
-    let r = render_after(
+    render_after(
         resume,
         Some(stop_after_s),
         &loaded,
@@ -247,6 +264,5 @@ fn run(
     .map_err(|e| match e {
         crate::render::RenderError::Cancelled => CANCELLED.to_string(),
         e => e.to_string(),
-    })?;
-    Ok(Rendered::new(Arc::new(r)))
+    })
 }
