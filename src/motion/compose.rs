@@ -253,7 +253,7 @@ pub fn compose(strokes: &[PlannedStroke], db: &MotionDb, params: &ComposeParams)
             .filter(|&i| strokes[i].hand == hand)
             .collect();
         let shaped = shape(strokes, &mine, db, params);
-        let (pieces, joins) = timeline(&shaped, hand, strokes, params);
+        let (pieces, joins) = timeline(&shaped, hand, params);
         let h = side_index(hand);
         let mut p = 0;
         for k in 0..n {
@@ -370,28 +370,23 @@ fn shape<'a>(
     shaped
 }
 
+/// Where a hand with no strokes rests, m (performer frame): in front of its shoulder,
+/// above the drums' height.
+pub fn idle_rest(hand: Side) -> DVec3 {
+    DVec3::new(0.25 * hand.sign(), 0.35, 0.95)
+}
+
 /// The pieces of one hand's timeline and the joins between them.
-fn timeline(
-    shaped: &[Shaped],
-    hand: Side,
-    strokes: &[PlannedStroke],
-    params: &ComposeParams,
-) -> (Vec<Piece>, Vec<Join>) {
+fn timeline(shaped: &[Shaped], hand: Side, params: &ComposeParams) -> (Vec<Piece>, Vec<Join>) {
     let rest_above = |s: &PlannedStroke| {
         s.target + s.toward_player * params.rest_back_m + DVec3::Z * params.rest_height_m
     };
     let f = params.blend_fraction;
     let Some(first) = shaped.first() else {
-        // An idle hand rests above the first drum struck on its side, or in front of it.
-        let anchor = strokes
-            .iter()
-            .min_by(|a, b| {
-                (a.target.x * hand.sign())
-                    .total_cmp(&(b.target.x * hand.sign()))
-                    .reverse()
-            })
-            .map_or(DVec3::new(0.25 * hand.sign(), 0.35, 0.95), rest_above);
-        return (vec![Piece::Hold(anchor)], Vec::new());
+        // An idle hand rests in front of its shoulder, clear of the drums: where the other
+        // hand plays may be out of its comfortable reach (a stretched arm held still
+        // under PD control oscillates).
+        return (vec![Piece::Hold(idle_rest(hand))], Vec::new());
     };
     let mut pieces = vec![Piece::Hold(rest_above(first.stroke))];
     let mut joins = vec![Join {

@@ -12,6 +12,7 @@
 //! edit ([`render_after`]).
 
 pub mod compensate;
+pub mod reach;
 pub mod reference;
 pub mod strikes;
 
@@ -216,6 +217,8 @@ pub enum RenderError {
     Drum(#[from] DrumError),
     #[error("the kit has no mallet {0}")]
     NoMallet(usize),
+    #[error(transparent)]
+    OutOfReach(#[from] reach::OutOfReach),
     #[error(
         "the simulation {what} at {time_s:.4} s of the score{}",
         beat.map_or(String::new(), |b| format!(", during beat {b}"))
@@ -301,6 +304,8 @@ pub fn render_after(
     if composition.len() < 2 || composition.strokes.is_empty() {
         return Err(RenderError::Empty);
     }
+    let skeleton = Skeleton::new(params.height_m, mallet.length_m);
+    reach::check(&composition.strokes, &skeleton)?;
     let start_s = composition.start_s;
     let rate = composition.rate_hz;
     stats.score_s = (composition.len() - 1) as f64 / rate;
@@ -350,10 +355,7 @@ pub fn render_after(
             (performance, sound)
         }
         None => {
-            let model = BodyModel::new(
-                Skeleton::new(params.height_m, mallet.length_m),
-                params.mass_kg,
-            );
+            let model = BodyModel::new(skeleton, params.mass_kg);
             let first = targets.reference(&Warp::default());
             let initial = initial_pose(&model, &first);
             let sim = Simulator::new(

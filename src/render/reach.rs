@@ -1,0 +1,104 @@
+//! Whether the body can reach every stroke, checked before simulating: a stroke whose
+//! target lies farther from its hand's shoulder (in the upright rest posture) than the arm
+//! and stick can stretch, plus what leaning the trunk adds, is refused with the beat named.
+//! Simulated, such a reach leaves the arm fully stretched, where the nested IK and the PD
+//! loops oscillate and the stick flails (see `body::sim`'s loss-of-control check). With
+//! the standard kit these are the centres of the outer drums played across the body.
+
+use crate::body::skeleton::{Joint, REST, Skeleton};
+use crate::kit::Side;
+use crate::motion::plan::PlannedStroke;
+
+/// How much farther than the stretched arm and stick the trunk's lean lets a tip go, m.
+pub const TRUNK_ALLOWANCE_M: f64 = 0.12;
+
+/// A stroke the body cannot reach.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error(
+    "beat {beat} is out of the {} hand's reach: its target on drum {drum} is {distance_m:.2} m \
+     from the shoulder, the arm and stick reach {reach_m:.2} m (play it with the other hand, \
+     or nearer the player)",
+    if *hand == Side::Left { "left" } else { "right" }
+)]
+pub struct OutOfReach {
+    pub beat: usize,
+    pub hand: Side,
+    pub drum: usize,
+    /// Distance from the shoulder to the target, m.
+    pub distance_m: f64,
+    /// How far the tip can go from the shoulder, m.
+    pub reach_m: f64,
+}
+
+/// How far from its shoulder a stick tip can go, m: upper arm, forearm, hand and stick
+/// in a line, plus [`TRUNK_ALLOWANCE_M`].
+pub fn reach(skeleton: &Skeleton) -> f64 {
+    let [_, elbow, wrist, grip] = Joint::arm(Side::Right);
+    let arm: f64 = [elbow, wrist, grip]
+        .iter()
+        .map(|j| skeleton.offsets[j.index()].length())
+        .sum();
+    arm + skeleton.stick_length_m + TRUNK_ALLOWANCE_M
+}
+
+/// The first stroke of `strokes` out of reach of `skeleton`, if any.
+pub fn check(strokes: &[PlannedStroke], skeleton: &Skeleton) -> Result<(), OutOfReach> {
+    let rest = skeleton.forward(&REST);
+    let reach_m = reach(skeleton);
+    for s in strokes {
+        let shoulder = rest.position[Joint::arm(s.hand)[0].index()];
+        let distance_m = s.target.distance(shoulder);
+        if distance_m > reach_m {
+            return Err(OutOfReach {
+                beat: s.beat,
+                hand: s.hand,
+                drum: s.drum,
+                distance_m,
+                reach_m,
+            });
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kit::Kit;
+    use crate::score::{Dynamic, PlayingMode};
+    use glam::DVec3;
+
+    fn stroke(hand: Side, target: DVec3) -> PlannedStroke {
+        PlannedStroke {
+            beat: 4,
+            tick: 0,
+            hand,
+            time_s: 1.0,
+            target,
+            toward_player: DVec3::NEG_Y,
+            drum: 0,
+            mode: PlayingMode::Legato,
+            dynamic: Dynamic::Mf,
+            unit: 0,
+        }
+    }
+
+    /// On the standard kit, the far-left drum's centre is within the left arm's reach and
+    /// beyond the right arm's; the refusal names the beat, the hand and both distances.
+    #[test]
+    fn the_far_drum_across_the_body_is_out_of_reach() {
+        let kit = Kit::standard();
+        let skeleton = Skeleton::new(1.75, kit.mallets[0].length_m);
+        let far_left = kit.drums[0].point_on_head(0.0, 0.0) + DVec3::Z * 0.03;
+        assert!(check(&[stroke(Side::Left, far_left)], &skeleton).is_ok());
+        let err = check(&[stroke(Side::Right, far_left)], &skeleton).unwrap_err();
+        assert_eq!((err.beat, err.hand), (4, Side::Right));
+        assert!(err.distance_m > err.reach_m, "{err}");
+        assert!(
+            err.to_string()
+                .starts_with("beat 4 is out of the right hand's reach")
+        );
+        let r = reach(&skeleton);
+        assert!((1.0..1.2).contains(&r), "{r}");
+    }
+}
