@@ -414,3 +414,59 @@ fn space_waits_for_audio_that_is_not_ready() {
     h.step();
     assert!(h.state().playback().is_playing());
 }
+
+/// A score with a stroke out of reach (the right hand on the far-left drum's centre): the
+/// real render worker refuses it, the status bar says why and offers "Show beat 1", which
+/// selects that beat and moves the playhead to just before it.
+#[test]
+fn a_render_error_shows_its_beat() {
+    use timpanist::score::{Beat, ImpactLocation, Score};
+    let dir = tempfile::tempdir().unwrap();
+    let mut score = Score::new("reach");
+    score.beats.push(Beat::plain(0, 1));
+    let mut far = Beat::plain(1920, 0);
+    far.hand = Hand::Right;
+    far.location = ImpactLocation::Centre;
+    score.beats.push(far);
+    let path = dir.path().join("reach.ron");
+    score.save(&path).unwrap();
+    let beat_s = score.tempo_map().seconds_at(1920.0);
+    std::env::set_current_dir(root()).unwrap();
+    let options = EditorOptions {
+        score: Some(path),
+        recent_store: Some(dir.path().join("recent.txt")),
+        audio_device: false,
+        render: true,
+    };
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(1400.0, 900.0))
+        .with_max_steps(64)
+        .build_eframe(move |_cc| EditorApp::with_options(options));
+    let began = std::time::Instant::now();
+    while h.state().render_error().is_none() {
+        assert!(began.elapsed().as_secs() < 60, "no render error");
+        h.step();
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let error = h.state().render_error().unwrap().to_string();
+    assert!(
+        error.contains("beat 1 is out of the right hand's reach"),
+        "{error}"
+    );
+    assert_eq!(h.state().render_error_beat(), Some(1));
+    h.state_mut().wait_for_composition();
+    h.run();
+    h.get_by_label("Show beat 1").click();
+    h.run();
+    assert_eq!(
+        h.state()
+            .selection()
+            .beats
+            .iter()
+            .copied()
+            .collect::<Vec<_>>(),
+        vec![1]
+    );
+    let t = h.state().playhead_s();
+    assert!((t - (beat_s - 0.5)).abs() < 1e-9, "{t} vs {beat_s}");
+}

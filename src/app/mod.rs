@@ -117,6 +117,8 @@ pub struct EditorApp {
     renderer: Option<renderer::Renderer>,
     /// Why the latest render failed.
     render_error: Option<String>,
+    /// The beat the render error names, if any (the status bar offers to show it).
+    render_error_beat: Option<usize>,
     /// Counts compositions received (for caches).
     generation: u64,
     selection: Selection,
@@ -172,6 +174,7 @@ impl EditorApp {
             composer: Composer::new(),
             renderer: options.render.then(renderer::Renderer::new),
             render_error: None,
+            render_error_beat: None,
             generation: 0,
             selection: Selection::default(),
             clipboard: Clipboard::default(),
@@ -476,7 +479,10 @@ impl EditorApp {
         let current = !renderer.is_busy();
         match done {
             Ok(r) => self.accept_rendering(r, current),
-            Err(e) => self.render_error = Some(format!("render: {e}")),
+            Err(e) => {
+                self.render_error = Some(format!("render: {}", e.message));
+                self.render_error_beat = e.beat;
+            }
         }
     }
 
@@ -511,6 +517,29 @@ impl EditorApp {
             self.waiting_to_play = false;
             self.playback.play_from(self.playhead_s);
         }
+    }
+
+    /// Select beat `b` and move the playhead just before it (the status bar's "Show beat"
+    /// after a render error naming it).
+    pub fn show_beat(&mut self, b: usize) {
+        let Some(doc) = &self.doc else { return };
+        let Some(beat) = doc.loaded.score.beats.get(b) else {
+            return;
+        };
+        let t = doc.loaded.score.tempo_map().seconds_at(beat.tick as f64);
+        self.pending.push(Command::Select(Selection::only(b)));
+        self.pending.push(Command::Seek((t - 0.5).max(0.0)));
+        self.drain();
+    }
+
+    fn is_rendering(&self) -> bool {
+        self.renderer.as_ref().is_some_and(|r| r.is_busy())
+    }
+
+    /// The beat the latest render error names, if any.
+    pub fn render_error_beat(&self) -> Option<usize> {
+        self.render_error_beat
+            .filter(|_| self.render_error.is_some())
     }
 
     /// Whether Space was pressed where the audio is not ready yet (playback starts once
@@ -964,7 +993,8 @@ impl EditorApp {
         });
     }
 
-    fn status_bar(&self, ui: &mut egui::Ui) {
+    fn status_bar(&mut self, ui: &mut egui::Ui) {
+        let mut show = None;
         ui.horizontal(|ui| {
             if let Some(n) = self.playback.notice() {
                 ui.colored_label(ui.visuals().warn_fg_color, n);
@@ -978,12 +1008,9 @@ impl EditorApp {
                 ui.label(format!("composed in {:.0} ms", d.as_secs_f64() * 1e3));
                 ui.separator();
             }
-            if self.renderer.as_ref().is_some_and(|r| r.is_busy()) {
+            if self.is_rendering() {
                 ui.spinner();
                 ui.label("rendering sound and motion");
-                ui.separator();
-            } else if let Some(e) = &self.render_error {
-                ui.colored_label(ui.visuals().error_fg_color, e);
                 ui.separator();
             }
             if self.is_dirty() {
@@ -991,7 +1018,24 @@ impl EditorApp {
                 ui.separator();
             }
             ui.label(&self.status);
+            // Last, cut to the width left (in full on hover), after its button.
+            if let Some(e) = self.render_error.as_ref().filter(|_| !self.is_rendering()) {
+                ui.separator();
+                if let Some(b) = self.render_error_beat
+                    && ui
+                        .small_button(format!("Show beat {b}"))
+                        .on_hover_text("Select the beat and move the playhead to it")
+                        .clicked()
+                {
+                    show = Some(b);
+                }
+                let text = egui::RichText::new(e).color(ui.visuals().error_fg_color);
+                ui.add(egui::Label::new(text).truncate()).on_hover_text(e);
+            }
         });
+        if let Some(b) = show {
+            self.show_beat(b);
+        }
     }
 
     /// Follow the playback clock: move the playhead, wrap at the loop end, stop at the end.

@@ -96,7 +96,45 @@ struct Slot {
     quit: bool,
 }
 
-type Reply = (u64, Result<Rendered, String>);
+/// Why a render failed: the message for the window, and the beat it names, if any (the
+/// one being played when the simulation stopped, or the one out of reach).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Failure {
+    pub message: String,
+    pub beat: Option<usize>,
+}
+
+impl Failure {
+    fn of(message: impl Into<String>) -> Failure {
+        Failure {
+            message: message.into(),
+            beat: None,
+        }
+    }
+}
+
+impl Failure {
+    fn is_cancelled(&self) -> bool {
+        self.message == crate::render::RenderError::Cancelled.to_string()
+    }
+}
+
+impl From<crate::render::RenderError> for Failure {
+    fn from(e: crate::render::RenderError) -> Failure {
+        use crate::render::RenderError;
+        let beat = match &e {
+            RenderError::Diverged { beat, .. } => *beat,
+            RenderError::OutOfReach(r) => Some(r.beat),
+            _ => None,
+        };
+        Failure {
+            message: e.to_string(),
+            beat,
+        }
+    }
+}
+
+type Reply = (u64, Result<Rendered, Failure>);
 
 /// The rendering worker.
 pub struct Renderer {
@@ -144,7 +182,7 @@ impl Renderer {
     }
 
     /// The newest finished render, if one arrived since the last poll.
-    pub fn poll(&mut self) -> Option<Result<Rendered, String>> {
+    pub fn poll(&mut self) -> Option<Result<Rendered, Failure>> {
         let mut newest = None;
         while let Ok((generation, result)) = self.replies.try_recv() {
             if generation >= self.done {
@@ -203,7 +241,7 @@ fn work(shared: &(Mutex<Slot>, Condvar), latest: &AtomicU64, tx: &mpsc::Sender<R
         });
         let Ok(db) = db else {
             let e = db.as_ref().err().cloned().unwrap_or_default();
-            if tx.send((request.generation, Err(e))).is_err() {
+            if tx.send((request.generation, Err(Failure::of(e)))).is_err() {
                 return;
             }
             continue;
@@ -223,7 +261,7 @@ fn work(shared: &(Mutex<Slot>, Condvar), latest: &AtomicU64, tx: &mpsc::Sender<R
                 let from = *origin.get_or_insert(r.stats.resumed_from_s);
                 Rendered::of_request(Arc::new(r), (from, began.elapsed()))
             });
-            if result.as_ref().is_err_and(|e| e == CANCELLED) {
+            if result.as_ref().is_err_and(Failure::is_cancelled) {
                 break;
             }
             complete = result.as_ref().map_or(true, |r| r.complete);
@@ -237,15 +275,13 @@ fn work(shared: &(Mutex<Slot>, Condvar), latest: &AtomicU64, tx: &mpsc::Sender<R
     }
 }
 
-const CANCELLED: &str = "cancelled";
-
 fn run(
     request: &Request,
     db: &MotionDb,
     latest: &AtomicU64,
     resume: &mut Option<Resume>,
     stop_after_s: f64,
-) -> Result<Rendering, String> {
+) -> Result<Rendering, Failure> {
     let loaded = LoadedScore {
         score: request.score.clone(),
         kit: request.kit.clone(),
@@ -261,8 +297,5 @@ fn run(
         &params,
         &mut |_| latest.load(Ordering::SeqCst) == request.generation,
     )
-    .map_err(|e| match e {
-        crate::render::RenderError::Cancelled => CANCELLED.to_string(),
-        e => e.to_string(),
-    })
+    .map_err(Failure::from)
 }
