@@ -36,17 +36,7 @@ fn rendering() -> Arc<Rendering> {
 /// a window large enough for every panel; with `rendered`, the rendering is handed over.
 /// With the render worker on, a spinner keeps repainting: the UI runs a few frames only.
 fn harness(dir: &Path, render: bool, rendered: bool) -> Harness<'static, EditorApp> {
-    std::env::set_current_dir(root()).unwrap();
-    let options = EditorOptions {
-        score: Some(score_path()),
-        recent_store: Some(dir.join("recent.txt")),
-        audio_device: false,
-        render,
-    };
-    let mut h = Harness::builder()
-        .with_size(egui::vec2(1400.0, 900.0))
-        .with_max_steps(64)
-        .build_eframe(move |_cc| EditorApp::with_options(options));
+    let mut h = editor(score_path(), dir, render);
     if rendered {
         h.state_mut().set_rendering(rendering());
     }
@@ -61,6 +51,21 @@ fn harness(dir: &Path, render: bool, rendered: bool) -> Harness<'static, EditorA
 }
 
 /// Let the composing worker finish, then run the UI until it is idle.
+/// An editor on `score` with the silent clock, rendering if `render`.
+fn editor(score: PathBuf, dir: &Path, render: bool) -> Harness<'static, EditorApp> {
+    std::env::set_current_dir(root()).unwrap();
+    let options = EditorOptions {
+        score: Some(score),
+        recent_store: Some(dir.join("recent.txt")),
+        audio_device: false,
+        render,
+    };
+    Harness::builder()
+        .with_size(egui::vec2(1400.0, 900.0))
+        .with_max_steps(64)
+        .build_eframe(move |_cc| EditorApp::with_options(options))
+}
+
 fn settle(h: &mut Harness<'static, EditorApp>) {
     h.step();
     h.state_mut().wait_for_composition();
@@ -431,17 +436,7 @@ fn a_render_error_shows_its_beat() {
     let path = dir.path().join("reach.ron");
     score.save(&path).unwrap();
     let beat_s = score.tempo_map().seconds_at(1920.0);
-    std::env::set_current_dir(root()).unwrap();
-    let options = EditorOptions {
-        score: Some(path),
-        recent_store: Some(dir.path().join("recent.txt")),
-        audio_device: false,
-        render: true,
-    };
-    let mut h = Harness::builder()
-        .with_size(egui::vec2(1400.0, 900.0))
-        .with_max_steps(64)
-        .build_eframe(move |_cc| EditorApp::with_options(options));
+    let mut h = editor(path, dir.path(), true);
     let began = std::time::Instant::now();
     while h.state().render_error().is_none() {
         assert!(began.elapsed().as_secs() < 60, "no render error");

@@ -147,11 +147,7 @@ fn resumed_render_after_an_edit_equals_a_whole_render() {
 /// score bit for bit as a whole rendering does.
 #[test]
 fn partial_render_then_rest_equals_a_whole_render() {
-    let db = db();
-    let loaded = LoadedScore::load(&root().join("scores/tempo-change.ron")).unwrap();
-    let params = RenderParams::default();
-    let mut resume = None;
-    render_after(&mut resume, None, &loaded, &db, &params, &mut |_| true).unwrap();
+    let (db, loaded, params, mut resume) = tempo_change_rendered();
     let mut edited = loaded.clone();
     let beat = edited.score.beats.len() / 2;
     edited.score.beats[beat].mode = PlayingMode::Staccato;
@@ -169,9 +165,25 @@ fn partial_render_then_rest_equals_a_whole_render() {
     assert_eq!(partial.audio.samples[..ready], whole.audio.samples[..ready]);
     let rest = render_after(&mut resume, None, &edited, &db, &params, &mut |_| true).unwrap();
     assert!(rest.complete && rest.stats.resumed_from_s.is_some());
-    assert_eq!(rest.audio.samples, whole.audio.samples);
-    assert_eq!(rest.motion, whole.motion);
-    assert_eq!(rest.events, whole.events);
+    assert_same_performance(&rest, &whole);
+}
+
+/// The tempo-change demo rendered with the default parameters, and what it leaves to
+/// resume from.
+fn tempo_change_rendered() -> (MotionDb, LoadedScore, RenderParams, Option<Resume>) {
+    let db = db();
+    let loaded = LoadedScore::load(&root().join("scores/tempo-change.ron")).unwrap();
+    let params = RenderParams::default();
+    let mut resume = None;
+    render_after(&mut resume, None, &loaded, &db, &params, &mut |_| true).unwrap();
+    (db, loaded, params, resume)
+}
+
+/// Bit for bit the same audio, motion and contacts.
+fn assert_same_performance(a: &Rendering, b: &Rendering) {
+    assert_eq!(a.audio.samples, b.audio.samples);
+    assert_eq!(a.motion, b.motion);
+    assert_eq!(a.events, b.events);
 }
 
 /// A rendering cancelled part way (the editor cancels one at each newer edit) leaves a
@@ -179,11 +191,7 @@ fn partial_render_then_rest_equals_a_whole_render() {
 /// bit what rendering that edit whole gives.
 #[test]
 fn rendering_after_a_cancelled_one_equals_a_whole_render() {
-    let db = db();
-    let loaded = LoadedScore::load(&root().join("scores/tempo-change.ron")).unwrap();
-    let params = RenderParams::default();
-    let mut resume = None;
-    render_after(&mut resume, None, &loaded, &db, &params, &mut |_| true).unwrap();
+    let (db, loaded, params, mut resume) = tempo_change_rendered();
     let beats = loaded.score.beats.len();
     let mut first = loaded.clone();
     first.score.beats[beats / 2].mode = PlayingMode::Staccato;
@@ -201,9 +209,7 @@ fn rendering_after_a_cancelled_one_equals_a_whole_render() {
     let whole = render(&second, &db, &params, &mut |_| true).unwrap();
     let resumed = render_after(&mut resume, None, &second, &db, &params, &mut |_| true).unwrap();
     assert!(resumed.stats.resumed_from_s.is_some(), "it resumes");
-    assert_eq!(resumed.audio.samples, whole.audio.samples);
-    assert_eq!(resumed.motion, whole.motion);
-    assert_eq!(resumed.events, whole.events);
+    assert_same_performance(&resumed, &whole);
 }
 
 fn below(rng: &mut Rng, n: u64) -> u64 {
