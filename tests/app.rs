@@ -3,40 +3,23 @@
 //! and reopens, asks before losing changes, reports bad files in the window, handles
 //! dropped files and keeps a recent-files list — all in temp dirs, never the real home.
 
+mod common;
+use common::settle;
+
 use eframe::egui;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use std::path::{Path, PathBuf};
-use timpanist::app::{EditorApp, EditorOptions};
+use timpanist::app::EditorApp;
 use timpanist::score::{Hand, PlayingMode};
 
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
+use common::root;
 
-/// An editor on `score` with its recent list in `dir` and the silent clock, in a window
-/// large enough for every panel.
+/// An editor on `score` with its recent list in `dir`, composed and idle.
 fn harness(score: Option<PathBuf>, dir: &Path) -> Harness<'static, EditorApp> {
-    std::env::set_current_dir(root()).unwrap();
-    let options = EditorOptions {
-        score,
-        recent_store: Some(dir.join("recent.txt")),
-        audio_device: false,
-        render: false,
-    };
-    let mut h = Harness::builder()
-        .with_size(egui::vec2(1400.0, 900.0))
-        .with_max_steps(64)
-        .build_eframe(move |_cc| EditorApp::with_options(options));
+    let mut h = common::editor(score, dir, false);
     settle(&mut h);
     h
-}
-
-/// Let the composing worker finish, then run the UI until it is idle.
-fn settle(h: &mut Harness<'static, EditorApp>) {
-    h.step();
-    h.state_mut().wait_for_composition();
-    h.run();
 }
 
 fn demo() -> PathBuf {

@@ -2,26 +2,18 @@
 //! copy/duplicate, nudge with the arrow keys, move between lanes, delete — each one undo
 //! step — and drag a beat along the timeline as one step.
 
+mod common;
+
 use eframe::egui;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use std::path::Path;
-use timpanist::app::{EditorApp, EditorOptions};
+use timpanist::app::EditorApp;
 use timpanist::score::Hand;
 
 fn harness(dir: &Path) -> Harness<'static, EditorApp> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    std::env::set_current_dir(root).unwrap();
-    let options = EditorOptions {
-        score: Some(root.join("scores/etude-modes.ron")),
-        recent_store: Some(dir.join("recent.txt")),
-        audio_device: false,
-        render: false,
-    };
-    let mut h = Harness::builder()
-        .with_size(egui::vec2(1400.0, 900.0))
-        .with_max_steps(64)
-        .build_eframe(move |_cc| EditorApp::with_options(options));
+    let score = common::root().join("scores/etude-modes.ron");
+    let mut h = common::editor(Some(score), dir, false);
     settle(&mut h);
     h
 }

@@ -4,19 +4,19 @@
 //! and says so when there is no rendering, a click on a plot seeks, and export writes a
 //! WAV and a motion CSV of the current rendering or refuses with the reason.
 
+mod common;
+
 use eframe::egui;
 use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT, Queryable};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
-use timpanist::app::{EditorApp, EditorOptions, PlotTab};
+use timpanist::app::{EditorApp, PlotTab};
 use timpanist::mocap::db::MotionDb;
 use timpanist::render::{RenderParams, Rendering, render};
 use timpanist::score::{Hand, LoadedScore};
 
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
+use common::root;
 
 fn score_path() -> PathBuf {
     root().join("scores/improvisation.ron")
@@ -36,7 +36,7 @@ fn rendering() -> Arc<Rendering> {
 /// a window large enough for every panel; with `rendered`, the rendering is handed over.
 /// With the render worker on, a spinner keeps repainting: the UI runs a few frames only.
 fn harness(dir: &Path, render: bool, rendered: bool) -> Harness<'static, EditorApp> {
-    let mut h = editor(score_path(), dir, render);
+    let mut h = common::editor(Some(score_path()), dir, render);
     if rendered {
         h.state_mut().set_rendering(rendering());
     }
@@ -51,26 +51,7 @@ fn harness(dir: &Path, render: bool, rendered: bool) -> Harness<'static, EditorA
 }
 
 /// Let the composing worker finish, then run the UI until it is idle.
-/// An editor on `score` with the silent clock, rendering if `render`.
-fn editor(score: PathBuf, dir: &Path, render: bool) -> Harness<'static, EditorApp> {
-    std::env::set_current_dir(root()).unwrap();
-    let options = EditorOptions {
-        score: Some(score),
-        recent_store: Some(dir.join("recent.txt")),
-        audio_device: false,
-        render,
-    };
-    Harness::builder()
-        .with_size(egui::vec2(1400.0, 900.0))
-        .with_max_steps(64)
-        .build_eframe(move |_cc| EditorApp::with_options(options))
-}
-
-fn settle(h: &mut Harness<'static, EditorApp>) {
-    h.step();
-    h.state_mut().wait_for_composition();
-    h.run();
-}
+use common::settle;
 
 /// Open the plot tab titled `title`.
 fn open_tab(h: &mut Harness<'static, EditorApp>, title: &str) {
@@ -436,7 +417,7 @@ fn a_render_error_shows_its_beat() {
     let path = dir.path().join("reach.ron");
     score.save(&path).unwrap();
     let beat_s = score.tempo_map().seconds_at(1920.0);
-    let mut h = editor(path, dir.path(), true);
+    let mut h = common::editor(Some(path), dir.path(), true);
     let began = std::time::Instant::now();
     while h.state().render_error().is_none() {
         assert!(began.elapsed().as_secs() < 60, "no render error");

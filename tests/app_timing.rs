@@ -4,12 +4,14 @@
 //! rendering of the score. Run with `cargo test --test app_timing -- --nocapture` to see
 //! the figures.
 
+mod common;
+
 use eframe::egui;
 use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT, Queryable};
 use std::path::Path;
 use std::time::Instant;
-use timpanist::app::{EditorApp, EditorOptions};
+use timpanist::app::EditorApp;
 use timpanist::mocap::db::MotionDb;
 use timpanist::render::{RenderParams, render};
 use timpanist::score::{Beat, Hand, Score};
@@ -29,17 +31,7 @@ fn frame_times(h: &mut Harness<'static, EditorApp>, n: usize) -> (f64, f64) {
 /// The editor on `score` (recent files in `dir`, no sound device), rendering if
 /// `render`.
 fn editor(score: std::path::PathBuf, dir: &Path, render: bool) -> Harness<'static, EditorApp> {
-    std::env::set_current_dir(env!("CARGO_MANIFEST_DIR")).unwrap();
-    let options = EditorOptions {
-        score: Some(score),
-        recent_store: Some(dir.join("recent.txt")),
-        audio_device: false,
-        render,
-    };
-    Harness::builder()
-        .with_size(egui::vec2(1400.0, 900.0))
-        .with_max_steps(64)
-        .build_eframe(move |_cc| EditorApp::with_options(options))
+    common::editor(Some(score), dir, render)
 }
 
 /// A 60-second score: eighth notes at 100 bpm over all four drums.

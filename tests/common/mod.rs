@@ -1,0 +1,46 @@
+//! Set-up shared by the editor's tests: an editor on a score with its recent-files list
+//! in a temporary folder and the silent clock, in a window large enough for every panel.
+// Each test crate uses only some of these.
+#![allow(dead_code)]
+
+use eframe::egui;
+use egui_kittest::{Harness, HarnessBuilder};
+use std::path::{Path, PathBuf};
+use timpanist::app::{EditorApp, EditorOptions};
+
+/// The repository (the tests run from it: the motion database is found there).
+pub fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The editor's options for `score`, its recent list in `dir`, no sound device,
+/// rendering if `render`; moves into the repository.
+pub fn options(score: Option<PathBuf>, dir: &Path, render: bool) -> EditorOptions {
+    std::env::set_current_dir(root()).unwrap();
+    EditorOptions {
+        score,
+        recent_store: Some(dir.join("recent.txt")),
+        audio_device: false,
+        render,
+    }
+}
+
+/// A 1400 × 900 window, at most 64 steps a run.
+pub fn builder() -> HarnessBuilder<EditorApp> {
+    Harness::builder()
+        .with_size(egui::vec2(1400.0, 900.0))
+        .with_max_steps(64)
+}
+
+/// The editor on `score` (see [`options`]).
+pub fn editor(score: Option<PathBuf>, dir: &Path, render: bool) -> Harness<'static, EditorApp> {
+    let options = options(score, dir, render);
+    builder().build_eframe(move |_cc| EditorApp::with_options(options))
+}
+
+/// Let the composing worker finish, then run the UI until it is idle.
+pub fn settle(h: &mut Harness<'static, EditorApp>) {
+    h.step();
+    h.state_mut().wait_for_composition();
+    h.run();
+}
