@@ -390,18 +390,22 @@ fn cli_render_refuses_bad_scores_cleanly() {
     let bad = dir.path().join("bad.ron");
     std::fs::write(&bad, "Score(version: 2, title: \"x\", beats: [oops])").unwrap();
     let wav = dir.path().join("out.wav");
-    let out = Command::new(env!("CARGO_BIN_EXE_timpanist"))
-        .current_dir(root())
-        .arg("render")
-        .arg(&bad)
-        .arg("--wav")
-        .arg(&wav)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success());
+    // Renders `score`: it must fail, write no WAV, and say why (returned).
+    let refused = |score: &Path| {
+        let out = Command::new(env!("CARGO_BIN_EXE_timpanist"))
+            .current_dir(root())
+            .arg("render")
+            .arg(score)
+            .arg("--wav")
+            .arg(&wav)
+            .output()
+            .unwrap();
+        assert!(!out.status.success());
+        assert!(!wav.exists());
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let stderr = refused(&bad);
     assert!(stderr.contains("bad.ron:1:"), "{stderr}");
-    assert!(!wav.exists());
 
     // A stroke the body cannot reach: the right hand on the far-left drum's centre.
     let mut score = Score::new("reach");
@@ -411,19 +415,9 @@ fn cli_render_refuses_bad_scores_cleanly() {
     score.beats.push(beat);
     let far = dir.path().join("far.ron");
     score.save(&far).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_timpanist"))
-        .current_dir(root())
-        .arg("render")
-        .arg(&far)
-        .arg("--wav")
-        .arg(&wav)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success());
+    let stderr = refused(&far);
     assert!(
         stderr.contains("far.ron: beat 0 is out of the right hand's reach"),
         "{stderr}"
     );
-    assert!(!wav.exists());
 }
