@@ -57,6 +57,11 @@ fn edit_to_composition_and_frame_times() {
     h.run();
     let first = h.state().last_compose_time().unwrap();
 
+    // Select a beat on the 26-inch drum (the template of new beats), then add one in the
+    // right hand's lane: the grid at this zoom is a bar, so it lands with a bar's first
+    // beat (on the 32-inch drum), which automatic sticking then gives the left hand.
+    h.state_mut().show_beat(102);
+    h.step();
     let at = h
         .state()
         .timeline_point(480 * 101 + 240, Hand::Right)

@@ -201,31 +201,43 @@ pub fn ik_targets(
     let mut pose = *initial;
     (0..reference.tips[0].len())
         .map(|k| {
-            pose = ik_target(model, reference, params, k, &pose);
+            pose = ik_target(model, reference, params, k, &pose, initial);
             pose
         })
         .collect()
 }
 
 /// The IK joint target of reference sample `k`, from the previous one (`previous`; the
-/// initial pose for sample 0).
+/// initial pose for sample 0). The redundancy is pulled toward the captured posture when
+/// there is one; else toward the previous pose for the arms and toward `posture` (the
+/// initial pose, upright) for the trunk, which would otherwise drift through the null
+/// space stroke after stroke (53° in 10 s of fast strokes over four drums).
 fn ik_target(
     model: &BodyModel,
     reference: &Reference,
     params: &SimParams,
     k: usize,
     previous: &Pose,
+    posture: &Pose,
 ) -> Pose {
-    let pull = reference.poses.as_ref().map(|p| &p[k]);
     let start = *previous;
-    let mut pose = *pull.unwrap_or(&start);
+    let pull = match &reference.poses {
+        Some(poses) => poses[k],
+        None => {
+            let mut pull = start;
+            let trunk = Joint::Trunk.index();
+            pull[trunk] = posture[trunk];
+            pull
+        }
+    };
+    let mut pose = reference.poses.as_ref().map_or(start, |p| p[k]);
     for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
         pose = ik::solve(
             &model.skeleton,
             &pose,
             side,
             reference.tips[h][k],
-            pull.or(Some(&start)),
+            Some(&pull),
             &params.ik,
         )
         .pose;
@@ -375,7 +387,14 @@ impl Simulator {
                 (Pipeline::Id, Some(poses)) => poses[next],
                 _ => {
                     let previous = self.targets.last().unwrap_or(&self.initial);
-                    ik_target(&self.model, reference, &self.params, next, previous)
+                    ik_target(
+                        &self.model,
+                        reference,
+                        &self.params,
+                        next,
+                        previous,
+                        &self.initial,
+                    )
                 }
             };
             self.targets.push(pose);
@@ -613,23 +632,23 @@ mod tests {
         assert!(err.to_string().contains("during beat"), "{err}");
     }
 
-    /// A target moving out of reach (the right tip's, to 2 m ahead in 0.4 s) with the
-    /// nominal gains: the tip cannot follow, and the simulation stops saying control of
-    /// that stick was lost, when and during which beat.
+    /// A target moving out of reach (the right tip's, to 2 m ahead in 1.6 s) with the
+    /// nominal gains: the body cannot follow, and the simulation stops saying control of
+    /// a stick was lost, when and during which beat.
     #[test]
     fn lost_control_is_reported_with_the_beat() {
         let model = BodyModel::default();
         let here = model.skeleton.forward(&REST);
         let tips = |side: Side, far: f64| {
-            (0..150)
-                .map(|k| here.tip(side) + DVec3::new(0.0, far * (k as f64 / 100.0).min(1.0), 0.0))
+            (0..500)
+                .map(|k| here.tip(side) + DVec3::new(0.0, far * (k as f64 / 400.0).min(1.0), 0.0))
                 .collect()
         };
         let reference = Reference {
             rate_hz: 250.0,
             tips: [tips(Side::Left, 0.0), tips(Side::Right, 2.0)],
             poses: None,
-            beats: vec![(0.5, 7)],
+            beats: vec![(1.9, 7)],
         };
         let run = |limit: f64| {
             let params = SimParams {
@@ -642,10 +661,8 @@ mod tests {
         let Err(SimError::Diverged(err)) = run(0.5) else {
             panic!("no loss of control reported")
         };
-        assert!(
-            err.what.contains("lost control of the right stick"),
-            "{err}"
-        );
+        // The right arm stretching drags the trunk, and with it the left stick.
+        assert!(err.what.contains("lost control of the"), "{err}");
         assert_eq!(err.beat, Some(7));
         assert!(err.time_s > 0.1, "{err}");
     }

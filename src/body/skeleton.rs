@@ -171,6 +171,27 @@ impl Skeleton {
     pub fn tip(&self, pose: &Pose, side: crate::kit::Side) -> DVec3 {
         self.forward(pose).tip(side)
     }
+
+    /// The shoulder of `side` in the upright rest posture, m.
+    pub fn shoulder(&self, side: crate::kit::Side) -> DVec3 {
+        self.forward(&REST).position[Joint::arm(side)[0].index()]
+    }
+
+    /// How far a stick tip can go from its shoulder, m: upper arm, forearm, hand and stick
+    /// in a line.
+    pub fn reach_m(&self) -> f64 {
+        let [_, elbow, wrist, grip] = Joint::arm(crate::kit::Side::Right);
+        let arm: f64 = [elbow, wrist, grip]
+            .iter()
+            .map(|j| self.offsets[j.index()].length())
+            .sum();
+        arm + self.stick_length_m
+    }
+
+    /// Whether a stick tip at `point` (m) is within the reach of `side`'s arm.
+    pub fn reaches(&self, side: crate::kit::Side, point: DVec3) -> bool {
+        point.distance(self.shoulder(side)) <= self.reach_m()
+    }
 }
 
 /// Joint positions and segment orientations in the performer frame for one pose.

@@ -18,6 +18,7 @@
 //!   linear: dynamic programming over the assignment that minimises the cost below.
 //!
 //! **Cost** of beat b played by hand h (weights are [`Params`] fields):
+//! * reach: [`UNREACHABLE_COST`] if h cannot reach the beat's point;
 //! * preference: `w_pref` if h is not the drum's preferred hand;
 //! * travel of h from its previous stroke p (horizontal distance d, Δt = t_b − t_p):
 //!   `w_dist·d + w_speed·max(0, d/Δt − v_comfort)²`;
@@ -46,6 +47,7 @@
 //! O(n · (beats per H + points)), linear in the number of beats n for a given
 //! density of notes and set of impact points.
 
+use crate::body::skeleton::Skeleton;
 use crate::kit::{Kit, Side};
 use crate::score::{Hand, Score};
 use glam::DVec2;
@@ -60,6 +62,11 @@ pub const CROSSING_TOLERANCE_M: f64 = 0.02;
 /// in effect infinite, but finite so that the other terms still rank the assignments a
 /// score forces into it (e.g. a fixed hand on a beat at the very end of its own roll).
 pub const IMPOSSIBLE_COST: f64 = 1e9;
+
+/// Cost of a beat played by a hand that cannot reach its point (the default player's
+/// stretched arm and stick from the shoulder, `Skeleton::reaches`): far above the other
+/// terms, far below [`IMPOSSIBLE_COST`]. Both hands pay it where neither reaches.
+pub const UNREACHABLE_COST: f64 = 1e6;
 
 /// How to choose hands.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -164,6 +171,8 @@ struct Stroke {
     /// The drum's minimum same-hand gap, s.
     min_gap: f64,
     roll: Option<RollTimes>,
+    /// Whether each hand (left, right) can reach the point.
+    reachable: [bool; 2],
 }
 
 /// Times of a roll's strokes that matter to sticking, s.
@@ -222,6 +231,9 @@ struct Prep {
 impl Prep {
     fn new(score: &Score, kit: &Kit) -> Prep {
         let map = score.tempo_map();
+        // The default player with the kit's first mallets.
+        let mallet_m = kit.mallets.first().map_or(0.37, |m| m.length_m);
+        let body = Skeleton::new(1.75, mallet_m);
         let seconds = |tick: u64| map.seconds_at(tick as f64);
         let mut ids: BTreeMap<(usize, u64, u64), usize> = BTreeMap::new();
         let mut points = Vec::new();
@@ -231,10 +243,12 @@ impl Prep {
             .map(|b| {
                 let drum = &kit.drums[b.drum];
                 let (r, angle) = b.location.polar();
+                let on_head = drum.point_on_head(r, angle);
+                let reachable = [Side::Left, Side::Right].map(|h| body.reaches(h, on_head));
                 let point = *ids
                     .entry((b.drum, r.to_bits(), angle.to_bits()))
                     .or_insert_with(|| {
-                        points.push(drum.point_on_head(r, angle).truncate());
+                        points.push(on_head.truncate());
                         points.len() - 1
                     });
                 let roll = b.roll.map(|roll| {
@@ -259,6 +273,7 @@ impl Prep {
                     fixed: b.hand.side(),
                     min_gap: drum.min_same_hand_gap_s,
                     roll,
+                    reachable,
                 }
             })
             .collect();
@@ -456,6 +471,9 @@ impl Costs<'_> {
         let p = self.params;
         let s = &self.prep.strokes[i];
         let mut cost = if side == s.preferred { 0.0 } else { p.w_pref };
+        if !s.reachable[side as usize] {
+            cost += UNREACHABLE_COST;
+        }
         cost += self.travel(hands[side as usize], s.point, s.time, s.min_gap);
         if let Some(r) = &s.roll {
             cost += self.travel(hands[side.other() as usize], s.point, r.second, s.min_gap);
@@ -606,6 +624,24 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The right hand cannot reach the far-left drum's playing spot (the left can): a
+    /// fast double stroke there, which would otherwise alternate hands, stays in the left
+    /// hand.
+    #[test]
+    fn optimal_keeps_beats_within_reach() {
+        let kit = Kit::standard();
+        let s = score(&[(0, 0), (ticks(0.06), 0)]);
+        let prep = Prep::new(&s, &kit);
+        assert_eq!(prep.strokes[0].reachable, [true, false]);
+        assert_eq!(run(&s, &kit, Method::Optimal), [Side::Left, Side::Left]);
+        let same_drum_elsewhere = score(&[(0, 1), (ticks(0.06), 1)]);
+        assert_ne!(
+            run(&same_drum_elsewhere, &kit, Method::Optimal)[0],
+            run(&same_drum_elsewhere, &kit, Method::Optimal)[1],
+            "within reach of both, a fast double stroke alternates"
+        );
     }
 
     /// Every method keeps fixed hands and splits simultaneous beats, whatever the drums.

@@ -335,7 +335,7 @@ impl Performance {
         self.commits.push(commit.clone());
         let last_s = self.targets.knots(cluster.end - 1, 0.0)[1].0;
         let until = (((last_s + LOOKAHEAD_S) * rate).ceil() as usize).clamp(commit.samples, n);
-        type Attempt = ((usize, f64), Vec<f64>, Vec<f64>, usize);
+        type Attempt = ((usize, usize, f64), Vec<f64>, Vec<f64>, usize);
         let mut best: Option<Attempt> = None;
         let mut attempt = 0;
         let mut diverged = false;
@@ -384,7 +384,8 @@ impl Performance {
                     None => missed += 1,
                 }
             }
-            let key = (missed + far_off, worst);
+            // A stroke that does not sound is worse than one whose force is off.
+            let key = (missed, far_off, worst);
             if best.as_ref().is_none_or(|b| key <= b.0) {
                 best = Some((
                     key,

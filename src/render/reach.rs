@@ -1,16 +1,15 @@
 //! Whether the body can reach every stroke, checked before simulating: a stroke whose
-//! target lies farther from its hand's shoulder (in the upright rest posture) than the arm
-//! and stick can stretch, plus what leaning the trunk adds, is refused with the beat named.
-//! Simulated, such a reach leaves the arm fully stretched, where the nested IK and the PD
-//! loops oscillate and the stick flails (see `body::sim`'s loss-of-control check). With
-//! the standard kit these are the centres of the outer drums played across the body.
+//! target lies farther from its hand's shoulder (in the upright rest posture) than the
+//! stretched arm and stick (`Skeleton::reach_m`) is refused with the beat named. Leaning
+//! the trunk could add some, but at speed the stretched arm oscillates first. Automatic
+//! sticking avoids such hands (`motion::sticking`). Simulated, such a reach leaves the arm
+//! fully stretched, where the nested IK and the PD loops oscillate and the stick flails
+//! (see `body::sim`'s loss-of-control check). With the standard kit these are the outer
+//! drums played across the body.
 
-use crate::body::skeleton::{Joint, REST, Skeleton};
+use crate::body::skeleton::Skeleton;
 use crate::kit::Side;
 use crate::motion::plan::PlannedStroke;
-
-/// How much farther than the stretched arm and stick the trunk's lean lets a tip go, m.
-pub const TRUNK_ALLOWANCE_M: f64 = 0.12;
 
 /// A stroke the body cannot reach.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -30,24 +29,11 @@ pub struct OutOfReach {
     pub reach_m: f64,
 }
 
-/// How far from its shoulder a stick tip can go, m: upper arm, forearm, hand and stick
-/// in a line, plus [`TRUNK_ALLOWANCE_M`].
-pub fn reach(skeleton: &Skeleton) -> f64 {
-    let [_, elbow, wrist, grip] = Joint::arm(Side::Right);
-    let arm: f64 = [elbow, wrist, grip]
-        .iter()
-        .map(|j| skeleton.offsets[j.index()].length())
-        .sum();
-    arm + skeleton.stick_length_m + TRUNK_ALLOWANCE_M
-}
-
 /// The first stroke of `strokes` out of reach of `skeleton`, if any.
 pub fn check(strokes: &[PlannedStroke], skeleton: &Skeleton) -> Result<(), OutOfReach> {
-    let rest = skeleton.forward(&REST);
-    let reach_m = reach(skeleton);
+    let reach_m = skeleton.reach_m();
     for s in strokes {
-        let shoulder = rest.position[Joint::arm(s.hand)[0].index()];
-        let distance_m = s.target.distance(shoulder);
+        let distance_m = s.target.distance(skeleton.shoulder(s.hand));
         if distance_m > reach_m {
             return Err(OutOfReach {
                 beat: s.beat,
@@ -98,7 +84,7 @@ mod tests {
             err.to_string()
                 .starts_with("beat 4 is out of the right hand's reach")
         );
-        let r = reach(&skeleton);
-        assert!((1.0..1.2).contains(&r), "{r}");
+        let r = skeleton.reach_m();
+        assert!((0.9..1.1).contains(&r), "{r}");
     }
 }
