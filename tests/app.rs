@@ -334,3 +334,34 @@ fn inspector_edits_settings_undoably_and_saves_them() {
     let s = &again.state().loaded().unwrap().score.settings;
     assert_eq!((s.control, s.sound), (Pipeline::Id, SoundModel::Sample));
 }
+
+/// With nothing selected, a beat added in a hand's lane goes on the first drum that hand
+/// prefers (the 26-inch for the right hand on the standard kit, the 32-inch for the left):
+/// never on a far drum across the body.
+#[test]
+fn a_new_beat_goes_on_a_drum_of_its_hand() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(Some(demo()), dir.path());
+    let kit = h.state().loaded().unwrap().kit.clone();
+    for (tick, hand) in [
+        (960 * 4 * 2 + 480, Hand::Right),
+        (960 * 4 * 3 + 480, Hand::Left),
+    ] {
+        h.key_press(egui::Key::Escape);
+        settle(&mut h);
+        assert!(h.state().selection().beats.is_empty());
+        let before = h.state().loaded().unwrap().score.beats.clone();
+        let at = h.state().timeline_point(tick, hand).unwrap();
+        click(&mut h, at);
+        let beats = &h.state().loaded().unwrap().score.beats;
+        let added: Vec<_> = beats.iter().filter(|b| !before.contains(b)).collect();
+        assert_eq!(added.len(), 1, "{hand:?}");
+        let drum = &kit.drums[added[0].drum];
+        assert_eq!(
+            Some(drum.preferred_hand),
+            hand.side(),
+            "{hand:?}: {}",
+            drum.name
+        );
+    }
+}

@@ -364,6 +364,10 @@ impl TimelineView {
                 Some(i) => out.push(Command::Select(Selection::only(i))),
                 None => {
                     let tick = snap(g.axis.tick_of(f64::from(p.x)), grid);
+                    let hand = LANES[g.lane_at(p.y)];
+                    // Like the last selected beat, else on the first drum the lane's hand
+                    // prefers (the far drums are out of the other hand's reach).
+                    let kit = input.doc.score.settings.kit(&input.doc.kit);
                     let template = input
                         .selection
                         .beats
@@ -371,10 +375,10 @@ impl TimelineView {
                         .next_back()
                         .and_then(|&i| beats.get(i))
                         .copied()
-                        .unwrap_or(Beat::plain(0, 0));
+                        .unwrap_or_else(|| Beat::plain(0, default_drum(&kit, hand)));
                     let beat = Beat {
                         tick,
-                        hand: LANES[g.lane_at(p.y)],
+                        hand,
                         roll: None,
                         ..template
                     };
@@ -517,4 +521,12 @@ fn beat_shape(mode: PlayingMode, c: Pos2, r: f32, fill: Color32, selected: bool)
             c + Vec2::new(-r, 0.0),
         ]),
     }
+}
+
+/// The drum a new beat in `hand`'s lane goes on when there is nothing to copy: the first
+/// drum that hand prefers (any hand: the first drum).
+fn default_drum(kit: &crate::kit::Kit, hand: crate::score::Hand) -> usize {
+    hand.side()
+        .and_then(|side| kit.drums.iter().position(|d| d.preferred_hand == side))
+        .unwrap_or(0)
 }
