@@ -116,9 +116,9 @@ pub struct EditorApp {
     /// Renders each version of the score for playback (`None` when disabled).
     renderer: Option<renderer::Renderer>,
     /// Why the latest render failed.
-    render_error: Option<String>,
-    /// The beat the render error names, if any (the status bar offers to show it).
-    render_error_beat: Option<usize>,
+    /// Why the latest render or playback failed, and the beat it names (the status bar
+    /// offers to show it).
+    render_error: Option<renderer::Failure>,
     /// Counts compositions received (for caches).
     generation: u64,
     selection: Selection,
@@ -174,7 +174,6 @@ impl EditorApp {
             composer: Composer::new(),
             renderer: options.render.then(renderer::Renderer::new),
             render_error: None,
-            render_error_beat: None,
             generation: 0,
             selection: Selection::default(),
             clipboard: Clipboard::default(),
@@ -223,7 +222,7 @@ impl EditorApp {
 
     /// Why the latest rendering failed, if it did.
     pub fn render_error(&self) -> Option<&str> {
-        self.render_error.as_deref()
+        self.render_error.as_ref().map(|f| f.message.as_str())
     }
 
     /// The error shown in the window, if any.
@@ -345,7 +344,7 @@ impl EditorApp {
             current: self.rendering_current,
             busy: self.renderer.as_ref().is_some_and(|r| r.is_busy()),
             enabled: self.renderer.is_some(),
-            error: self.render_error.as_deref(),
+            error: self.render_error(),
         }
         .blocked()
     }
@@ -480,8 +479,10 @@ impl EditorApp {
         match done {
             Ok(r) => self.accept_rendering(r, current),
             Err(e) => {
-                self.render_error = Some(format!("render: {}", e.message));
-                self.render_error_beat = e.beat;
+                self.render_error = Some(renderer::Failure {
+                    message: format!("render: {}", e.message),
+                    ..e
+                })
             }
         }
     }
@@ -509,7 +510,7 @@ impl EditorApp {
             .playback
             .set_audio(Arc::clone(r) as Arc<dyn tape::StereoSource>)
         {
-            self.render_error = Some(format!("playback: {e}"));
+            self.render_error = Some(renderer::Failure::of(format!("playback: {e}")));
             return;
         }
         self.audio_ready_s = ready_s;
@@ -538,8 +539,7 @@ impl EditorApp {
 
     /// The beat the latest render error names, if any.
     pub fn render_error_beat(&self) -> Option<usize> {
-        self.render_error_beat
-            .filter(|_| self.render_error.is_some())
+        self.render_error.as_ref().and_then(|f| f.beat)
     }
 
     /// Whether Space was pressed where the audio is not ready yet (playback starts once
@@ -1021,7 +1021,7 @@ impl EditorApp {
             // Last, cut to the width left (in full on hover), after its button.
             if let Some(e) = self.render_error.as_ref().filter(|_| !self.is_rendering()) {
                 ui.separator();
-                if let Some(b) = self.render_error_beat
+                if let Some(b) = e.beat
                     && ui
                         .small_button(format!("Show beat {b}"))
                         .on_hover_text("Select the beat and move the playhead to it")
@@ -1029,8 +1029,9 @@ impl EditorApp {
                 {
                     show = Some(b);
                 }
-                let text = egui::RichText::new(e).color(ui.visuals().error_fg_color);
-                ui.add(egui::Label::new(text).truncate()).on_hover_text(e);
+                let text = egui::RichText::new(&e.message).color(ui.visuals().error_fg_color);
+                ui.add(egui::Label::new(text).truncate())
+                    .on_hover_text(&e.message);
             }
         });
         if let Some(b) = show {
@@ -1186,8 +1187,8 @@ impl EditorApp {
             (t(g.lanes.left()), t(g.lanes.right()))
         });
         let busy = self.renderer.as_ref().is_some_and(|r| r.is_busy());
-        let note = match (&self.render_error, busy, &self.renderer) {
-            (Some(e), _, _) => Some(e.clone()),
+        let note = match (self.render_error(), busy, &self.renderer) {
+            (Some(e), _, _) => Some(e.to_string()),
             (None, true, _) => Some("rendering sound and motion...".to_string()),
             (None, false, None) => Some("rendering is turned off".to_string()),
             (None, false, Some(_)) => None,

@@ -12,7 +12,9 @@ use super::pose::Simulated;
 use super::tape::StereoSource;
 use crate::kit::Kit;
 use crate::mocap::db::MotionDb;
-use crate::render::{FIRST_STEP_S, RESUME_STEP_S, RenderParams, Rendering, Resume, render_after};
+use crate::render::{
+    FIRST_STEP_S, RESUME_STEP_S, RenderError, RenderParams, Rendering, Resume, render_after,
+};
 use crate::score::{LoadedScore, Score};
 use eframe::egui;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -105,7 +107,8 @@ pub struct Failure {
 }
 
 impl Failure {
-    fn of(message: impl Into<String>) -> Failure {
+    /// A failure that names no beat.
+    pub fn of(message: impl Into<String>) -> Failure {
         Failure {
             message: message.into(),
             beat: None,
@@ -113,15 +116,8 @@ impl Failure {
     }
 }
 
-impl Failure {
-    fn is_cancelled(&self) -> bool {
-        self.message == crate::render::RenderError::Cancelled.to_string()
-    }
-}
-
-impl From<crate::render::RenderError> for Failure {
-    fn from(e: crate::render::RenderError) -> Failure {
-        use crate::render::RenderError;
+impl From<RenderError> for Failure {
+    fn from(e: RenderError) -> Failure {
         let beat = match &e {
             RenderError::Diverged { beat, .. } => *beat,
             RenderError::OutOfReach(r) => Some(r.beat),
@@ -257,13 +253,14 @@ fn work(shared: &(Mutex<Slot>, Condvar), latest: &AtomicU64, tx: &mpsc::Sender<R
             } else {
                 RESUME_STEP_S
             };
-            let result = run(&request, db, latest, &mut resume, stop_after_s).map(|r| {
-                let from = *origin.get_or_insert(r.stats.resumed_from_s);
-                Rendered::of_request(Arc::new(r), (from, began.elapsed()))
-            });
-            if result.as_ref().is_err_and(Failure::is_cancelled) {
-                break;
-            }
+            let result = match run(&request, db, latest, &mut resume, stop_after_s) {
+                Err(RenderError::Cancelled) => break,
+                Err(e) => Err(Failure::from(e)),
+                Ok(r) => {
+                    let from = *origin.get_or_insert(r.stats.resumed_from_s);
+                    Ok(Rendered::of_request(Arc::new(r), (from, began.elapsed())))
+                }
+            };
             complete = result.as_ref().map_or(true, |r| r.complete);
             if tx.send((request.generation, result)).is_err() {
                 return;
@@ -281,7 +278,7 @@ fn run(
     latest: &AtomicU64,
     resume: &mut Option<Resume>,
     stop_after_s: f64,
-) -> Result<Rendering, Failure> {
+) -> Result<Rendering, RenderError> {
     let loaded = LoadedScore {
         score: request.score.clone(),
         kit: request.kit.clone(),
@@ -297,5 +294,4 @@ fn run(
         &params,
         &mut |_| latest.load(Ordering::SeqCst) == request.generation,
     )
-    .map_err(Failure::from)
 }

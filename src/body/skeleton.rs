@@ -115,18 +115,21 @@ pub struct Skeleton {
     pub stick_length_m: f64,
 }
 
+/// Height of the default player, m: the one the segment lengths below are given for.
+pub const DEFAULT_HEIGHT_M: f64 = 1.75;
+
 impl Default for Skeleton {
-    /// A standing adult of about 1.75 m (segment lengths after Winter's anthropometric
-    /// tables) holding 0.37 m mallets 4 cm from their end.
+    /// A standing adult of [`DEFAULT_HEIGHT_M`] (segment lengths after Winter's
+    /// anthropometric tables) holding 0.37 m mallets 4 cm from their end.
     fn default() -> Self {
-        Skeleton::new(1.75, 0.37)
+        Skeleton::new(DEFAULT_HEIGHT_M, 0.37)
     }
 }
 
 impl Skeleton {
     /// A skeleton scaled to `height_m` holding mallets of `mallet_length_m`.
     pub fn new(height_m: f64, mallet_length_m: f64) -> Skeleton {
-        let h = height_m / 1.75;
+        let h = height_m / DEFAULT_HEIGHT_M;
         let mut offsets = [DVec3::ZERO; JOINT_COUNT];
         let mut set = |j: Joint, v: DVec3| offsets[j.index()] = v * h;
         set(Joint::Neck, DVec3::new(0.0, 0.0, 0.48));

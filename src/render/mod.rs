@@ -110,7 +110,7 @@ impl Default for RenderParams {
             plan: PlanParams::default(),
             compose: ComposeParams::default(),
             mallet: 0,
-            height_m: 1.75,
+            height_m: crate::body::skeleton::DEFAULT_HEIGHT_M,
             mass_kg: 70.0,
             max_attempts: 6,
             timing_tolerance_s: 0.0015,

@@ -59,7 +59,7 @@ pub struct Saved {
 }
 
 /// The frame synthesis resumes from with states `saved`, for a change at frame `from`.
-pub fn resume_frame(saved: &[Saved], from: usize) -> usize {
+fn resume_frame(saved: &[Saved], from: usize) -> usize {
     saved
         .iter()
         .rev()
@@ -78,22 +78,12 @@ pub struct DrumSynth {
     voices: Vec<Voice>,
 }
 
-/// Render drum `j`'s sound into `out` (mono, 48 kHz, from t = 0). Returns whether anything
-/// touched the drum.
-pub fn render_drum(drums: &DrumSet, j: usize, out: &mut [f32]) -> bool {
-    let mut synth = DrumSynth::default();
-    let mut mono = Vec::new();
-    let (heard, _) = resynthesise(drums, j, &mut mono, out.len(), &mut synth);
-    out.copy_from_slice(&mono);
-    heard
-}
-
-/// [`render_drum`] again, `frames` long, into `out` that holds the output `synth` was
-/// rendered with: the record is compared with the one heard then, and synthesis resumes
-/// from the latest saved state before the first frame a changed entry (or the end of the
-/// previous output) reaches; the output before it is kept. Bit for bit a whole
-/// [`render_drum`]. Returns whether anything touched the drum and the first frame
-/// rewritten (`frames` when nothing changed).
+/// Render drum `j`'s sound (mono, 48 kHz, from t = 0), `frames` long, into `out` that
+/// holds the output `synth` was rendered with (empty, with a default `synth`, the first
+/// time): the record is compared with the one heard then, and synthesis resumes from the
+/// latest saved state before the first frame a changed entry (or the end of the previous
+/// output) reaches; the output before it is kept. Bit for bit a whole render. Returns
+/// whether anything touched the drum and the first frame rewritten.
 pub fn resynthesise(
     drums: &DrumSet,
     j: usize,
