@@ -4,10 +4,10 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::path::Path;
-use timpanist::body::evaluate::{reference_of, simulated_body, units_for};
 use timpanist::body::sim::{Pipeline, SimParams, simulate};
 use timpanist::body::skeleton::JOINT_COUNT;
 use timpanist::mocap::db::MotionDb;
+use timpanist::render::evaluate::{reference_of, simulated_body, units_for};
 use timpanist::score::PlayingMode;
 
 fn bench(c: &mut Criterion) {

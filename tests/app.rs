@@ -211,6 +211,7 @@ fn save_and_reopen() {
     let edited = h.state().loaded().unwrap().score.clone();
     let target = dir.path().join("saved.ron");
     h.state_mut().save_to(&target);
+    h.state_mut().wait_for_files();
     assert!(h.state().error().is_none(), "{:?}", h.state().error());
     assert!(!h.state().is_dirty());
     let again = harness(Some(target.clone()), dir.path());
@@ -324,6 +325,7 @@ fn inspector_edits_settings_undoably_and_saves_them() {
     );
     let path = dir.path().join("with-settings.ron");
     h.state_mut().save_to(&path);
+    h.state_mut().wait_for_files();
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(
         text.contains("settings") && text.contains("Sample"),

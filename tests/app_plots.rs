@@ -224,6 +224,7 @@ fn export_writes_wav_and_motion() {
 
     let wav = out.path().join("improvisation.wav");
     h.state_mut().export_wav_to(&wav);
+    h.state_mut().wait_for_files();
     assert!(h.state().error().is_none(), "{:?}", h.state().error());
     assert!(
         h.state().status().contains("exported"),
@@ -249,6 +250,7 @@ fn export_writes_wav_and_motion() {
 
     let csv = out.path().join("improvisation-motion.csv");
     h.state_mut().export_motion_to(&csv);
+    h.state_mut().wait_for_files();
     assert!(h.state().error().is_none(), "{:?}", h.state().error());
     let text = std::fs::read_to_string(&csv).unwrap();
     let lines: Vec<&str> = text.lines().collect();
@@ -266,6 +268,7 @@ fn export_writes_wav_and_motion() {
     // The motion as C3D: every joint and tip, read back by the C3D reader.
     let c3d = out.path().join("improvisation-motion.c3d");
     h.state_mut().export_c3d_to(&c3d);
+    h.state_mut().wait_for_files();
     assert!(h.state().error().is_none(), "{:?}", h.state().error());
     let take =
         timpanist::mocap::import::c3d::read(&c3d, &std::fs::read(&c3d).unwrap(), None).unwrap();
@@ -278,6 +281,7 @@ fn export_writes_wav_and_motion() {
     // The score as MIDI: imported again, the same beats at the same ticks.
     let mid = out.path().join("improvisation.mid");
     h.state_mut().export_midi_to(&mid);
+    h.state_mut().wait_for_files();
     assert!(h.state().error().is_none(), "{:?}", h.state().error());
     let loaded = LoadedScore::load(&score_path()).unwrap();
     let (back, _) =
@@ -295,6 +299,7 @@ fn export_writes_wav_and_motion() {
 
     // A failing write is an error in the window, not a panic.
     h.state_mut().export_wav_to(Path::new("/no/such/dir/x.wav"));
+    h.state_mut().wait_for_files();
     assert!(h.state().error().unwrap().contains("/no/such/dir/x.wav"));
     h.run();
     h.get_by_label_contains("Error: cannot export to /no/such/dir/x.wav");
@@ -323,6 +328,7 @@ fn export_is_refused_without_a_current_rendering() {
             .is_disabled()
     );
     h.state_mut().export_wav_to(&wav);
+    h.state_mut().wait_for_files();
     let error = h.state().error().unwrap().to_string();
     assert!(
         error.contains("cannot export: rendering is turned off"),
@@ -353,6 +359,7 @@ fn export_is_refused_without_a_current_rendering() {
     settle(&mut h);
     assert!(h.state().is_dirty());
     h.state_mut().export_motion_to(&out.path().join("m.csv"));
+    h.state_mut().wait_for_files();
     let error = h.state().error().unwrap().to_string();
     assert!(error.contains("changed since it was rendered"), "{error}");
     assert_eq!(std::fs::read_dir(out.path()).unwrap().count(), 0);

@@ -1,5 +1,5 @@
 //! The modal timpani, the Hertz stick–membrane contact and the three sound models, end to
-//! end with a scripted stick (issue 6 §1–3 acceptance checks).
+//! end with a scripted stick (the acceptance checks of the modes, the contact and the sound).
 
 use glam::DVec3;
 use timpanist::drum::strike::{self, PLAYING_SPOT_FRACTION, SIM_RATE_HZ, ScriptedStick};

@@ -5,12 +5,12 @@
 use midly::num::{u4, u7, u15, u24, u28};
 use midly::{Format, Header, MetaMessage, MidiMessage, Smf, Timing, TrackEvent, TrackEventKind};
 use std::path::Path;
+use timpanist::base::pitch::Pitch;
 use timpanist::io::midi_export::export;
 use timpanist::io::midi_import::{
     ImportOptions, ImportReport, MidiError, TrackChoice, import, import_file,
 };
 use timpanist::kit::Kit;
-use timpanist::pitch::Pitch;
 use timpanist::score::{
     Beat, Dynamic, Hand, ImpactLocation, MeterChange, PlayingMode, Roll, Score, TempoChange,
     TempoPoint,

@@ -222,7 +222,7 @@ fn shipped_database_rebuilds_bit_for_bit() {
     let rebuilt = synthesize(&SynthConfig::default());
     let index_text = std::fs::read_to_string(dir.join("index.ron")).unwrap();
     assert!(
-        timpanist::io::ron_file::to_pretty(&rebuilt.index) == index_text,
+        timpanist::base::ron_file::to_pretty(&rebuilt.index) == index_text,
         "index.ron differs"
     );
     for (entry, data) in rebuilt.index.takes.iter().zip(&rebuilt.takes) {

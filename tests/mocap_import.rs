@@ -7,7 +7,8 @@
 use glam::{DQuat, DVec3};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
-use timpanist::mocap::import::{self, Format, c3d, plain_csv, write_c3d};
+use timpanist::io::c3d_write::write_c3d;
+use timpanist::mocap::import::{self, Format, c3d, plain_csv};
 use timpanist::mocap::{ImportError, Take, Track};
 
 fn fixture(rel: &str) -> PathBuf {

@@ -4,15 +4,15 @@
 
 use glam::{DQuat, DVec3};
 use std::path::Path;
+use timpanist::base::rng::Rng;
 use timpanist::body::control::{Gains, limit_torques, pd_torques};
 use timpanist::body::dynamics::{Dynamics, State};
-use timpanist::body::evaluate::{self, EvalParams};
+use timpanist::body::limits::JointLimit;
 use timpanist::body::model::BodyModel;
 use timpanist::body::sim::{Pipeline, SimParams, simulate};
 use timpanist::body::skeleton::{JOINT_COUNT, Joint};
 use timpanist::mocap::db::MotionDb;
-use timpanist::mocap::limits::JointLimit;
-use timpanist::rng::Rng;
+use timpanist::render::evaluate::{self, EvalParams};
 
 fn db() -> MotionDb {
     MotionDb::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("mocap")).unwrap()

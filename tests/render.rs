@@ -1,14 +1,12 @@
-//! The whole-score render (issue 6 §4–5, issue 5's property test): every demo score
+//! The whole-score render (and the property test over random scores): every demo score
 //! sounds every stroke on time, renders bit-identically, never produces NaN or clipping;
-//! the CLI writes WAV, motion and events and fails cleanly; randomised scores never make
-//! the physics explode.
+//! randomised scores never make the physics explode. The CLI's render is in cli_render.rs.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use timpanist::base::rng::Rng;
 use timpanist::kit::Kit;
 use timpanist::mocap::db::MotionDb;
 use timpanist::render::{RenderError, RenderParams, Rendering, Resume, render, render_after};
-use timpanist::rng::Rng;
 use timpanist::score::{Beat, Dynamic, Hand, ImpactLocation, LoadedScore, PlayingMode, Score};
 
 fn root() -> &'static Path {
@@ -310,116 +308,4 @@ fn randomised_scores_never_explode() {
     // many across the body), none lost control.
     assert!(rendered > 500, "only {rendered} of 1000 rendered");
     assert!(lost <= 10, "{lost} of 1000 lost control");
-}
-
-/// `timpanist render` writes a WAV, the motion CSV and C3D, the events JSON with the
-/// issue's fields and a PNG plot, and prints its statistics.
-#[test]
-fn cli_render_writes_wav_motion_and_events() {
-    let dir = tempfile::tempdir().unwrap();
-    let (wav, csv, json, png) = (
-        dir.path().join("out.wav"),
-        dir.path().join("motion.csv"),
-        dir.path().join("events.json"),
-        dir.path().join("plot.png"),
-    );
-    let out = Command::new(env!("CARGO_BIN_EXE_timpanist"))
-        .current_dir(root())
-        .args(["render", "scores/improvisation.ron", "--stats", "--wav"])
-        .arg(&wav)
-        .arg("--motion")
-        .arg(&csv)
-        .arg("--c3d")
-        .arg(dir.path().join("motion.c3d"))
-        .arg("--events")
-        .arg(&json)
-        .arg("--plot")
-        .arg(&png)
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(
-        stdout.contains("real time") && stdout.contains("drums"),
-        "{stdout}"
-    );
-    let reader = hound::WavReader::open(&wav).unwrap();
-    assert_eq!(
-        (reader.spec().sample_rate, reader.spec().channels),
-        (48_000, 2)
-    );
-    let events: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    let first = &events.as_array().unwrap()[0];
-    for key in [
-        "beat",
-        "hand",
-        "drum",
-        "scheduled_s",
-        "contact_s",
-        "duration_ms",
-        "peak_force_n",
-        "impact_speed_mps",
-        "x_m",
-        "y_m",
-    ] {
-        assert!(first.get(key).is_some(), "{key} missing in {first}");
-    }
-    let motion = std::fs::read_to_string(&csv).unwrap();
-    assert!(motion.starts_with("time_s,left_tip_x_m"));
-    assert!(motion.lines().count() > 250);
-    let c3d = dir.path().join("motion.c3d");
-    let take =
-        timpanist::mocap::import::c3d::read(&c3d, &std::fs::read(&c3d).unwrap(), None).unwrap();
-    assert_eq!(
-        take.frames,
-        motion.lines().count() - 1,
-        "a frame per CSV row"
-    );
-    assert!(take.track("LTIP_TARGET").is_some() && take.track("ELBOW_R").is_some());
-    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
-}
-
-/// A malformed score, or one with a stroke out of reach, fails with its name and the
-/// place or beat, a non-zero exit, and no WAV.
-#[test]
-fn cli_render_refuses_bad_scores_cleanly() {
-    let dir = tempfile::tempdir().unwrap();
-    let bad = dir.path().join("bad.ron");
-    std::fs::write(&bad, "Score(version: 2, title: \"x\", beats: [oops])").unwrap();
-    let wav = dir.path().join("out.wav");
-    // Renders `score`: it must fail, write no WAV, and say why (returned).
-    let refused = |score: &Path| {
-        let out = Command::new(env!("CARGO_BIN_EXE_timpanist"))
-            .current_dir(root())
-            .arg("render")
-            .arg(score)
-            .arg("--wav")
-            .arg(&wav)
-            .output()
-            .unwrap();
-        assert!(!out.status.success());
-        assert!(!wav.exists());
-        String::from_utf8_lossy(&out.stderr).into_owned()
-    };
-    let stderr = refused(&bad);
-    assert!(stderr.contains("bad.ron:1:"), "{stderr}");
-
-    // A stroke the body cannot reach: the right hand on the far-left drum's centre.
-    let mut score = Score::new("reach");
-    let mut beat = Beat::plain(960, 0);
-    beat.hand = Hand::Right;
-    beat.location = ImpactLocation::Centre;
-    score.beats.push(beat);
-    let far = dir.path().join("far.ron");
-    score.save(&far).unwrap();
-    let stderr = refused(&far);
-    assert!(
-        stderr.contains("far.ron: beat 0 is out of the right hand's reach"),
-        "{stderr}"
-    );
 }

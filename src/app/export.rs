@@ -1,4 +1,4 @@
-//! File > Export (issue 7 §7): the rendering of the score as it is now, written as a WAV
+//! File > Export: the rendering of the score as it is now, written as a WAV
 //! (16-bit stereo 48 kHz, `sound::write_wav`), as motion CSV (`io::motion_csv`, the same
 //! columns as `timpanist render --motion`) or as motion C3D (`io::motion_c3d`, joints and
 //! tips for motion-capture tools); and the score itself as a Standard MIDI File
@@ -7,10 +7,12 @@
 //! with the reason, while the only rendering is of an older version of the score or there
 //! is none.
 
-use crate::io::{midi_export, motion_c3d, motion_csv, ron_file};
+use crate::base::ron_file::{self, FileError};
+use crate::io::{midi_export, motion_c3d, motion_csv};
 use crate::kit::Kit;
 use crate::render::Rendering;
 use crate::score::Score;
+use crate::sound::SoundError;
 use std::path::{Path, PathBuf};
 
 /// What to export.
@@ -96,6 +98,26 @@ impl RenderState<'_> {
     }
 }
 
+/// Why an export was not written.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ExportError {
+    #[error("cannot export to {}: the score has not been rendered", path.display())]
+    NotRendered { path: PathBuf },
+    #[error("cannot export to {}: {source}", path.display())]
+    File {
+        path: PathBuf,
+        #[source]
+        source: FileError,
+    },
+    #[error("cannot export to {}: {source}", path.display())]
+    Sound {
+        path: PathBuf,
+        #[source]
+        source: SoundError,
+    },
+}
+
 /// Write `what` of the score (played on `kit`) or of its `rendering` to `path`; a line
 /// for the status bar, or why it failed.
 pub fn write(
@@ -103,11 +125,14 @@ pub fn write(
     (score, kit): (&Score, &Kit),
     rendering: Option<&Rendering>,
     path: &Path,
-) -> Result<String, String> {
-    let failed = |e: &dyn std::fmt::Display| format!("cannot export to {}: {e}", path.display());
+) -> Result<String, ExportError> {
+    let failed = |source| ExportError::File {
+        path: path.to_path_buf(),
+        source,
+    };
     if what == Export::Midi {
         let bytes = midi_export::export(score, kit);
-        ron_file::write_atomic(path, &bytes).map_err(|e| failed(&e))?;
+        ron_file::write_atomic(path, &bytes).map_err(failed)?;
         return Ok(format!(
             "exported {} ({} beats, {} bytes)",
             path.display(),
@@ -116,7 +141,9 @@ pub fn write(
         ));
     }
     let Some(rendering) = rendering else {
-        return Err(failed(&"the score has not been rendered"));
+        return Err(ExportError::NotRendered {
+            path: path.to_path_buf(),
+        });
     };
     let samples = |r: &Rendering| {
         format!(
@@ -134,11 +161,16 @@ pub fn write(
                 &rendering.reference,
                 &rendering.skeleton(),
             );
-            ron_file::write_atomic(path, &bytes).map_err(|e| failed(&e))?;
+            ron_file::write_atomic(path, &bytes).map_err(failed)?;
             Ok(samples(rendering))
         }
         Export::Wav => {
-            crate::sound::write_wav(path, &rendering.audio).map_err(|e| failed(&e))?;
+            crate::sound::write_wav(path, &rendering.audio).map_err(|source| {
+                ExportError::Sound {
+                    path: path.to_path_buf(),
+                    source,
+                }
+            })?;
             let a = &rendering.audio;
             Ok(format!(
                 "exported {} ({:.1} s, {} Hz, {} channels)",
@@ -151,7 +183,7 @@ pub fn write(
         Export::Motion => {
             let text =
                 motion_csv::to_csv(&rendering.motion, &rendering.reference, rendering.start_s);
-            ron_file::write_atomic(path, text.as_bytes()).map_err(|e| failed(&e))?;
+            ron_file::write_atomic(path, text.as_bytes()).map_err(failed)?;
             Ok(samples(rendering))
         }
     }

@@ -1,10 +1,11 @@
 //! Reading documents into the editor: score files (`.ron`) and MIDI imports (`.mid`),
 //! by explicit open or by drag and drop; every failure becomes a message for the window.
 
-use crate::io::midi_import::{ImportOptions, import_file};
+use crate::base::ron_file::FileError;
+use crate::io::midi_import::{ImportOptions, MidiError, import_file};
 use crate::kit::Kit;
 use crate::score::LoadedScore;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// What a file is, judged by its extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -38,11 +39,25 @@ pub struct Opened {
     pub message: String,
 }
 
+/// Why a file did not open.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum OpenError {
+    #[error(transparent)]
+    Score(#[from] FileError),
+    #[error(transparent)]
+    Midi(#[from] MidiError),
+    #[error("{}: not a score (.ron) or MIDI (.mid) file", .0.display())]
+    NotAScore(PathBuf),
+    #[error("the bundled standard kit is missing")]
+    NoKit,
+}
+
 /// Read a score file or import a MIDI file, by extension.
-pub fn read(path: &Path) -> Result<Opened, String> {
+pub fn read(path: &Path) -> Result<Opened, OpenError> {
     match kind_of(path) {
         FileKind::Score => {
-            let loaded = LoadedScore::load(path).map_err(|e| e.to_string())?;
+            let loaded = LoadedScore::load(path)?;
             let mut message = format!("opened {}", path.display());
             if !loaded.notices.is_empty() {
                 message = loaded.notices.join("; ");
@@ -54,18 +69,14 @@ pub fn read(path: &Path) -> Result<Opened, String> {
             })
         }
         FileKind::Midi => import_midi(path),
-        FileKind::Other => Err(format!(
-            "{}: not a score (.ron) or MIDI (.mid) file",
-            path.display()
-        )),
+        FileKind::Other => Err(OpenError::NotAScore(path.to_path_buf())),
     }
 }
 
 /// Import a MIDI file onto the bundled standard kit as a new, unsaved score.
-pub fn import_midi(path: &Path) -> Result<Opened, String> {
-    let kit = Kit::bundled("standard").ok_or("the bundled standard kit is missing")?;
-    let (score, report) =
-        import_file(path, &kit, &ImportOptions::default()).map_err(|e| e.to_string())?;
+pub fn import_midi(path: &Path) -> Result<Opened, OpenError> {
+    let kit = Kit::bundled("standard").ok_or(OpenError::NoKit)?;
+    let (score, report) = import_file(path, &kit, &ImportOptions::default())?;
     let mut message = format!(
         "imported {} notes from {} ({})",
         report.notes,
@@ -107,10 +118,16 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let bad = dir.path().join("bad.ron");
         std::fs::write(&bad, "Score(nonsense").unwrap();
-        assert!(read(&bad).err().unwrap().contains("bad.ron"));
+        assert!(read(&bad).err().unwrap().to_string().contains("bad.ron"));
         let mid = dir.path().join("bad.mid");
         std::fs::write(&mid, b"not midi").unwrap();
-        assert!(read(&mid).err().unwrap().contains("bad.mid"));
-        assert!(read(Path::new("x.txt")).err().unwrap().contains("x.txt"));
+        assert!(read(&mid).err().unwrap().to_string().contains("bad.mid"));
+        assert!(
+            read(Path::new("x.txt"))
+                .err()
+                .unwrap()
+                .to_string()
+                .contains("x.txt")
+        );
     }
 }

@@ -2,6 +2,7 @@
 //! file (one path per line) whose location is injectable so tests never touch the real
 //! home; by default `$XDG_CONFIG_HOME/timpanist/recent.txt` (or `~/.config/...`).
 
+use crate::base::ron_file::{self, FileError};
 use std::path::{Path, PathBuf};
 
 /// How many recent files are kept.
@@ -46,8 +47,8 @@ impl RecentFiles {
         &self.paths
     }
 
-    /// Put `path` first and write the list; an error writing it is returned for display.
-    pub fn add(&mut self, path: &Path) -> Result<(), String> {
+    /// Put `path` first and write the list; an error writing the list is returned.
+    pub fn add(&mut self, path: &Path) -> Result<(), FileError> {
         let path = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
         self.paths.retain(|p| *p != path);
         self.paths.insert(0, path);
@@ -56,12 +57,12 @@ impl RecentFiles {
     }
 
     /// Drop `path` (e.g. it no longer opens) and write the list.
-    pub fn remove(&mut self, path: &Path) -> Result<(), String> {
+    pub fn remove(&mut self, path: &Path) -> Result<(), FileError> {
         self.paths.retain(|p| p != path);
         self.write()
     }
 
-    fn write(&self) -> Result<(), String> {
+    fn write(&self) -> Result<(), FileError> {
         let Some(store) = &self.store else {
             return Ok(());
         };
@@ -71,15 +72,12 @@ impl RecentFiles {
             .map(|p| format!("{}\n", p.display()))
             .collect();
         if let Some(dir) = store.parent() {
-            std::fs::create_dir_all(dir)
-                .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+            std::fs::create_dir_all(dir).map_err(|source| FileError::Io {
+                path: dir.to_path_buf(),
+                source,
+            })?;
         }
-        std::fs::write(store, text).map_err(|e| {
-            format!(
-                "cannot write the recent files list {}: {e}",
-                store.display()
-            )
-        })
+        ron_file::write_atomic(store, text.as_bytes())
     }
 }
 

@@ -1,24 +1,21 @@
-//! The render pipeline off the UI thread: after each composition request the latest score
-//! is rendered (body + drums + sound, `crate::render`) on one long-lived worker; a newer
-//! request cancels the render in progress. Each rendering resumes the previous one's
-//! performance from its latest saved state before the edit (`render::render_after`) and
-//! first renders only a second past it, so the edited part plays at once; the rest
-//! follows. The UI polls once per frame and hands the rendering to playback (which plays
-//! its audio in place), the simulated
-//! poses and membranes to the 3D view and the whole rendering to the plots and to
-//! File > Export.
+//! The rendering half of the editor's pipeline: each composition the composing worker
+//! makes is rendered (body + drums + sound, `crate::render::render_composition`) on a
+//! [`Worker`](super::worker::Worker) of its own; a newer request cancels the render in
+//! progress. Each rendering resumes the previous one's performance from its latest saved
+//! state before the edit and first renders only a little past it, so the edited part plays
+//! at once; the rest follows in steps. What a rendering gives the editor: its audio to
+//! playback (played in place), the simulated poses and membranes to the 3D view, all of
+//! it to the plots and File > Export.
 
 use super::pose::Simulated;
 use super::tape::StereoSource;
-use crate::kit::Kit;
-use crate::mocap::db::MotionDb;
+use super::worker::Job;
+use crate::motion::compose::Composition;
 use crate::render::{
-    FIRST_STEP_S, RESUME_STEP_S, RenderError, RenderParams, Rendering, Resume, render_after,
+    FIRST_STEP_S, RESUME_STEP_S, RenderError, RenderParams, Rendering, Resume, render_composition,
 };
-use crate::score::{LoadedScore, Score};
-use eframe::egui;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, Condvar, Mutex, mpsc};
+use crate::score::LoadedScore;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// A finished render, ready for playback, the view, the plots and export.
@@ -85,19 +82,6 @@ impl StereoSource for Rendering {
     }
 }
 
-struct Request {
-    generation: u64,
-    score: Score,
-    kit: Kit,
-    ctx: Option<egui::Context>,
-}
-
-#[derive(Default)]
-struct Slot {
-    request: Option<Request>,
-    quit: bool,
-}
-
 /// Why a render failed: the message for the window, and the beat it names, if any (the
 /// one being played when the simulation stopped, or the one out of reach).
 #[derive(Clone, Debug, PartialEq)]
@@ -130,168 +114,53 @@ impl From<RenderError> for Failure {
     }
 }
 
-type Reply = (u64, Result<Rendered, Failure>);
-
-/// The rendering worker.
-pub struct Renderer {
-    shared: Arc<(Mutex<Slot>, Condvar)>,
-    /// The newest generation requested; the worker stops a render that is older.
-    latest: Arc<AtomicU64>,
-    replies: mpsc::Receiver<Reply>,
-    done: u64,
-    /// Whether the newest reply was a whole rendering.
-    complete: bool,
+/// What the rendering worker is asked: a score and the composition of it the view
+/// already shows (the render does not compose again).
+pub struct Request {
+    /// The score and its kit (before the score's settings change the kit).
+    pub loaded: LoadedScore,
+    pub composition: Arc<Composition>,
 }
 
-impl Renderer {
-    /// Start the worker.
-    pub fn new() -> Renderer {
-        let shared = Arc::new((Mutex::new(Slot::default()), Condvar::new()));
-        let latest = Arc::new(AtomicU64::new(0));
-        let (tx, replies) = mpsc::channel();
-        let (worker, newest) = (Arc::clone(&shared), Arc::clone(&latest));
-        std::thread::Builder::new()
-            .name("render".into())
-            .spawn(move || work(&worker, &newest, &tx))
-            .expect("spawn the rendering thread");
-        Renderer {
-            shared,
-            latest,
-            replies,
-            done: 0,
-            complete: true,
-        }
-    }
+/// One reply of the rendering worker: a rendering (partial ones first) or why it failed.
+pub type Reply = Result<Rendered, Failure>;
 
-    /// Render `score` on `kit`, cancelling any render in progress.
-    pub fn request(&mut self, score: &Score, kit: &Kit, ctx: Option<egui::Context>) {
-        let generation = self.latest.fetch_add(1, Ordering::SeqCst) + 1;
-        let (lock, cv) = &*self.shared;
-        let mut slot = lock.lock().expect("renderer lock");
-        slot.request = Some(Request {
-            generation,
-            score: score.clone(),
-            kit: kit.clone(),
-            ctx,
-        });
-        cv.notify_one();
-    }
-
-    /// The newest finished render, if one arrived since the last poll.
-    pub fn poll(&mut self) -> Option<Result<Rendered, Failure>> {
-        let mut newest = None;
-        while let Ok((generation, result)) = self.replies.try_recv() {
-            if generation >= self.done {
-                self.done = generation;
-                self.complete = result.as_ref().map_or(true, |r| r.complete);
-                newest = Some(result);
-            }
-        }
-        newest
-    }
-
-    /// Whether a render of the latest request is still to come (or its rest).
-    pub fn is_busy(&self) -> bool {
-        self.done < self.latest.load(Ordering::SeqCst) || !self.complete
-    }
-}
-
-impl Default for Renderer {
-    fn default() -> Self {
-        Renderer::new()
-    }
-}
-
-impl Drop for Renderer {
-    fn drop(&mut self) {
-        self.latest.fetch_add(1, Ordering::SeqCst);
-        let (lock, cv) = &*self.shared;
-        if let Ok(mut slot) = lock.lock() {
-            slot.quit = true;
-            cv.notify_one();
-        }
-    }
-}
-
-fn work(shared: &(Mutex<Slot>, Condvar), latest: &AtomicU64, tx: &mpsc::Sender<Reply>) {
-    let mut db: Option<Result<MotionDb, String>> = None;
-    // What the renderings so far left: the next one resumes from it where it can.
+/// The rendering worker's job: render each request's composition, first the edited part
+/// (quick, to play at once) and then the rest in steps, each resuming the performance the
+/// renderings so far left (kept here across requests).
+pub fn job() -> impl FnMut(Request, &Job<Reply>) + Send + 'static {
     let mut resume: Option<Resume> = None;
-    loop {
-        let request = {
-            let (lock, cv) = shared;
-            let mut slot = lock.lock().expect("renderer lock");
-            loop {
-                if slot.quit {
-                    return;
-                }
-                if let Some(r) = slot.request.take() {
-                    break r;
-                }
-                slot = cv.wait(slot).expect("renderer lock");
-            }
-        };
-        let db = db.get_or_insert_with(|| {
-            MotionDb::load(&crate::mocap::db::default_dir())
-                .map_err(|e| format!("no motion database: {e}"))
-        });
-        let Ok(db) = db else {
-            let e = db.as_ref().err().cloned().unwrap_or_default();
-            if tx.send((request.generation, Err(Failure::of(e)))).is_err() {
-                return;
-            }
-            continue;
-        };
-        // First the edited part (quick, to play at once), then the rest in steps.
-        let mut complete = false;
+    move |request, job| {
+        let params = RenderParams::for_score(&request.loaded.score.settings);
         let began = Instant::now();
         // Where the first step resumed from.
         let mut origin: Option<Option<f64>> = None;
-        while !complete {
+        loop {
             let stop_after_s = if origin.is_none() {
                 FIRST_STEP_S
             } else {
                 RESUME_STEP_S
             };
-            let result = match run(&request, db, latest, &mut resume, stop_after_s) {
-                Err(RenderError::Cancelled) => break,
+            let result = render_composition(
+                &mut resume,
+                Some(stop_after_s),
+                &request.loaded,
+                (*request.composition).clone(),
+                &params,
+                &mut |_| job.is_current(),
+            );
+            let reply = match result {
+                Err(RenderError::Cancelled) => return,
                 Err(e) => Err(Failure::from(e)),
                 Ok(r) => {
                     let from = *origin.get_or_insert(r.stats.resumed_from_s);
                     Ok(Rendered::of_request(Arc::new(r), (from, began.elapsed())))
                 }
             };
-            complete = result.as_ref().map_or(true, |r| r.complete);
-            if tx.send((request.generation, result)).is_err() {
+            let complete = reply.as_ref().map_or(true, |r| r.complete);
+            if !job.send(reply, complete) || complete {
                 return;
-            }
-            if let Some(ctx) = &request.ctx {
-                ctx.request_repaint();
             }
         }
     }
-}
-
-fn run(
-    request: &Request,
-    db: &MotionDb,
-    latest: &AtomicU64,
-    resume: &mut Option<Resume>,
-    stop_after_s: f64,
-) -> Result<Rendering, RenderError> {
-    let loaded = LoadedScore {
-        score: request.score.clone(),
-        kit: request.kit.clone(),
-        kit_source: String::new(),
-        notices: Vec::new(),
-    };
-    let params = RenderParams::for_score(&loaded.score.settings);
-    render_after(
-        resume,
-        Some(stop_after_s),
-        &loaded,
-        db,
-        &params,
-        &mut |_| latest.load(Ordering::SeqCst) == request.generation,
-    )
 }

@@ -1,4 +1,4 @@
-//! The inspector's performance and sound settings (issue 7 §5): control pipeline, IK
+//! The inspector's performance and sound settings: control pipeline, IK
 //! method, PD gain scale, sound model, membrane modes and frequency source, and the kit's
 //! drums with editable head diameter and tension. Every change is one undoable edit of
 //! the score's settings (a drag is one step) and the editor re-renders.

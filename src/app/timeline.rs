@@ -8,7 +8,7 @@ use super::command::Command;
 use super::selection::{self, LANES, Selection, lane_of};
 use super::time_axis::{TimeAxis, snap};
 use crate::score::edit::ScoreEdit;
-use crate::score::{Beat, LoadedScore, PlayingMode};
+use crate::score::{Beat, LoadedScore, MeterMap, PlayingMode};
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use std::collections::BTreeSet;
 
@@ -50,10 +50,12 @@ pub struct Geometry {
 impl Geometry {
     /// Screen position of `tick` in the middle of lane `lane`.
     pub fn point(&self, tick: f64, lane: usize) -> Pos2 {
-        Pos2::new(
-            self.axis.x_of(tick) as f32,
-            self.lanes.top() + LANE_H * (lane as f32 + 0.5),
-        )
+        Pos2::new(self.axis.x_of(tick) as f32, self.lane_y(lane))
+    }
+
+    /// Screen `y` of the middle of lane `lane`.
+    fn lane_y(&self, lane: usize) -> f32 {
+        self.lanes.top() + LANE_H * (lane as f32 + 0.5)
     }
 
     /// The lane under screen `y`, clamped to the lanes.
@@ -133,17 +135,9 @@ impl TimelineView {
     pub fn show(&mut self, ui: &mut egui::Ui, input: &TimelineInput, out: &mut Vec<Command>) {
         let score = &input.doc.score;
         let meter = score.meter_map();
-        let tempo = score.tempo_map();
         let end_tick = score.beats.iter().map(|b| b.end_tick()).max().unwrap_or(0);
         let last_bar = meter.position(end_tick).bar + 2;
-        let height = RULER_H + LANE_H * LANES.len() as f32;
-        let (rect, _) =
-            ui.allocate_exact_size(Vec2::new(ui.available_width(), height), Sense::hover());
-        let ruler = Rect::from_min_max(
-            Pos2::new(rect.left() + LABEL_W, rect.top()),
-            Pos2::new(rect.right(), rect.top() + RULER_H),
-        );
-        let lanes = Rect::from_min_max(Pos2::new(rect.left() + LABEL_W, ruler.bottom()), rect.max);
+        let (rect, ruler, lanes) = allocate(ui);
         let axis = *self.axis.get_or_insert_with(|| {
             TimeAxis::fit(
                 meter.bar_start(last_bar) as f64,
@@ -155,158 +149,48 @@ impl TimelineView {
         self.geometry = Some(geometry);
         let grid = self.grid_ticks(input.doc);
 
-        let lanes_resp = ui
-            .interact(
-                lanes,
-                ui.make_persistent_id("timeline-lanes"),
-                Sense::click_and_drag(),
-            )
-            .on_hover_text_at_pointer("Click: add a beat. Drag: move or box-select.");
-        lanes_resp.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "Timeline"));
-        let ruler_resp = ui.interact(
-            ruler,
-            ui.make_persistent_id("timeline-ruler"),
-            Sense::click_and_drag(),
-        );
-        ruler_resp.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "Ruler"));
-
-        // Zoom (Ctrl+wheel or pinch) and scroll (wheel) while hovered.
+        let (lanes_resp, ruler_resp) = interact(ui, lanes, ruler);
         if lanes_resp.hovered() || ruler_resp.hovered() {
-            let (zoom, scroll, pointer) =
-                ui.input(|i| (i.zoom_delta(), i.smooth_scroll_delta, i.pointer.hover_pos()));
-            let axis = self.axis.as_mut().expect("axis set above");
-            if zoom != 1.0
-                && let Some(p) = pointer
-            {
-                axis.zoom_about(f64::from(p.x), 1.0 / f64::from(zoom));
-            }
-            let dx = if scroll.x != 0.0 { scroll.x } else { scroll.y };
-            if dx != 0.0 {
-                axis.pan(-f64::from(dx));
-            }
+            self.zoom_and_scroll(ui);
         }
 
-        let painter = ui.painter_at(rect);
-        let visuals = ui.visuals();
-        painter.rect_filled(rect, 4.0, visuals.extreme_bg_color);
-        let grid_colour = visuals.widgets.noninteractive.bg_stroke.color;
-        let text_colour = visuals.text_color();
-        let x_of = |t: f64| axis.x_of(t) as f32;
-        let lane_y = |lane: usize| lanes.top() + LANE_H * (lane as f32 + 0.5);
-
-        // Loop region.
-        if let Some((a, b)) = input.loop_ticks {
-            let r = Rect::from_x_y_ranges(x_of(a as f64)..=x_of(b as f64), rect.y_range());
-            painter.rect_filled(
-                r.intersect(lanes.union(ruler)),
-                0.0,
-                Color32::from_rgba_unmultiplied(80, 160, 80, 40),
-            );
-        }
-        // Bar and beat grid.
-        for bar in 1..=last_bar {
-            let start = meter.bar_start(bar);
-            let x = x_of(start as f64);
-            if x > rect.right() {
-                break;
-            }
-            let sig = meter.signature_at(start);
-            if x >= lanes.left() {
-                painter.line_segment(
-                    [Pos2::new(x, rect.top()), Pos2::new(x, rect.bottom())],
-                    Stroke::new(1.5, grid_colour),
-                );
-                painter.text(
-                    Pos2::new(x + 3.0, ruler.center().y),
-                    egui::Align2::LEFT_CENTER,
-                    bar.to_string(),
-                    egui::FontId::monospace(10.0),
-                    text_colour,
-                );
-            }
-            let bar_len = sig.bar_ticks(score.ticks_per_quarter);
-            let mut t = start + grid;
-            while t < start + bar_len {
-                let bx = x_of(t as f64);
-                if bx >= lanes.left() && bx <= rect.right() {
-                    let on_beat =
-                        (t - start).is_multiple_of(sig.beat_ticks(score.ticks_per_quarter));
-                    painter.line_segment(
-                        [Pos2::new(bx, lanes.top()), Pos2::new(bx, rect.bottom())],
-                        Stroke::new(if on_beat { 0.8 } else { 0.3 }, grid_colour),
-                    );
-                }
-                t += grid;
-            }
-        }
-        for (lane, name) in LANE_NAMES.iter().enumerate() {
-            let y = lane_y(lane);
-            painter.text(
-                Pos2::new(rect.left() + 6.0, y),
-                egui::Align2::LEFT_CENTER,
-                *name,
-                egui::FontId::proportional(12.0),
-                text_colour,
-            );
-            painter.line_segment(
-                [
-                    Pos2::new(lanes.left(), lanes.top() + LANE_H * lane as f32),
-                    Pos2::new(lanes.right(), lanes.top() + LANE_H * lane as f32),
-                ],
-                Stroke::new(0.5, grid_colour),
-            );
-        }
-
-        // Beats (the dragged ones are already moved in the score).
-        let beat_painter = painter.with_clip_rect(lanes);
-        for (i, beat) in score.beats.iter().enumerate() {
-            let x = x_of(beat.tick as f64);
-            if x < lanes.left() - 20.0 || x > rect.right() + 20.0 {
-                continue;
-            }
-            let centre = Pos2::new(x, lane_y(lane_of(beat.hand)));
-            let r = beat_radius(beat);
-            let colour = mode_colour(beat.mode);
-            if let Some(roll) = beat.roll {
-                let end = x_of((beat.tick + roll.length_ticks) as f64);
-                beat_painter.rect_filled(
-                    Rect::from_min_max(
-                        centre - Vec2::new(0.0, 3.0),
-                        Pos2::new(end, centre.y + 3.0),
-                    ),
-                    2.0,
-                    colour.gamma_multiply(0.6),
-                );
-            }
-            let selected = input.selection.beats.contains(&i);
-            beat_painter.add(beat_shape(beat.mode, centre, r, colour, selected));
-            beat_painter.text(
-                centre + Vec2::new(0.0, r + 6.0),
-                egui::Align2::CENTER_CENTER,
-                beat.drum.to_string(),
-                egui::FontId::monospace(9.0),
-                text_colour,
-            );
-        }
-
-        // Playhead.
-        let ph = x_of(tempo.tick_at(input.playhead_s));
-        if ph >= lanes.left() && ph <= rect.right() {
-            painter.line_segment(
-                [Pos2::new(ph, rect.top()), Pos2::new(ph, rect.bottom())],
-                Stroke::new(1.5, Color32::from_rgb(250, 80, 80)),
-            );
-        }
+        // Drawn with the axis as it was at the start of the frame.
+        let canvas = Canvas::new(ui, rect, ruler, geometry);
+        canvas.draw_loop(input.loop_ticks);
+        canvas.draw_grid(&meter, last_bar, grid, score.ticks_per_quarter);
+        canvas.draw_lanes();
+        // The dragged beats are already moved in the score.
+        canvas.draw_beats(&score.beats, input.selection);
+        canvas.draw_playhead(score.tempo_map().tick_at(input.playhead_s));
 
         self.ruler_input(&ruler_resp, &geometry, input, grid, out);
         self.lanes_input(ui, &lanes_resp, &geometry, input, grid, out);
         if let (Some(from), Some(to)) = (self.box_from, lanes_resp.interact_pointer_pos()) {
-            painter.rect_stroke(
+            canvas.painter.rect_stroke(
                 Rect::from_two_pos(from, to),
                 0.0,
-                Stroke::new(1.0, visuals.selection.stroke.color),
+                Stroke::new(1.0, ui.visuals().selection.stroke.color),
                 egui::StrokeKind::Inside,
             );
+        }
+    }
+
+    /// Zoom (Ctrl+wheel or pinch) about the pointer and scroll (wheel) the axis, from
+    /// this frame's input.
+    fn zoom_and_scroll(&mut self, ui: &egui::Ui) {
+        let (zoom, scroll, pointer) =
+            ui.input(|i| (i.zoom_delta(), i.smooth_scroll_delta, i.pointer.hover_pos()));
+        let Some(axis) = self.axis.as_mut() else {
+            return;
+        };
+        if zoom != 1.0
+            && let Some(p) = pointer
+        {
+            axis.zoom_about(f64::from(p.x), 1.0 / f64::from(zoom));
+        }
+        let dx = if scroll.x != 0.0 { scroll.x } else { scroll.y };
+        if dx != 0.0 {
+            axis.pan(-f64::from(dx));
         }
     }
 
@@ -463,6 +347,200 @@ impl TimelineView {
         if !resp.is_pointer_button_down_on() && !resp.drag_stopped() {
             self.drag = None;
             self.box_from = None;
+        }
+    }
+}
+
+/// Allocate the timeline's area at the full available width: the whole, the ruler (on
+/// top, right of the lane labels) and the lanes below it.
+fn allocate(ui: &mut egui::Ui) -> (Rect, Rect, Rect) {
+    let height = RULER_H + LANE_H * LANES.len() as f32;
+    let (rect, _) = ui.allocate_exact_size(Vec2::new(ui.available_width(), height), Sense::hover());
+    let ruler = Rect::from_min_max(
+        Pos2::new(rect.left() + LABEL_W, rect.top()),
+        Pos2::new(rect.right(), rect.top() + RULER_H),
+    );
+    let lanes = Rect::from_min_max(Pos2::new(rect.left() + LABEL_W, ruler.bottom()), rect.max);
+    (rect, ruler, lanes)
+}
+
+/// Make the lanes and the ruler clickable and draggable (named canvases for
+/// accessibility); their responses, lanes first.
+fn interact(ui: &egui::Ui, lanes: Rect, ruler: Rect) -> (egui::Response, egui::Response) {
+    let lanes_resp = ui
+        .interact(
+            lanes,
+            ui.make_persistent_id("timeline-lanes"),
+            Sense::click_and_drag(),
+        )
+        .on_hover_text_at_pointer("Click: add a beat. Drag: move or box-select.");
+    lanes_resp.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "Timeline"));
+    let ruler_resp = ui.interact(
+        ruler,
+        ui.make_persistent_id("timeline-ruler"),
+        Sense::click_and_drag(),
+    );
+    ruler_resp.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "Ruler"));
+    (lanes_resp, ruler_resp)
+}
+
+/// Where one frame of the timeline is drawn, and in which colours.
+struct Canvas {
+    painter: egui::Painter,
+    /// The whole timeline.
+    rect: Rect,
+    /// The bar ruler.
+    ruler: Rect,
+    /// The axis and the lanes.
+    geometry: Geometry,
+    grid_colour: Color32,
+    text_colour: Color32,
+}
+
+impl Canvas {
+    /// A painter for `rect`, its background filled.
+    fn new(ui: &egui::Ui, rect: Rect, ruler: Rect, geometry: Geometry) -> Canvas {
+        let painter = ui.painter_at(rect);
+        let visuals = ui.visuals();
+        painter.rect_filled(rect, 4.0, visuals.extreme_bg_color);
+        Canvas {
+            painter,
+            rect,
+            ruler,
+            geometry,
+            grid_colour: visuals.widgets.noninteractive.bg_stroke.color,
+            text_colour: visuals.text_color(),
+        }
+    }
+
+    /// Screen x of `tick`.
+    fn x_of(&self, tick: f64) -> f32 {
+        self.geometry.axis.x_of(tick) as f32
+    }
+
+    /// Shade the loop region `(start, end)` (ticks) over the ruler and lanes.
+    fn draw_loop(&self, loop_ticks: Option<(u64, u64)>) {
+        if let Some((a, b)) = loop_ticks {
+            let r = Rect::from_x_y_ranges(
+                self.x_of(a as f64)..=self.x_of(b as f64),
+                self.rect.y_range(),
+            );
+            self.painter.rect_filled(
+                r.intersect(self.geometry.lanes.union(self.ruler)),
+                0.0,
+                Color32::from_rgba_unmultiplied(80, 160, 80, 40),
+            );
+        }
+    }
+
+    /// Bar lines numbered on the ruler up to `last_bar`, and grid lines every `grid`
+    /// ticks within each bar (heavier on the beats).
+    fn draw_grid(&self, meter: &MeterMap, last_bar: u64, grid: u64, ticks_per_quarter: u32) {
+        let (rect, lanes) = (self.rect, self.geometry.lanes);
+        for bar in 1..=last_bar {
+            let start = meter.bar_start(bar);
+            let x = self.x_of(start as f64);
+            if x > rect.right() {
+                break;
+            }
+            let sig = meter.signature_at(start);
+            if x >= lanes.left() {
+                self.painter.line_segment(
+                    [Pos2::new(x, rect.top()), Pos2::new(x, rect.bottom())],
+                    Stroke::new(1.5, self.grid_colour),
+                );
+                self.painter.text(
+                    Pos2::new(x + 3.0, self.ruler.center().y),
+                    egui::Align2::LEFT_CENTER,
+                    bar.to_string(),
+                    egui::FontId::monospace(10.0),
+                    self.text_colour,
+                );
+            }
+            let bar_len = sig.bar_ticks(ticks_per_quarter);
+            let mut t = start + grid;
+            while t < start + bar_len {
+                let bx = self.x_of(t as f64);
+                if bx >= lanes.left() && bx <= rect.right() {
+                    let on_beat = (t - start).is_multiple_of(sig.beat_ticks(ticks_per_quarter));
+                    self.painter.line_segment(
+                        [Pos2::new(bx, lanes.top()), Pos2::new(bx, rect.bottom())],
+                        Stroke::new(if on_beat { 0.8 } else { 0.3 }, self.grid_colour),
+                    );
+                }
+                t += grid;
+            }
+        }
+    }
+
+    /// The lane names and the line at the top of each lane.
+    fn draw_lanes(&self) {
+        let lanes = self.geometry.lanes;
+        for (lane, name) in LANE_NAMES.iter().enumerate() {
+            self.painter.text(
+                Pos2::new(self.rect.left() + 6.0, self.geometry.lane_y(lane)),
+                egui::Align2::LEFT_CENTER,
+                *name,
+                egui::FontId::proportional(12.0),
+                self.text_colour,
+            );
+            self.painter.line_segment(
+                [
+                    Pos2::new(lanes.left(), lanes.top() + LANE_H * lane as f32),
+                    Pos2::new(lanes.right(), lanes.top() + LANE_H * lane as f32),
+                ],
+                Stroke::new(0.5, self.grid_colour),
+            );
+        }
+    }
+
+    /// The beats in view, clipped to the lanes: shape by mode, size by dynamic, a bar to
+    /// the end of a roll, the drum below; selected ones outlined.
+    fn draw_beats(&self, beats: &[Beat], selection: &Selection) {
+        let lanes = self.geometry.lanes;
+        let beat_painter = self.painter.with_clip_rect(lanes);
+        for (i, beat) in beats.iter().enumerate() {
+            let x = self.x_of(beat.tick as f64);
+            if x < lanes.left() - 20.0 || x > self.rect.right() + 20.0 {
+                continue;
+            }
+            let centre = Pos2::new(x, self.geometry.lane_y(lane_of(beat.hand)));
+            let r = beat_radius(beat);
+            let colour = mode_colour(beat.mode);
+            if let Some(roll) = beat.roll {
+                let end = self.x_of((beat.tick + roll.length_ticks) as f64);
+                beat_painter.rect_filled(
+                    Rect::from_min_max(
+                        centre - Vec2::new(0.0, 3.0),
+                        Pos2::new(end, centre.y + 3.0),
+                    ),
+                    2.0,
+                    colour.gamma_multiply(0.6),
+                );
+            }
+            let selected = selection.beats.contains(&i);
+            beat_painter.add(beat_shape(beat.mode, centre, r, colour, selected));
+            beat_painter.text(
+                centre + Vec2::new(0.0, r + 6.0),
+                egui::Align2::CENTER_CENTER,
+                beat.drum.to_string(),
+                egui::FontId::monospace(9.0),
+                self.text_colour,
+            );
+        }
+    }
+
+    /// The playhead line at `tick`, when it is in view.
+    fn draw_playhead(&self, tick: f64) {
+        let ph = self.x_of(tick);
+        if ph >= self.geometry.lanes.left() && ph <= self.rect.right() {
+            self.painter.line_segment(
+                [
+                    Pos2::new(ph, self.rect.top()),
+                    Pos2::new(ph, self.rect.bottom()),
+                ],
+                Stroke::new(1.5, Color32::from_rgb(250, 80, 80)),
+            );
         }
     }
 }

@@ -7,7 +7,7 @@
 
 use super::dynamics::{Dynamics, State};
 use super::skeleton::{JOINT_COUNT, Pose};
-use crate::mocap::limits::{JointLimit, quat_log};
+use crate::body::limits::{JointLimit, quat_log};
 use glam::{DMat3, DQuat, DVec3};
 
 /// PD gains and torque limits per joint: ks = ω²·I and kd = 2ζω·I with I the joint's

@@ -557,7 +557,7 @@ fn integrate(state: &mut State, qdd: &[DVec3; N], dt: f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rng::Rng;
+    use crate::base::rng::Rng;
 
     const DOF: usize = 3 * N;
 

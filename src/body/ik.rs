@@ -9,19 +9,9 @@
 //! q ← (R_parent⁻¹·exp(ω)·R_parent)·q.
 
 use super::skeleton::{Frames, JOINT_COUNT, Joint, Pose, Skeleton};
+pub use crate::base::choices::IkMethod;
 use crate::kit::Side;
 use glam::{DMat3, DQuat, DVec3};
-
-/// How each iteration turns the tip error into joint steps.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum IkMethod {
-    /// Δθ = α·Jᵀe (α chosen by the optimal step along Jᵀe).
-    Transpose,
-    /// Δθ = Jᵀ(JJᵀ)⁻¹e.
-    PseudoInverse,
-    /// Δθ = Jᵀ(JJᵀ + λ²I)⁻¹e.
-    DampedLeastSquares,
-}
 
 /// Solver settings.
 #[derive(Clone, Debug, PartialEq)]

@@ -21,27 +21,9 @@ use super::dynamics::{Dynamics, State};
 use super::ik::{self, IkParams};
 use super::model::BodyModel;
 use super::skeleton::{JOINT_COUNT, Joint, Pose};
+pub use crate::base::choices::Pipeline;
 use crate::kit::Side;
 use glam::DVec3;
-
-/// A control pipeline.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum Pipeline {
-    Ik,
-    Id,
-    Himc,
-}
-
-impl Pipeline {
-    /// Lower-case name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Pipeline::Ik => "ik",
-            Pipeline::Id => "id",
-            Pipeline::Himc => "himc",
-        }
-    }
-}
 
 /// Simulation settings.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,7 +1,7 @@
 //! `timpanist check FILE...`: validate scores and kits, printing every problem as
 //! `path: place: message` (parse errors as `path:line:col: message`).
 
-use crate::io::ron_file::{self, FileError};
+use crate::base::ron_file::{self, FileError};
 use crate::kit::Kit;
 use crate::score::Score;
 use std::path::Path;

@@ -1,8 +1,9 @@
 //! `timpanist compose`: write the two composed stick-tip trajectories of a score as CSV
 //! and, with `--plot`, a PNG of tip height and depth against time with the beats marked.
 
+use crate::base::ron_file;
 use crate::io::plot::{Figure, Panel, Series};
-use crate::io::{ron_file, tips_csv};
+use crate::io::tips_csv;
 use crate::kit::Side;
 use crate::mocap::db::MotionDb;
 use crate::motion::compose::{ComposeParams, Composition};
@@ -40,9 +41,7 @@ pub fn run(
     let took = started.elapsed();
     let csv = tips_csv::to_csv(&comp);
     if let Some(plot) = plot {
-        figure(&comp, &loaded.score.title)
-            .save_png(plot)
-            .map_err(anyhow::Error::msg)?;
+        figure(&comp, &loaded.score.title).save_png(plot)?;
     }
     ron_file::write_atomic(output, csv.as_bytes())?;
     println!(

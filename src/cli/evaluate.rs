@@ -1,15 +1,15 @@
 //! `timpanist evaluate`: the seed 000 §3.3 comparison of the IK, ID and HIMC pipelines on
 //! captured strokes of each playing mode — a table, optional JSON, optional Fig. 5 plots.
 
+use crate::base::rng::Rng;
+use crate::base::ron_file;
 use crate::body::control::rotation_error;
-use crate::body::evaluate::{self, EvalParams, Report};
 use crate::body::model::BodyModel;
 use crate::body::sim::Motion;
 use crate::body::skeleton::{Joint, REST};
 use crate::io::plot::{Figure, Panel, Series};
-use crate::io::ron_file;
 use crate::mocap::db::MotionDb;
-use crate::rng::Rng;
+use crate::render::evaluate::{self, EvalParams, Report};
 use crate::score::PlayingMode;
 use plotters::style::RGBColor;
 use std::path::Path;
@@ -28,7 +28,7 @@ pub fn run(
         ..EvalParams::default()
     };
     let started = std::time::Instant::now();
-    let report = evaluate::evaluate(&db, &model, &params).map_err(anyhow::Error::msg)?;
+    let report = evaluate::evaluate(&db, &model, &params)?;
     let took = started.elapsed().as_secs_f64();
     print_table(&report);
     let simulated: f64 = PlayingMode::ALL
@@ -54,17 +54,14 @@ pub fn run(
                 continue;
             };
             let reference = evaluate::reference_of(&db, unit);
-            let motions = evaluate::trial(&model, &reference, &params, &mut Rng::new(params.seed))
-                .map_err(anyhow::Error::msg)?;
+            let motions = evaluate::trial(&model, &reference, &params, &mut Rng::new(params.seed))?;
             let captured = Motion {
                 rate_hz: reference.rate_hz,
                 tips: reference.tips.clone(),
                 poses: reference.poses.clone().unwrap_or_default(),
             };
             let path = dir.join(format!("fig5-{}.png", mode.name().replace(' ', "-")));
-            fig5(&model, mode, &captured, &motions)
-                .save_png(&path)
-                .map_err(anyhow::Error::msg)?;
+            fig5(&model, mode, &captured, &motions).save_png(&path)?;
             println!("wrote {}", path.display());
         }
     }

@@ -1,7 +1,8 @@
 //! `timpanist import-midi` and `timpanist export-midi`: Standard MIDI Files in and out.
 
+use crate::base::ron_file;
+use crate::io::midi_export;
 use crate::io::midi_import::{self, ImportOptions, TrackChoice};
-use crate::io::{midi_export, ron_file};
 use crate::kit::Kit;
 use crate::score::LoadedScore;
 use anyhow::Context;

@@ -1,11 +1,11 @@
 //! `timpanist mocap synth | stats`: build the synthetic motion database and summarise a
 //! database (per playing mode and grip, per dynamic, and joint limits).
 
+use crate::body::limits::JointLimit;
 use crate::body::skeleton::Joint;
 use crate::mocap::db::MotionDb;
 use crate::mocap::import::Format;
 use crate::mocap::ingest::{IngestOptions, UpAxis, ingest};
-use crate::mocap::limits::JointLimit;
 use crate::mocap::{stats, synth};
 use crate::score::{Dynamic, Grip};
 use std::path::Path;

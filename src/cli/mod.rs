@@ -272,10 +272,26 @@ fn report(e: &anyhow::Error) -> String {
     text
 }
 
+/// Open the editor (built with the default `editor` feature).
+#[cfg(feature = "editor")]
+fn edit(score: Option<PathBuf>) -> anyhow::Result<ExitCode> {
+    crate::app::run(score).map(|()| ExitCode::SUCCESS)
+}
+
+/// A headless build has no editor: say how to get one.
+#[cfg(not(feature = "editor"))]
+fn edit(_score: Option<PathBuf>) -> anyhow::Result<ExitCode> {
+    anyhow::bail!(
+        "this timpanist was built without the editor (cargo's --no-default-features); \
+         rebuild it with the default features (`cargo install --path .` or `cargo build`) \
+         to open the editor, or use the other commands (`timpanist --help`)"
+    )
+}
+
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
-        None => crate::app::run(None).map(|()| ExitCode::SUCCESS),
-        Some(Command::Edit { score }) => crate::app::run(score).map(|()| ExitCode::SUCCESS),
+        None => edit(None),
+        Some(Command::Edit { score }) => edit(score),
         Some(Command::Check { files }) => Ok(check::run(&files)),
         Some(Command::ImportMidi {
             input,
@@ -384,7 +400,7 @@ mod tests {
     #[test]
     fn report_says_each_cause_once() {
         let io = std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
-        let e = anyhow::Error::new(crate::io::FileError::Io {
+        let e = anyhow::Error::new(crate::base::ron_file::FileError::Io {
             path: PathBuf::from("mocap/index.ron"),
             source: io,
         })

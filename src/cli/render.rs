@@ -4,9 +4,10 @@
 //! before anything is written; each file is written atomically.
 
 use super::compose::HAND_COLOURS;
+use crate::base::ron_file;
 use crate::body::sim::Pipeline;
 use crate::io::plot::{Figure, Panel, Series};
-use crate::io::{motion_c3d, motion_csv, ron_file};
+use crate::io::{motion_c3d, motion_csv};
 use crate::mocap::db::MotionDb;
 use crate::motion::plan::PlanParams;
 use crate::render::{Progress, RenderParams, Rendering, render};
@@ -78,7 +79,7 @@ pub fn run(
         .map(|_| figure(&rendering, &loaded.score.title));
     crate::sound::write_wav(outputs.wav, &rendering.audio)?;
     if let (Some(path), Some(figure)) = (outputs.plot, figure) {
-        figure.save_png(path).map_err(anyhow::Error::msg)?;
+        figure.save_png(path)?;
     }
     if let (Some(path), Some(text)) = (outputs.motion, motion) {
         ron_file::write_atomic(path, text.as_bytes())?;

@@ -1,5 +1,5 @@
 //! Bessel functions of the first kind J_m (integer order) and their zeros j_mn: the radial
-//! part of the circular-membrane mode shapes J_m(j_mn·r/a) (issue 6 §1, seed 000 eq. 5's
+//! part of the circular-membrane mode shapes J_m(j_mn·r/a) (seed 000 eq. 5's
 //! modal shapes for a circular head).
 //!
 //! J_m(x) = (1/2π)∫₀^{2π} cos(mτ − x·sin τ) dτ is evaluated with the trapezoidal rule,

@@ -2,9 +2,18 @@
 //! compression c > 0 between the felt ball and the (displaced) head surface, 0 otherwise.
 //! The compression is capped at the felt ball's radius (beyond it the stick's core would
 //! meet the head), so a tip driven far below the head gets a large but finite force.
+//!
+//! Effective mass at the tip ([`effective_mass_kg`]): the mallet pivots about the grip; with
+//! a third of its mass in the felt head at the tip and two thirds in a uniform shaft
+//! (I/L² = m_shaft/3), m_eff = m/3 + (2m/3)/3 = 5m/9.
 
 use super::DrumError;
 use crate::kit::Mallet;
+
+/// Effective mass of a mallet at its tip when it pivots about the grip, kg (5/9 of its mass).
+pub fn effective_mass_kg(mallet: &Mallet) -> f64 {
+    mallet.mass_kg * 5.0 / 9.0
+}
 
 /// One mallet's contact law.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,5 +1,5 @@
-//! The timpani heads as modal membranes struck through a Hertz felt contact (issue 6
-//! §1–2; seed 000 §4, eqs. 4–6): mode tables per head ([`modes`]), the exact per-mode time
+//! The timpani heads as modal membranes struck through a Hertz felt contact (seed
+//! 000 §4, eqs. 4–6): mode tables per head ([`modes`]), the exact per-mode time
 //! step ([`oscillator`]), the contact law ([`contact`]), the whole kit stepped at the
 //! simulation rate with both stick tips ([`set`]), and a scripted stick for tests and
 //! benchmarks ([`strike`]).
@@ -11,25 +11,10 @@ pub mod oscillator;
 pub mod set;
 pub mod strike;
 
+pub use crate::base::choices::{DEFAULT_MODE_COUNT, FrequencySource, MAX_MODE_COUNT};
 pub use contact::HertzContact;
 pub use modes::{HeadMode, HeadModes, Orientation};
 pub use set::{ContactEvent, DrumCheckpoint, DrumSet, Excitation};
-
-/// Default number of mode orientations per head.
-pub const DEFAULT_MODE_COUNT: usize = 24;
-/// Largest number of mode orientations per head.
-pub const MAX_MODE_COUNT: usize = 200;
-
-/// Where mode frequencies come from.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum FrequencySource {
-    /// The kit's measured ratios to the (1,1) for the modes it lists (kettledrum
-    /// 1.50, 1.98, 2.44, 2.94 by default), the in-vacuo membrane for the others.
-    #[default]
-    Measured,
-    /// The ideal membrane, f_mn = air_loading · j_mn/(2πa) · √(T/σ), for every mode.
-    Membrane,
-}
 
 /// How many modes each head has and where their frequencies come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,4 +1,4 @@
-//! The modes of one timpani head (issue 6 §1): circular-membrane modes (m, n) with shapes
+//! The modes of one timpani head: circular-membrane modes (m, n) with shapes
 //! Φ = J_m(j_mn·r/a)·cos(mθ) or ·sin(mθ) (both orientations of each degenerate pair),
 //! frequencies from the kit's measured ratios or from tension and density, per-mode decay
 //! (T60), radiation weight and modal mass — the diagonal M_S, K_S of seed 000 eq. 5.

@@ -1,5 +1,5 @@
 //! Every head of a kit stepped at the simulation rate with the two stick tips in contact
-//! (issue 6 §2; seed 000 eqs. 5–6), two-way: each tip's Hertz force F = k·c^α, with
+//! (seed 000 eqs. 5–6), two-way: each tip's Hertz force F = k·c^α, with
 //! c = (head surface + d(x)) − (tip − felt radius) and d(x) = Σ q_k Φ_k(x), pushes the
 //! membrane modes down (generalised force −F·Φ_k(x)) and the stick up, so the stick
 //! rebounds physically and a strike on a ringing head feels its motion.
@@ -8,7 +8,7 @@
 //! force is implicit in the contact: the one that satisfies F = k·c^α with c the
 //! compression at the *end* of the step, predicted from the modes' exact response to F
 //! and the tip moving on with its velocity (plus F·dt²/m_eff, m_eff from
-//! [`effective_mass_kg`](super::strike::effective_mass_kg)). An explicit force (from the
+//! [`effective_mass_kg`](super::contact::effective_mass_kg)). An explicit force (from the
 //! start-of-step state) gained energy when a stick rested on the head and blew up. Modes at or
 //! above the simulation's Nyquist frequency (f ≥ 1/(2·dt)) are left out of the mechanical
 //! coupling — they would alias — but still sound: the audio voices (48 kHz) take every
@@ -188,7 +188,7 @@ impl DrumSet {
             dt_s,
             config: *config,
             law,
-            tip_mass_kg: super::strike::effective_mass_kg(mallet),
+            tip_mass_kg: super::contact::effective_mass_kg(mallet),
             heads,
             step: 0,
             contacts: Vec::new(),

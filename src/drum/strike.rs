@@ -3,11 +3,10 @@
 //! through [`DrumSet::step`] (semi-implicit Euler), so the contact and the rebound come
 //! from the two-way coupling alone. Also the dynamics → impact-speed map.
 //!
-//! Effective mass at the tip ([`effective_mass_kg`]): the mallet pivots about the grip; with
-//! a third of its mass in the felt head at the tip and two thirds in a uniform shaft
-//! (I/L² = m_shaft/3), m_eff = m/3 + (2m/3)/3 = 5m/9. The body simulation supplies its own
-//! (arm-loaded) dynamics instead.
+//! The stick's mass is the mallet's effective mass at the tip ([`effective_mass_kg`]); the
+//! body simulation supplies its own (arm-loaded) dynamics instead.
 
+pub use super::contact::effective_mass_kg;
 use super::set::DrumSet;
 use crate::kit::{Drum, Mallet, Side};
 use crate::score::Dynamic;
@@ -29,11 +28,6 @@ pub const FULL_SPEED_MPS: f64 = 5.6;
 /// Downward impact speed for a dynamic, m/s (linear in MIDI velocity, see [`FULL_SPEED_MPS`]).
 pub fn impact_speed_mps(dynamic: Dynamic) -> f64 {
     FULL_SPEED_MPS * dynamic.velocity().clamp(0.0, 1.0)
-}
-
-/// Effective mass of a mallet at its tip when it pivots about the grip, kg (5/9 of its mass).
-pub fn effective_mass_kg(mallet: &Mallet) -> f64 {
-    mallet.mass_kg * 5.0 / 9.0
 }
 
 /// A stick tip as a point mass.

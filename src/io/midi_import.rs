@@ -11,8 +11,8 @@
 //! from 1 in messages, as General MIDI does.
 
 use super::midi_export::{BeatData, GM_TIMPANI};
+use crate::base::pitch::Pitch;
 use crate::kit::Kit;
-use crate::pitch::Pitch;
 use crate::score::meter;
 use crate::score::tempo::BPM_RANGE;
 use crate::score::{

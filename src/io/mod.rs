@@ -1,12 +1,11 @@
-//! File adapters: strict RON files with atomic saving, Standard MIDI Files in and out,
-//! and composed and simulated motion as CSV and C3D.
+//! File adapters over what the layers below make: Standard MIDI Files in and out, composed
+//! and simulated motion as CSV and C3D, and PNG figures. (Strict RON reading and atomic
+//! writing are on the ground floor, `base::ron_file`, since kits and scores use them.)
 
+pub mod c3d_write;
 pub mod midi_export;
 pub mod midi_import;
 pub mod motion_c3d;
 pub mod motion_csv;
 pub mod plot;
-pub mod ron_file;
 pub mod tips_csv;
-
-pub use ron_file::FileError;

@@ -7,7 +7,7 @@
 
 use crate::body::sim::{Motion, Reference};
 use crate::body::skeleton::{Joint, Skeleton};
-use crate::mocap::import::c3d::write_c3d;
+use crate::io::c3d_write::write_c3d;
 use crate::mocap::{Take, Track};
 use std::path::PathBuf;
 

@@ -55,9 +55,28 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     }
 }
 
+/// Why a figure could not be written.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PlotError {
+    /// The PNG (or its temporary file beside it) could not be written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: std::path::PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// Plotters could not draw the figure.
+    #[error("{}: cannot draw the figure: {message}", path.display())]
+    Draw {
+        path: std::path::PathBuf,
+        message: String,
+    },
+}
+
 impl Figure {
     /// Draw the figure to a PNG at `path`, atomically.
-    pub fn save_png(&self, path: &Path) -> Result<(), String> {
+    pub fn save_png(&self, path: &Path) -> Result<(), PlotError> {
         register_font();
         let dir = match path.parent() {
             Some(p) if !p.as_os_str().is_empty() => p,
@@ -67,11 +86,18 @@ impl Figure {
             .prefix(".timpanist-")
             .suffix(".png")
             .tempfile_in(dir)
-            .map_err(|e| format!("{}: {e}", path.display()))?;
-        self.draw(tmp.path())
-            .map_err(|e| format!("{}: {e}", path.display()))?;
-        tmp.persist(path)
-            .map_err(|e| format!("{}: {}", path.display(), e.error))?;
+            .map_err(|source| PlotError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        self.draw(tmp.path()).map_err(|e| PlotError::Draw {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        tmp.persist(path).map_err(|e| PlotError::Io {
+            path: path.to_path_buf(),
+            source: e.error,
+        })?;
         Ok(())
     }
 

@@ -7,8 +7,9 @@
 
 pub mod validate;
 
-use crate::io::ron_file::{self, FileError};
-use crate::pitch::Pitch;
+pub use crate::base::gesture::Side;
+use crate::base::pitch::Pitch;
+use crate::base::ron_file::{self, FileError};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -22,31 +23,6 @@ pub const BUNDLED_KITS: &[(&str, &str)] = &[
     ("pair", include_str!("../../kits/pair.ron")),
     ("solo", include_str!("../../kits/solo.ron")),
 ];
-
-/// A side of the body.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-pub enum Side {
-    Left,
-    Right,
-}
-
-impl Side {
-    /// The other side.
-    pub fn other(self) -> Side {
-        match self {
-            Side::Left => Side::Right,
-            Side::Right => Side::Left,
-        }
-    }
-
-    /// −1 for left, +1 for right (the hand-value convention of seed 003 §4.2.2).
-    pub fn sign(self) -> f64 {
-        match self {
-            Side::Left => -1.0,
-            Side::Right => 1.0,
-        }
-    }
-}
 
 /// A set of drums and mallets.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

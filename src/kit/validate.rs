@@ -3,7 +3,7 @@
 
 use super::Kit;
 
-pub use crate::problem::Problem;
+pub use crate::base::problem::Problem;
 
 fn positive(x: f64) -> bool {
     x.is_finite() && x > 0.0

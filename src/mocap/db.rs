@@ -11,8 +11,8 @@
 //! its second difference in time, and written as zigzag LEB128 varints. Positions are in
 //! the performer frame (metres; +x right, +y forward, +z up).
 
+use crate::base::ron_file::{self, FileError};
 use crate::body::skeleton::{JOINT_COUNT, Joint, Pose};
-use crate::io::ron_file::{self, FileError};
 use crate::kit::Side;
 use crate::score::{Dynamic, Grip, ImpactLocation, PlayingMode};
 use flate2::Compression;

@@ -1,11 +1,10 @@
 //! Motion capture: reading captures from real systems, cutting them into one-stroke motion
 //! units, the on-disk motion database, the synthetic performer that builds the shipped
-//! database, and joint-limit estimation (seed 000 Alg. 1).
+//! database (joint-limit estimation from its captures lives in `body::limits`).
 
 pub mod db;
 pub mod import;
 pub mod ingest;
-pub mod limits;
 pub mod segment;
 pub mod stats;
 pub mod synth;

@@ -23,10 +23,10 @@
 
 use super::db::{self, Index, MotionDb, TakeData, TakeEntry, UnitEntry};
 use super::segment::{SegmentParams, segment};
+use crate::base::rng::Rng;
 use crate::body::ik::{self, IkParams};
 use crate::body::skeleton::{JOINT_COUNT, Joint, Pose, REST, Skeleton};
 use crate::kit::{Kit, Side};
-use crate::rng::Rng;
 use crate::score::{Dynamic, Grip, ImpactLocation, PlayingMode};
 use glam::{DQuat, DVec3};
 

@@ -3,7 +3,7 @@
 
 use super::compose::{ComposeParams, Composition, compose};
 use super::handles;
-use super::plan::{PlanParams, plan};
+use super::plan::{PlanError, PlanParams, plan};
 use crate::kit::Kit;
 use crate::mocap::db::MotionDb;
 use crate::score::Score;
@@ -15,7 +15,7 @@ pub fn trajectories(
     db: &MotionDb,
     plan_params: &PlanParams,
     compose_params: &ComposeParams,
-) -> Result<Composition, String> {
+) -> Result<Composition, PlanError> {
     let strokes = plan(score, kit, db, plan_params)?;
     let mut comp = compose(&strokes, db, compose_params);
     handles::apply(&mut comp, score);

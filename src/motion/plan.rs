@@ -5,9 +5,9 @@
 //! are not robotic (the same seed gives the same plan).
 
 use super::sticking::{self, Method};
+use crate::base::rng::Rng;
 use crate::kit::{Kit, Side};
 use crate::mocap::db::{MotionDb, UnitEntry};
-use crate::rng::Rng;
 use crate::score::{Dynamic, Grip, ImpactLocation, PlayingMode, Score};
 use glam::DVec3;
 
@@ -73,6 +73,15 @@ fn match_cost(
         + 1.0 * f64::from(u.hand != hand)
 }
 
+/// Why a score could not be planned.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum PlanError {
+    /// There is no stroke to splice from.
+    #[error("the motion database has no units")]
+    EmptyDatabase,
+}
+
 /// The strokes of `score` in time order, each with a motion unit from `db`.
 /// Errors if the database is empty.
 pub fn plan(
@@ -80,9 +89,9 @@ pub fn plan(
     kit: &Kit,
     db: &MotionDb,
     params: &PlanParams,
-) -> Result<Vec<PlannedStroke>, String> {
+) -> Result<Vec<PlannedStroke>, PlanError> {
     if db.index.units.is_empty() {
-        return Err("the motion database has no units".into());
+        return Err(PlanError::EmptyDatabase);
     }
     let sides = sticking::assign(score, kit, params.sticking, &sticking::Params::default());
     let tempo = score.tempo_map();

@@ -1,4 +1,4 @@
-//! Strikes on the beat (issue 6 §5), settled front to back. The simulated body lags its
+//! Strikes on the beat, settled front to back. The simulated body lags its
 //! targets, so each stroke's target is played earlier by however late its contact was,
 //! and aims deeper or shallower until its peak force meets its dynamic's. Strokes closer
 //! than [`CLUSTER_GAP_S`] (either hand) are settled together: from a saved state before

@@ -1,5 +1,5 @@
 //! Rendering a whole score to sound and motion: the one pipeline behind `timpanist render`
-//! and the editor's playback (issue 6 §4–5).
+//! and the editor's playback.
 //!
 //! compose (plan + splice, `motion`) → targets (strike-through, per-stroke time warp,
 //! [`reference`]) → the body simulated at 10 kHz by the chosen control pipeline with its
@@ -12,6 +12,7 @@
 //! edit ([`render_after`]).
 
 pub mod compensate;
+pub mod evaluate;
 pub mod reach;
 pub mod reference;
 pub mod strikes;
@@ -26,7 +27,7 @@ use crate::kit::Side;
 use crate::mocap::db::MotionDb;
 use crate::motion::compose::{ComposeParams, Composition};
 use crate::motion::perform;
-use crate::motion::plan::{PlanParams, PlannedStroke};
+use crate::motion::plan::{PlanError, PlanParams, PlannedStroke};
 use crate::score::{LoadedScore, Settings};
 use crate::sound::{Audio, SoundError, SoundModel, SoundState};
 use compensate::{Aims, Performance, Stage};
@@ -210,7 +211,7 @@ pub struct Rendering {
 #[non_exhaustive]
 pub enum RenderError {
     #[error("cannot compose the score: {0}")]
-    Compose(String),
+    Compose(#[from] PlanError),
     #[error("the score is empty: nothing to render")]
     Empty,
     #[error(transparent)]
@@ -284,13 +285,6 @@ pub fn render_after(
     params: &RenderParams,
     progress: &mut dyn FnMut(Progress) -> bool,
 ) -> Result<Rendering, RenderError> {
-    let mut stats = Stats::default();
-    let kit: &Kit = &loaded.score.settings.kit(&loaded.kit);
-    let mallet = kit
-        .mallets
-        .get(params.mallet)
-        .ok_or(RenderError::NoMallet(params.mallet))?;
-    let law = crate::drum::HertzContact::of(mallet)?;
     if !progress(Progress {
         stage: "composing",
         fraction: 0.0,
@@ -298,142 +292,78 @@ pub fn render_after(
         return Err(RenderError::Cancelled);
     }
     let began = Instant::now();
-    let composition = perform::trajectories(&loaded.score, kit, db, &params.plan, &params.compose)
-        .map_err(RenderError::Compose)?;
-    stats.compose = began.elapsed();
+    let composition = compose(loaded, db, params)?;
+    let compose_time = began.elapsed();
+    let mut rendering =
+        render_composition(resume, stop_after_s, loaded, composition, params, progress)?;
+    rendering.stats.compose = compose_time;
+    Ok(rendering)
+}
+
+/// The two tip trajectories `render` performs for `loaded` (planned and composed with the
+/// parameters' plan and compose settings, on the kit as the score's settings change it):
+/// what the editor's view shows, handed to [`render_composition`] so a score is composed
+/// once.
+pub fn compose(
+    loaded: &LoadedScore,
+    db: &MotionDb,
+    params: &RenderParams,
+) -> Result<Composition, RenderError> {
+    let kit: &Kit = &loaded.score.settings.kit(&loaded.kit);
+    Ok(perform::trajectories(
+        &loaded.score,
+        kit,
+        db,
+        &params.plan,
+        &params.compose,
+    )?)
+}
+
+/// [`render_after`] of a score already composed by [`compose`] (with the same `loaded` and
+/// `params`): simulate, settle and sound it.
+pub fn render_composition(
+    resume: &mut Option<Resume>,
+    stop_after_s: Option<f64>,
+    loaded: &LoadedScore,
+    composition: Composition,
+    params: &RenderParams,
+    progress: &mut dyn FnMut(Progress) -> bool,
+) -> Result<Rendering, RenderError> {
+    let kit: &Kit = &loaded.score.settings.kit(&loaded.kit);
+    let mallet = kit
+        .mallets
+        .get(params.mallet)
+        .ok_or(RenderError::NoMallet(params.mallet))?;
+    let law = crate::drum::HertzContact::of(mallet)?;
     if composition.len() < 2 || composition.strokes.is_empty() {
         return Err(RenderError::Empty);
     }
     let skeleton = Skeleton::new(params.height_m, mallet.length_m);
     reach::check(&composition.strokes, &skeleton)?;
-    let start_s = composition.start_s;
-    let rate = composition.rate_hz;
-    stats.score_s = (composition.len() - 1) as f64 / rate;
+    let mut stats = Stats {
+        score_s: (composition.len() - 1) as f64 / composition.rate_hz,
+        ..Stats::default()
+    };
     let shape = StrikeShape {
         ball_radius_m: law.ball_radius_m,
         half_width_s: params.strike_half_width_s,
     };
     let targets = Targets::new(&composition, &shape, params.strike_depth_m);
-    let strokes = composition.strokes.len();
-    let same_heads = resume
-        .as_ref()
-        .is_some_and(|r| r.kit == *kit && r.params.modes == params.modes);
-    let resumed = resume.as_ref().and_then(|p| {
-        let same =
-            p.params == *params && p.kit == *kit && p.start_s == start_s && p.rate_hz == rate;
-        let old_len = p.tips[0].len();
-        let same_until = (0..old_len.min(composition.len()))
-            .find(|&k| (0..2).any(|h| p.tips[h][k] != composition.tips[h][k]))
-            .unwrap_or(old_len.min(composition.len()));
-        let at = p
-            .performance
-            .resumable(&p.strokes, &composition.strokes, &targets, same_until);
-        // Where the change is heard: the first stroke that differs, else the first
-        // target sample that does (none for the same score: a rendering continued).
-        let (new, old) = (&composition.strokes, &p.strokes);
-        let changed_s = (0..new.len().max(old.len()))
-            .find(|&i| new.get(i) != old.get(i))
-            .and_then(|i| new.get(i).or(old.get(i)))
-            .map(|s| s.time_s)
-            .or_else(|| {
-                (same_until < old_len.max(composition.len()))
-                    .then(|| start_s + same_until as f64 / rate)
-            });
-        same.then_some(at).flatten().map(|at| (at, changed_s))
-    });
-    let mut changed_s = None;
-    let (performance, sound) = match resumed {
-        Some((at, changed)) => {
-            changed_s = changed;
-            let Resume {
-                mut performance,
-                sound,
-                ..
-            } = resume.take().expect("resuming");
-            performance.resume_at(at, targets, strokes);
-            stats.resumed_from_s = Some(start_s + performance.sim.samples() as f64 / rate);
-            (performance, sound)
-        }
-        None => {
-            let model = BodyModel::new(skeleton, params.mass_kg);
-            let first = targets.reference(&Warp::default());
-            let initial = initial_pose(&model, &first);
-            let sim = Simulator::new(
-                &model,
-                &first,
-                params.control,
-                &params.sim,
-                &initial,
-                &[params.gain_scale; crate::body::skeleton::JOINT_COUNT],
-            )
-            .map_err(|e| RenderError::of_simulation(e, start_s))?;
-            let dt = 1.0 / (rate * (params.sim.sim_hz / rate).round().max(1.0));
-            let drums = DrumSet::new(kit, mallet, &params.modes, dt)?;
-            // The sound compares each drum's record itself: it resumes whenever the
-            // heads are the same.
-            let sound = resume
-                .take()
-                .filter(|_| same_heads)
-                .map(|r| r.sound)
-                .unwrap_or_default();
-            (Performance::new(targets, sim, drums, strokes), sound)
-        }
+    let run = Run {
+        kit,
+        params,
+        composition: &composition,
     };
-    let state = resume.insert(Resume {
-        performance,
-        sound,
-        strokes: composition.strokes.clone(),
-        tips: composition.tips.clone(),
-        start_s,
-        rate_hz: rate,
-        params: params.clone(),
-        kit: kit.clone(),
-    });
-    let performance = &mut state.performance;
-    let aims = Aims {
-        force_n: composition
-            .strokes
-            .iter()
-            .map(|s| params.force_at_silence_n + params.force_range_n * s.dynamic.velocity())
-            .collect(),
-        force_tolerance: params.force_tolerance,
-        tolerance_s: params.timing_tolerance_s,
-        acceptable_s: params.timing_acceptable_s,
-        settle_attempts: params.settle_attempts,
-        max_attempts: params.max_attempts.max(1),
-        first_depth_m: params.strike_depth_m,
-    };
-    let began = Instant::now();
-    let mut report = |f: f64| {
-        progress(Progress {
-            stage: "simulating",
-            fraction: 0.02 + 0.9 * f,
-        })
-    };
-    let mut stage = Stage {
-        start_s,
-        drum_time: Duration::ZERO,
-        report: &mut report,
-    };
+    let started = run.start(resume.take(), targets, skeleton)?;
+    stats.resumed_from_s = started.resumed_from_s;
+    let state = resume.insert(started.state);
     let horizon = stats.resumed_from_s.zip(stop_after_s).map(|(from, after)| {
-        let at = changed_s.map_or(from, |c: f64| c.max(from));
-        ((at + after - start_s) * rate).ceil().max(0.0) as usize
+        let at = started.changed_s.map_or(from, |c: f64| c.max(from));
+        ((at + after - composition.start_s) * composition.rate_hz)
+            .ceil()
+            .max(0.0) as usize
     });
-    let outcome = performance.run(&composition.strokes, &aims, &mut stage, horizon);
-    stats.drums = stage.drum_time;
-    stats.simulate = began.elapsed();
-    let complete = outcome.map_err(|e| RenderError::of_simulation(e, start_s))?;
-    let simulated_to_s = start_s + (performance.sim.samples().max(1) - 1) as f64 / rate;
-    stats.simulated_s = performance.simulated_samples as f64 / rate;
-    stats.clusters = performance.clusters_settled();
-    stats.attempts = performance.attempts;
-    let drums = &performance.drums;
-    let matches = strikes::match_strokes(&composition.strokes, drums.contacts());
-    let timing = strikes::timing(&strikes::errors(
-        &composition.strokes,
-        drums.contacts(),
-        &matches,
-    ));
+    let complete = run.settle(&mut state.performance, horizon, &mut stats, progress)?;
     if !progress(Progress {
         stage: "sound",
         fraction: 0.93,
@@ -441,40 +371,27 @@ pub fn render_after(
         return Err(RenderError::Cancelled);
     }
     let began = Instant::now();
-    // A partial rendering's audio stops where later strikes could still change it.
-    let (end_s, ready_s) = if complete {
-        let end_s = start_s + stats.score_s + params.tail_s;
-        (end_s, end_s)
-    } else {
-        (
-            simulated_to_s,
-            simulated_to_s - 2.0 * performance.drums.dt_s(),
-        )
-    };
-    // The sound resumes whatever the performance did when the heads are the same: it
-    // compares each drum's record itself.
-    let previous_sound = std::mem::take(&mut state.sound);
-    let (audio, sound) = crate::sound::render_resuming(
-        kit,
-        drums,
-        end_s.max(0.0),
-        params.sound,
-        Some(previous_sound),
-    )?;
-    state.sound = sound;
+    let (audio, ready_s) = run.sound(state, complete)?;
     stats.sound = began.elapsed();
-    let events = strikes::events(&composition.strokes, drums.contacts(), &matches);
     progress(Progress {
         stage: "done",
         fraction: 1.0,
     });
     let performance = &state.performance;
+    let drums = &performance.drums;
+    let matches = strikes::match_strokes(&composition.strokes, drums.contacts());
+    let timing = strikes::timing(&strikes::errors(
+        &composition.strokes,
+        drums.contacts(),
+        &matches,
+    ));
+    let events = strikes::events(&composition.strokes, drums.contacts(), &matches);
     Ok(Rendering {
         reference: performance.targets.reference(&performance.warp),
         motion: performance.sim.motion().clone(),
+        start_s: composition.start_s,
         composition,
-        start_s,
-        drums: performance.drums.clone(),
+        drums: drums.clone(),
         events,
         timing,
         audio,
@@ -484,6 +401,196 @@ pub fn render_after(
         params: params.clone(),
         kit: kit.clone(),
     })
+}
+
+/// One rendering's fixed inputs.
+struct Run<'a> {
+    kit: &'a Kit,
+    params: &'a RenderParams,
+    composition: &'a Composition,
+}
+
+/// Where a rendering starts from: its state, the score time it resumed from (none when
+/// it starts afresh) and where the change it renders is first heard.
+struct Started {
+    state: Resume,
+    resumed_from_s: Option<f64>,
+    changed_s: Option<f64>,
+}
+
+impl Run<'_> {
+    /// Resume `previous` at its latest saved state before the change, when it is of the
+    /// same kit and parameters, else start a new performance (keeping the sound's state
+    /// when the heads are the same: the sound compares each drum's record itself).
+    fn start(
+        &self,
+        previous: Option<Resume>,
+        targets: Targets,
+        skeleton: Skeleton,
+    ) -> Result<Started, RenderError> {
+        let (comp, params, kit) = (self.composition, self.params, self.kit);
+        let (start_s, rate) = (comp.start_s, comp.rate_hz);
+        let strokes = comp.strokes.len();
+        let resumable = previous
+            .as_ref()
+            .and_then(|p| self.resume_point(p, &targets));
+        let (performance, sound, resumed_from_s, changed_s) = match (previous, resumable) {
+            (Some(previous), Some((at, changed_s))) => {
+                let Resume {
+                    mut performance,
+                    sound,
+                    ..
+                } = previous;
+                performance.resume_at(at, targets, strokes);
+                let from = start_s + performance.sim.samples() as f64 / rate;
+                (performance, sound, Some(from), changed_s)
+            }
+            (previous, _) => {
+                let model = BodyModel::new(skeleton, params.mass_kg);
+                let first = targets.reference(&Warp::default());
+                let initial = initial_pose(&model, &first);
+                let sim = Simulator::new(
+                    &model,
+                    &first,
+                    params.control,
+                    &params.sim,
+                    &initial,
+                    &[params.gain_scale; crate::body::skeleton::JOINT_COUNT],
+                )
+                .map_err(|e| RenderError::of_simulation(e, start_s))?;
+                let dt = 1.0 / (rate * (params.sim.sim_hz / rate).round().max(1.0));
+                let mallet = &kit.mallets[params.mallet];
+                let drums = DrumSet::new(kit, mallet, &params.modes, dt)?;
+                let sound = previous
+                    .filter(|r| r.kit == *kit && r.params.modes == params.modes)
+                    .map(|r| r.sound)
+                    .unwrap_or_default();
+                let performance = Performance::new(targets, sim, drums, strokes);
+                (performance, sound, None, None)
+            }
+        };
+        Ok(Started {
+            state: Resume {
+                performance,
+                sound,
+                strokes: comp.strokes.clone(),
+                tips: comp.tips.clone(),
+                start_s,
+                rate_hz: rate,
+                params: params.clone(),
+                kit: kit.clone(),
+            },
+            resumed_from_s,
+            changed_s,
+        })
+    }
+
+    /// The saved state of `previous` to resume from for this composition (none when the
+    /// kit, parameters or timing differ), and where the change is heard: the first stroke
+    /// that differs, else the first target sample that does (none for the same score: a
+    /// rendering continued).
+    fn resume_point(&self, previous: &Resume, targets: &Targets) -> Option<(usize, Option<f64>)> {
+        let comp = self.composition;
+        let same = previous.params == *self.params
+            && previous.kit == *self.kit
+            && previous.start_s == comp.start_s
+            && previous.rate_hz == comp.rate_hz;
+        if !same {
+            return None;
+        }
+        let old_len = previous.tips[0].len();
+        let common = old_len.min(comp.len());
+        let same_until = (0..common)
+            .find(|&k| (0..2).any(|h| previous.tips[h][k] != comp.tips[h][k]))
+            .unwrap_or(common);
+        let at = previous.performance.resumable(
+            &previous.strokes,
+            &comp.strokes,
+            targets,
+            same_until,
+        )?;
+        let (new, old) = (&comp.strokes, &previous.strokes);
+        let changed_s = (0..new.len().max(old.len()))
+            .find(|&i| new.get(i) != old.get(i))
+            .and_then(|i| new.get(i).or(old.get(i)))
+            .map(|s| s.time_s)
+            .or_else(|| {
+                (same_until < old_len.max(comp.len()))
+                    .then(|| comp.start_s + same_until as f64 / comp.rate_hz)
+            });
+        Some((at, changed_s))
+    }
+
+    /// Settle the strokes on their beats front to back (up to `horizon` samples, when
+    /// given); true when the whole score is simulated.
+    fn settle(
+        &self,
+        performance: &mut Performance,
+        horizon: Option<usize>,
+        stats: &mut Stats,
+        progress: &mut dyn FnMut(Progress) -> bool,
+    ) -> Result<bool, RenderError> {
+        let (comp, params) = (self.composition, self.params);
+        let aims = Aims {
+            force_n: comp
+                .strokes
+                .iter()
+                .map(|s| params.force_at_silence_n + params.force_range_n * s.dynamic.velocity())
+                .collect(),
+            force_tolerance: params.force_tolerance,
+            tolerance_s: params.timing_tolerance_s,
+            acceptable_s: params.timing_acceptable_s,
+            settle_attempts: params.settle_attempts,
+            max_attempts: params.max_attempts.max(1),
+            first_depth_m: params.strike_depth_m,
+        };
+        let began = Instant::now();
+        let mut report = |f: f64| {
+            progress(Progress {
+                stage: "simulating",
+                fraction: 0.02 + 0.9 * f,
+            })
+        };
+        let mut stage = Stage {
+            start_s: comp.start_s,
+            drum_time: Duration::ZERO,
+            report: &mut report,
+        };
+        let outcome = performance.run(&comp.strokes, &aims, &mut stage, horizon);
+        stats.drums = stage.drum_time;
+        stats.simulate = began.elapsed();
+        let complete = outcome.map_err(|e| RenderError::of_simulation(e, comp.start_s))?;
+        stats.simulated_s = performance.simulated_samples as f64 / comp.rate_hz;
+        stats.clusters = performance.clusters_settled();
+        stats.attempts = performance.attempts;
+        Ok(complete)
+    }
+
+    /// The sound of the performance so far, resuming the state's synthesis, and the score
+    /// time up to which it is final, s (a partial rendering's audio stops where later
+    /// strikes could still change it).
+    fn sound(&self, state: &mut Resume, complete: bool) -> Result<(Audio, f64), RenderError> {
+        let comp = self.composition;
+        let drums = &state.performance.drums;
+        let (end_s, ready_s) = if complete {
+            let end_s = comp.start_s + (comp.len() - 1) as f64 / comp.rate_hz + self.params.tail_s;
+            (end_s, end_s)
+        } else {
+            let samples = state.performance.sim.samples().max(1) - 1;
+            let simulated_to_s = comp.start_s + samples as f64 / comp.rate_hz;
+            (simulated_to_s, simulated_to_s - 2.0 * drums.dt_s())
+        };
+        let previous = std::mem::take(&mut state.sound);
+        let (audio, sound) = crate::sound::render_resuming(
+            self.kit,
+            drums,
+            end_s.max(0.0),
+            self.params.sound,
+            Some(previous),
+        )?;
+        state.sound = sound;
+        Ok((audio, ready_s))
+    }
 }
 
 impl Rendering {

@@ -3,7 +3,7 @@
 //! tips touch the head surface at impact), a *strike-through* dip so each stroke aims a
 //! few millimetres into the head (players strike through the head, not onto it), and a
 //! per-hand time warp that plays each stroke earlier or later by the shift the timing
-//! compensation measured (issue 6 §5).
+//! compensation measured.
 //!
 //! The warp is a list of knots per hand: each stroke holds its shift over its dip, and
 //! *anchors* fix the shift at times the compensation has settled; between knots the shift

@@ -9,12 +9,13 @@ pub mod settings;
 pub mod tempo;
 pub mod validate;
 
-use crate::io::ron_file::{self, FileError};
+use crate::base::pitch::Pitch;
+use crate::base::ron_file::{self, FileError};
 use crate::kit::{Kit, Side};
-use crate::pitch::Pitch;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
+pub use crate::base::gesture::{Dynamic, Grip, Hand, ImpactLocation, PlayingMode};
 pub use meter::{BarBeat, MeterChange, MeterMap};
 pub use settings::Settings;
 pub use tempo::{TempoChange, TempoMap, TempoPoint};
@@ -24,186 +25,6 @@ pub const SCORE_FORMAT_VERSION: u32 = 2;
 
 /// Ticks per quarter note of new scores.
 pub const DEFAULT_TICKS_PER_QUARTER: u32 = 960;
-
-/// The hand that plays a beat.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum Hand {
-    Left,
-    Right,
-    /// Let a sticking method choose (see `motion::sticking`).
-    Auto,
-}
-
-impl Hand {
-    /// The side, if the hand is fixed.
-    pub fn side(self) -> Option<Side> {
-        match self {
-            Hand::Left => Some(Side::Left),
-            Hand::Right => Some(Side::Right),
-            Hand::Auto => None,
-        }
-    }
-}
-
-impl From<Side> for Hand {
-    fn from(side: Side) -> Hand {
-        match side {
-            Side::Left => Hand::Left,
-            Side::Right => Hand::Right,
-        }
-    }
-}
-
-/// The five timpani playing modes (seed 000 §2.4).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-pub enum PlayingMode {
-    Legato,
-    Tenuto,
-    Accent,
-    VerticalAccent,
-    Staccato,
-}
-
-impl PlayingMode {
-    /// All modes in the order of the number keys 1–5.
-    pub const ALL: [PlayingMode; 5] = [
-        PlayingMode::Legato,
-        PlayingMode::Tenuto,
-        PlayingMode::Accent,
-        PlayingMode::VerticalAccent,
-        PlayingMode::Staccato,
-    ];
-
-    /// Lower-case name as used on the command line and in reports.
-    pub fn name(self) -> &'static str {
-        match self {
-            PlayingMode::Legato => "legato",
-            PlayingMode::Tenuto => "tenuto",
-            PlayingMode::Accent => "accent",
-            PlayingMode::VerticalAccent => "vertical accent",
-            PlayingMode::Staccato => "staccato",
-        }
-    }
-}
-
-/// Grip of the sticks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub enum Grip {
-    /// Thumbs up, palms facing each other: large vertical motion.
-    French,
-    /// Palms down: smaller vertical motion, more wrist.
-    German,
-}
-
-/// How loud a beat is: a dynamic marking or an exact velocity in 0–1.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub enum Dynamic {
-    Pp,
-    P,
-    Mp,
-    Mf,
-    F,
-    Ff,
-    /// A velocity in 0–1 (1 is MIDI velocity 127).
-    Velocity(f64),
-}
-
-impl Dynamic {
-    /// The markings from soft to loud with their MIDI velocities.
-    pub const MARKS: [(Dynamic, u8, &'static str); 6] = [
-        (Dynamic::Pp, 33, "pp"),
-        (Dynamic::P, 49, "p"),
-        (Dynamic::Mp, 64, "mp"),
-        (Dynamic::Mf, 80, "mf"),
-        (Dynamic::F, 96, "f"),
-        (Dynamic::Ff, 112, "ff"),
-    ];
-
-    /// Velocity in 0–1.
-    pub fn velocity(self) -> f64 {
-        match self {
-            Dynamic::Velocity(v) => v,
-            mark => {
-                let (_, midi, _) = Self::MARKS
-                    .iter()
-                    .find(|(m, _, _)| *m == mark)
-                    .expect("every marking is in MARKS");
-                f64::from(*midi) / 127.0
-            }
-        }
-    }
-
-    /// MIDI velocity 1–127.
-    pub fn midi_velocity(self) -> u8 {
-        (self.velocity() * 127.0).round().clamp(1.0, 127.0) as u8
-    }
-
-    /// The marking for a MIDI velocity if it is exactly a marking's, else a velocity.
-    pub fn from_midi_velocity(velocity: u8) -> Dynamic {
-        Self::MARKS
-            .iter()
-            .find(|(_, v, _)| *v == velocity)
-            .map(|(m, _, _)| *m)
-            .unwrap_or(Dynamic::Velocity(f64::from(velocity) / 127.0))
-    }
-
-    /// The nearest marking's name, e.g. "mf".
-    pub fn nearest_mark(self) -> &'static str {
-        let v = self.velocity() * 127.0;
-        Self::MARKS
-            .iter()
-            .min_by(|a, b| {
-                (f64::from(a.1) - v)
-                    .abs()
-                    .total_cmp(&(f64::from(b.1) - v).abs())
-            })
-            .map(|m| m.2)
-            .expect("MARKS is not empty")
-    }
-}
-
-/// Where the mallet strikes the head.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub enum ImpactLocation {
-    /// The centre of the head (dull, short sound).
-    Centre,
-    /// The usual playing spot, a third of the radius in from the rim, toward the player.
-    PlayingSpot,
-    /// Just inside the rim, toward the player.
-    Rim,
-    /// Any point: radius as a fraction of the head radius (0 centre, 1 rim) and angle in
-    /// degrees from the direction toward the player, counter-clockwise seen from above.
-    Point { radius: f64, angle_deg: f64 },
-}
-
-impl ImpactLocation {
-    /// Radius fraction of the playing spot.
-    pub const PLAYING_SPOT_RADIUS: f64 = 2.0 / 3.0;
-    /// Radius fraction of a rim stroke.
-    pub const RIM_RADIUS: f64 = 0.92;
-
-    /// (radius fraction, angle in degrees) on the head.
-    pub fn polar(self) -> (f64, f64) {
-        match self {
-            ImpactLocation::Centre => (0.0, 0.0),
-            ImpactLocation::PlayingSpot => (Self::PLAYING_SPOT_RADIUS, 0.0),
-            ImpactLocation::Rim => (Self::RIM_RADIUS, 0.0),
-            ImpactLocation::Point { radius, angle_deg } => (radius, angle_deg),
-        }
-    }
-
-    /// Short name for display.
-    pub fn name(self) -> String {
-        match self {
-            ImpactLocation::Centre => "centre".into(),
-            ImpactLocation::PlayingSpot => "playing spot".into(),
-            ImpactLocation::Rim => "rim".into(),
-            ImpactLocation::Point { radius, angle_deg } => {
-                format!("r {radius:.2} at {angle_deg:.0}°")
-            }
-        }
-    }
-}
 
 /// A roll (tremolo) starting at a beat: single strokes alternating hands, starting with
 /// the beat's hand.
@@ -464,7 +285,7 @@ impl Score {
     }
 
     /// Problems of this score against `kit`, in file order.
-    pub fn problems(&self, kit: &Kit) -> Vec<crate::problem::Problem> {
+    pub fn problems(&self, kit: &Kit) -> Vec<crate::base::problem::Problem> {
         validate::problems(self, kit)
     }
 }

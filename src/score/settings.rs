@@ -1,14 +1,13 @@
-//! How a score is performed and heard, saved with it (issue 7 §5): the control pipeline,
+//! How a score is performed and heard, saved with it: the control pipeline,
 //! the IK method, the PD gains, the sound model, the membrane modes, and per-drum changes
 //! of the kit (head diameter, tension). Absent from a file means the defaults; a score
 //! with default settings is written without them.
 
-use crate::body::ik::IkMethod;
-use crate::body::sim::Pipeline;
-use crate::drum::FrequencySource;
+use crate::base::choices::{
+    DEFAULT_MODE_COUNT, FrequencySource, IkMethod, MAX_MODE_COUNT, Pipeline, SoundModel,
+};
+use crate::base::problem::Problem;
 use crate::kit::Kit;
-use crate::problem::Problem;
-use crate::sound::SoundModel;
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
 
@@ -29,7 +28,7 @@ pub struct DrumChange {
 /// Range of the PD gain scale.
 pub const GAIN_SCALE_RANGE: std::ops::RangeInclusive<f64> = 0.25..=4.0;
 /// Range of membrane modes per head.
-pub const MODE_COUNT_RANGE: std::ops::RangeInclusive<usize> = 1..=200;
+pub const MODE_COUNT_RANGE: std::ops::RangeInclusive<usize> = 1..=MAX_MODE_COUNT;
 /// Range of head diameters, m.
 pub const DIAMETER_RANGE_M: std::ops::RangeInclusive<f64> = 0.4..=0.9;
 /// Range of membrane tensions, N/m.
@@ -59,7 +58,7 @@ impl Default for Settings {
             ik: IkMethod::DampedLeastSquares,
             gain_scale: 1.0,
             sound: SoundModel::Modal,
-            modes: crate::drum::ModeConfig::default().count,
+            modes: DEFAULT_MODE_COUNT,
             frequencies: FrequencySource::Measured,
             drums: Vec::new(),
         }

@@ -3,8 +3,8 @@
 //! no more simultaneous strokes than hands).
 
 use super::{Dynamic, Hand, ImpactLocation, SCORE_FORMAT_VERSION, Score, meter, tempo};
+use crate::base::problem::Problem;
 use crate::kit::Kit;
-use crate::problem::Problem;
 
 /// Every problem in `score` played on `kit`, in file order.
 pub fn problems(score: &Score, kit: &Kit) -> Vec<Problem> {

@@ -1,4 +1,4 @@
-//! Sound from the simulated strikes (issue 6 §3), 48 kHz stereo, the same code offline and
+//! Sound from the simulated strikes, 48 kHz stereo, the same code offline and
 //! live: three models — **modal** (a voice bank driven by the recorded contact force,
 //! seed 000 §4), **sample** replay and **signal**-based partials (seed 002) — each with a
 //! fixed calibration, mixed with a constant-power pan from each drum's placement x, then
@@ -14,12 +14,11 @@ pub mod wav;
 pub use spectrum::spectrum;
 pub use wav::write_wav;
 
+pub use crate::base::choices::SoundModel;
 use crate::drum::DrumSet;
 use crate::kit::Kit;
 use std::f64::consts::FRAC_PI_4;
-use std::fmt;
 use std::path::PathBuf;
-use std::str::FromStr;
 
 /// Audio sample rate, Hz.
 pub const SAMPLE_RATE_HZ: u32 = 48_000;
@@ -33,50 +32,6 @@ pub const REFERENCE_SPEED_MPS: f64 = 4.94;
 /// Peak level the sample and signal models give the reference strike (−6 dBFS); the
 /// modal model's calibration puts a reference strike on the 26-inch drum there too.
 pub const REFERENCE_LEVEL: f64 = 0.5;
-
-/// Which sound model renders.
-#[derive(
-    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
-)]
-pub enum SoundModel {
-    /// Modal voices driven by the simulated contact force.
-    #[default]
-    Modal,
-    /// A recorded note per drum, pitched and scaled by impact speed.
-    Sample,
-    /// Decaying partials at the kit's modes plus a noise burst.
-    Signal,
-}
-
-impl SoundModel {
-    /// Every model with its command-line name.
-    pub const ALL: [(SoundModel, &'static str); 3] = [
-        (SoundModel::Modal, "modal"),
-        (SoundModel::Sample, "sample"),
-        (SoundModel::Signal, "signal"),
-    ];
-}
-
-impl fmt::Display for SoundModel {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let name = Self::ALL
-            .iter()
-            .find(|(m, _)| m == self)
-            .map_or("?", |(_, n)| n);
-        f.write_str(name)
-    }
-}
-
-impl FromStr for SoundModel {
-    type Err = SoundError;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Self::ALL
-            .iter()
-            .find(|(_, n)| n.eq_ignore_ascii_case(s.trim()))
-            .map(|(m, _)| *m)
-            .ok_or_else(|| SoundError::UnknownModel(s.to_string()))
-    }
-}
 
 /// Rendered sound.
 #[derive(Clone, Debug, PartialEq)]
@@ -121,8 +76,6 @@ impl Audio {
 /// Why sound could not be rendered or written.
 #[derive(Debug, thiserror::Error)]
 pub enum SoundError {
-    #[error("unknown sound model `{0}` (expected modal, sample or signal)")]
-    UnknownModel(String),
     #[error("duration {0} s is not a finite time ≥ 0 of at most 24 hours")]
     Duration(f64),
     #[error("the {model} model produced a non-finite sample at frame {frame}")]

@@ -1,4 +1,4 @@
-//! The modal sound model (issue 6 §3, seed 000 §4): per head, a [`VoiceBank`] of every
+//! The modal sound model (seed 000 §4): per head, a [`VoiceBank`] of every
 //! audible mode driven by the contact force the simulation recorded. The force, held over
 //! each simulation step, is resampled to 48 kHz by a triangle kernel one step wide each
 //! side (linear interpolation, impulse preserved); mode k receives F·Φ_k(x)/M_k (its shape

@@ -8,8 +8,8 @@
 use super::modal::{FLUSH_FLOOR, voices_for};
 use super::voices::VoiceBank;
 use super::{REFERENCE_LEVEL, REFERENCE_SPEED_MPS, SAMPLE_RATE_HZ};
+use crate::base::rng::Rng;
 use crate::drum::DrumSet;
-use crate::rng::Rng;
 
 /// Scale of the partials: with the kit's gains and the shapes at the playing spot, a
 /// reference strike peaks near `REFERENCE_LEVEL` (measured: 0.22 at scale 2 → 4.4).

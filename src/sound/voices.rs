@@ -1,4 +1,4 @@
-//! The modal voice bank (issue 6 §3): one exact two-pole resonator per mode at the audio
+//! The modal voice bank: one exact two-pole resonator per mode at the audio
 //! rate — the ZOH step of [`ModeStep`](crate::drum::oscillator::ModeStep), whose poles are
 //! the impulse-invariant r·e^{±iω_d/fs}, r = exp(−1/(τ·fs)), τ = T60/ln 1000 — laid out as
 //! a struct of arrays in lanes of 8 f32 so the per-sample update *and* the sum over modes

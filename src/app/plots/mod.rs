@@ -1,4 +1,4 @@
-//! The plot area under the timeline (issue 7 §4), one tab at a time: the composed tips;
+//! The plot area under the timeline, one tab at a time: the composed tips;
 //! then, from the rendering, target against simulated tips, contact force per strike, the
 //! output waveform with the spectrum of one strike, and the simulated joint angles. Every
 //! time axis follows the timeline's visible window, shows the playhead and seeks on a

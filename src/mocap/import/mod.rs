@@ -1,5 +1,5 @@
 //! Importers for capture files: C3D, OptiTrack Motive CSV, Vicon Nexus CSV and our own
-//! plain CSV, plus a C3D writer for our own exports.
+//! plain CSV. (The C3D writer for our own exports is in the `io` layer: `io::c3d_write`.)
 //!
 //! Every importer returns a [`Take`]: labelled tracks at one fixed rate, positions in
 //! metres in the file's own axes (converted from the file's length unit), `None` where a
@@ -18,8 +18,6 @@ mod csv_text;
 pub mod motive;
 pub mod plain_csv;
 pub mod vicon;
-
-pub use c3d::write_c3d;
 
 use super::take::{ImportError, Take};
 use std::path::Path;

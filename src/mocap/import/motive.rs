@@ -54,29 +54,87 @@ struct Entity {
     rotation: [Option<usize>; 4],
 }
 
+/// What line 1's key/value pairs say.
+struct Meta<'r> {
+    /// The line's number (for errors).
+    line: usize,
+    /// Frame rate, Hz.
+    rate_hz: f64,
+    /// Length unit of the positions.
+    unit: LengthUnit,
+    /// `Rotation Type`: the value's column and text.
+    rotation_type: Option<(usize, &'r str)>,
+    /// `Total Exported Frames`, when given.
+    total_frames: Option<usize>,
+}
+
+/// The header rows above the `Frame` row, told apart.
+struct HeaderRows<'r, 'a> {
+    ty: &'r Row<'a>,
+    name: &'r Row<'a>,
+    id: Option<&'r Row<'a>>,
+    kind: &'r Row<'a>,
+}
+
 /// Read a Motive CSV export; `unit` overrides `Length Units`.
 pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take, ImportError> {
     let text = csv_text::decode(bytes);
     let mut rows = csv_text::rows(&text);
-    let err = |place: String, msg: String| ImportError::format(path, place, msg);
-
-    // Line 1: key/value pairs.
     let first = rows.next().ok_or_else(|| {
-        err(
-            "line 1".into(),
-            "expected \"Format Version,…\", found an empty file".into(),
+        ImportError::format(
+            path,
+            "line 1",
+            "expected \"Format Version,…\", found an empty file",
         )
     })?;
+    let meta = read_meta(path, &first, unit)?;
+    let (header, frame_row) = header_rows(path, &mut rows)?;
+    let head = classify_header(path, &header, &frame_row)?;
+    let width = frame_row
+        .used_width()
+        .max(header.iter().map(Row::used_width).max().unwrap_or(0));
+    let entities = group_columns(path, &head, &frame_row, width)?;
+    check_entities(path, &entities, &head, &meta)?;
+    let (tracks, frames) = read_data(path, rows, &entities, width, &meta, frame_row.line)?;
+    if let Some(n) = meta.total_frames.filter(|&n| n != frames) {
+        return Err(ImportError::format(
+            path,
+            "line 1",
+            format!(
+                "expected {n} data rows as \"Total Exported Frames\" says, found {frames}: the \
+                 export is truncated or was edited"
+            ),
+        ));
+    }
+    Ok(Take {
+        source: path.to_path_buf(),
+        rate_hz: meta.rate_hz,
+        frames,
+        file_unit: meta.unit.symbol().to_string(),
+        tracks,
+        notes: Vec::new(),
+    })
+}
+
+/// Read line 1, `Format Version,…` and key/value pairs: the rate, the length unit
+/// (`unit` overrides it), the rotation type and the frame count.
+fn read_meta<'r>(
+    path: &Path,
+    first: &'r Row,
+    unit: Option<LengthUnit>,
+) -> Result<Meta<'r>, ImportError> {
+    let err =
+        |col: usize, msg: String| ImportError::format(path, csv_text::place(first.line, col), msg);
     if !first.cell(0).eq_ignore_ascii_case("Format Version") {
         return Err(err(
-            csv_text::place(first.line, 0),
+            0,
             format!(
                 "expected \"Format Version\" (a Motive CSV export), found \"{}\"",
                 csv_text::shorten(first.cell(0))
             ),
         ));
     }
-    let meta = |key: &str| -> Option<(usize, &str)> {
+    let meta = |key: &str| -> Option<(usize, &'r str)> {
         (0..first.cells.len())
             .step_by(2)
             .find(|&c| first.cell(c).eq_ignore_ascii_case(key))
@@ -85,17 +143,17 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
     let (rate_col, rate_text) = meta("Export Frame Rate")
         .or_else(|| meta("Capture Frame Rate"))
         .ok_or_else(|| {
-            err(
-                "line 1".into(),
-                "expected an \"Export Frame Rate\" or \"Capture Frame Rate\" entry, found neither"
-                    .into(),
+            ImportError::format(
+                path,
+                "line 1",
+                "expected an \"Export Frame Rate\" or \"Capture Frame Rate\" entry, found neither",
             )
         })?;
     let rate_hz = match rate_text.parse::<f64>() {
         Ok(r) if r.is_finite() && r > 0.0 => r,
         _ => {
             return Err(err(
-                csv_text::place(first.line, rate_col),
+                rate_col,
                 format!(
                     "expected a frame rate above 0 Hz, found \"{}\"",
                     csv_text::shorten(rate_text)
@@ -108,7 +166,7 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         (None, None) => LengthUnit::Metre,
         (None, Some((col, name))) => LengthUnit::parse(name).ok_or_else(|| {
             err(
-                csv_text::place(first.line, col),
+                col,
                 format!(
                     "expected Length Units Meters, Centimeters or Millimeters, found \"{}\"",
                     csv_text::shorten(name)
@@ -116,65 +174,81 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
             )
         })?,
     };
-    let scale = unit.metres();
-    let rotation_type = meta("Rotation Type");
     let total_frames = match meta("Total Exported Frames") {
         Some((col, t)) if !t.is_empty() => Some(t.parse::<usize>().map_err(|_| {
             err(
-                csv_text::place(first.line, col),
+                col,
                 format!("expected a frame count, found \"{}\"", csv_text::shorten(t)),
             )
         })?),
         _ => None,
     };
+    Ok(Meta {
+        line: first.line,
+        rate_hz,
+        unit,
+        rotation_type: meta("Rotation Type"),
+        total_frames,
+    })
+}
 
-    // Header rows up to the "Frame" row.
+/// The header rows between line 1 and the `Frame` row (blank lines before them
+/// skipped), and the `Frame` row itself.
+fn header_rows<'a>(
+    path: &Path,
+    rows: &mut impl Iterator<Item = Row<'a>>,
+) -> Result<(Vec<Row<'a>>, Row<'a>), ImportError> {
     let mut header: Vec<Row> = Vec::new();
-    let frame_row = loop {
+    loop {
         let Some(row) = rows.next() else {
-            return Err(err(
-                "end of file".into(),
+            return Err(ImportError::format(
+                path,
+                "end of file",
                 "expected the column header row \"Frame,Time (Seconds),X,Y,Z,…\", found the end \
-                 of the file"
-                    .into(),
+                 of the file",
             ));
         };
         if row.cell(0).eq_ignore_ascii_case("Frame") {
-            break row;
+            return Ok((header, row));
         }
         if row.is_blank() {
             if header.is_empty() {
                 continue;
             }
-            return Err(err(
+            return Err(ImportError::format(
+                path,
                 format!("line {}", row.line),
                 "expected a header row (Type, Name, ID, Rotation/Position) or the \"Frame\" \
-                 row, found a blank line"
-                    .into(),
+                 row, found a blank line",
             ));
         }
         if header.len() >= 6 {
-            return Err(err(
+            return Err(ImportError::format(
+                path,
                 format!("line {}", row.line),
-                "expected the \"Frame,Time (Seconds),…\" row after at most 5 header rows".into(),
+                "expected the \"Frame,Time (Seconds),…\" row after at most 5 header rows",
             ));
         }
         header.push(row);
-    };
-    let (type_row, name_row, id_row, kind_row) = classify_header(path, &header, &frame_row)?;
-    let width = frame_row
-        .used_width()
-        .max(header.iter().map(Row::used_width).max().unwrap_or(0));
+    }
+}
 
-    // Group the columns into tracks.
+/// Group the columns into tracks by consecutive equal type, name and ID, and find each
+/// track's Position and Rotation X, Y, Z (W) columns.
+fn group_columns(
+    path: &Path,
+    rows: &HeaderRows,
+    frame_row: &Row,
+    width: usize,
+) -> Result<Vec<Entity>, ImportError> {
     let mut entities: Vec<Entity> = Vec::new();
     let mut prev_key: Option<(String, String, String)> = None;
     for col in 2..width {
-        let ty = type_row.cell(col);
+        let ty = rows.ty.cell(col);
         let key = (
             ty.to_string(),
-            name_row.cell(col).to_string(),
-            id_row.map_or("", |r| r.cell(col)).to_string(),
+            rows.name.cell(col).to_string(),
+            rows.id.map_or("", |r| r.cell(col)).to_string(),
         );
         let new = prev_key.as_ref() != Some(&key);
         prev_key = Some(key);
@@ -187,7 +261,7 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         if new {
             entities.push(Entity {
                 kind,
-                label: name_row.cell(col).to_string(),
+                label: rows.name.cell(col).to_string(),
                 first_col: col,
                 position: [None; 3],
                 rotation: [None; 4],
@@ -197,7 +271,7 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
             continue;
         };
         let axis = frame_row.cell(col).to_ascii_uppercase();
-        let part = kind_row.cell(col);
+        let part = rows.kind.cell(col);
         let slot = match (part.to_ascii_lowercase().as_str(), axis.as_str()) {
             ("position", "X") => &mut e.position[0],
             ("position", "Y") => &mut e.position[1],
@@ -209,7 +283,8 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
             _ => continue,
         };
         if slot.is_some() {
-            return Err(err(
+            return Err(ImportError::format(
+                path,
                 csv_text::place(frame_row.line, col),
                 format!(
                     "expected one {part} {axis} column for \"{}\", found a second",
@@ -219,10 +294,22 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         }
         *slot = Some(col);
     }
-    for e in &entities {
+    Ok(entities)
+}
+
+/// Check that every track has all three position columns and, if it has rotation
+/// columns, all four of them in quaternion form.
+fn check_entities(
+    path: &Path,
+    entities: &[Entity],
+    rows: &HeaderRows,
+    meta: &Meta,
+) -> Result<(), ImportError> {
+    for e in entities {
         if e.position.iter().any(Option::is_none) {
-            return Err(err(
-                csv_text::place(type_row.line, e.first_col),
+            return Err(ImportError::format(
+                path,
+                csv_text::place(rows.ty.line, e.first_col),
                 format!(
                     "expected Position X, Y and Z columns for \"{}\", found only some or none",
                     e.label
@@ -231,11 +318,13 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         }
         let rot = e.rotation.iter().filter(|c| c.is_some()).count();
         if rot > 0 {
-            if let Some((col, t)) =
-                rotation_type.filter(|(_, t)| !t.eq_ignore_ascii_case("Quaternion"))
+            if let Some((col, t)) = meta
+                .rotation_type
+                .filter(|(_, t)| !t.eq_ignore_ascii_case("Quaternion"))
             {
-                return Err(err(
-                    csv_text::place(first.line, col),
+                return Err(ImportError::format(
+                    path,
+                    csv_text::place(meta.line, col),
                     format!(
                         "expected Rotation Type Quaternion, found \"{}\" (Euler angles are not \
                          supported: export again with Rotation Type Quaternion)",
@@ -244,8 +333,9 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
                 ));
             }
             if rot != 4 {
-                return Err(err(
-                    csv_text::place(kind_row.line, e.first_col),
+                return Err(ImportError::format(
+                    path,
+                    csv_text::place(rows.kind.line, e.first_col),
                     format!(
                         "expected Rotation X, Y, Z and W columns for \"{}\", found {rot} of them",
                         e.label
@@ -254,14 +344,27 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
             }
         }
     }
-    let labels = unique_labels(&entities);
+    Ok(())
+}
+
+/// Read the data rows after the `Frame` row (line `frame_line`) into one track per
+/// entity, checking the time step against the rate; also the number of frames (1 or
+/// more).
+fn read_data<'a>(
+    path: &'a Path,
+    rows: impl Iterator<Item = Row<'a>> + 'a,
+    entities: &[Entity],
+    width: usize,
+    meta: &Meta,
+    frame_line: usize,
+) -> Result<(Vec<Track>, usize), ImportError> {
+    let labels = unique_labels(entities);
     let mut tracks: Vec<Track> = entities
         .iter()
         .zip(labels)
         .map(|(_, label)| Track::empty(label))
         .collect();
-
-    // Data rows.
+    let (rate_hz, scale) = (meta.rate_hz, meta.unit.metres());
     let step = 1.0 / rate_hz;
     let mut prev_time: Option<f64> = None;
     let mut frames = 0usize;
@@ -273,7 +376,8 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         if let Some(p) = prev_time {
             let d = t - p;
             if (d - step).abs() > 0.01 * step + 2e-6 {
-                return Err(err(
+                return Err(ImportError::format(
+                    path,
                     csv_text::place(row.line, 1),
                     format!(
                         "expected a time step of {step:.6} s (the export frame rate \
@@ -299,28 +403,13 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         frames += 1;
     }
     if frames == 0 {
-        return Err(err(
-            format!("line {}", frame_row.line + 1),
-            "expected data rows after the \"Frame\" row, found none".into(),
+        return Err(ImportError::format(
+            path,
+            format!("line {}", frame_line + 1),
+            "expected data rows after the \"Frame\" row, found none",
         ));
     }
-    if let Some(n) = total_frames.filter(|&n| n != frames) {
-        return Err(err(
-            "line 1".into(),
-            format!(
-                "expected {n} data rows as \"Total Exported Frames\" says, found {frames}: the \
-                 export is truncated or was edited"
-            ),
-        ));
-    }
-    Ok(Take {
-        source: path.to_path_buf(),
-        rate_hz,
-        frames,
-        file_unit: unit.symbol().to_string(),
-        tracks,
-        notes: Vec::new(),
-    })
+    Ok((tracks, frames))
 }
 
 /// Tell the header rows apart: (Type, Name, ID if present, Rotation/Position).
@@ -328,7 +417,7 @@ fn classify_header<'r, 'a>(
     path: &Path,
     header: &'r [Row<'a>],
     frame_row: &Row,
-) -> Result<(&'r Row<'a>, &'r Row<'a>, Option<&'r Row<'a>>, &'r Row<'a>), ImportError> {
+) -> Result<HeaderRows<'r, 'a>, ImportError> {
     let tag = |r: &Row| -> String {
         let t = if r.cell(0).is_empty() {
             r.cell(1)
@@ -370,12 +459,12 @@ fn classify_header<'r, 'a>(
             format!("expected a {what} row above the \"Frame\" row, found none"),
         )
     };
-    Ok((
-        ty.ok_or_else(|| missing("Type"))?,
-        name.ok_or_else(|| missing("Name"))?,
+    Ok(HeaderRows {
+        ty: ty.ok_or_else(|| missing("Type"))?,
+        name: name.ok_or_else(|| missing("Name"))?,
         id,
-        kind.ok_or_else(|| missing("Rotation/Position"))?,
-    ))
+        kind: kind.ok_or_else(|| missing("Rotation/Position"))?,
+    })
 }
 
 /// Labels without repeats: a solved rigid-body marker sharing a measured marker's name

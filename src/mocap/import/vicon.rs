@@ -53,49 +53,30 @@ struct Columns {
 pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take, ImportError> {
     let text = csv_text::decode(bytes);
     let mut rows = csv_text::rows(&text);
-    let err = |place: String, msg: String| ImportError::format(path, place, msg);
-    let mut next_row = |what: &str, after: usize| {
-        rows.next().ok_or_else(|| {
-            ImportError::format(
-                path,
-                format!("line {}", after + 1),
-                format!("expected {what}, found the end of the file"),
-            )
-        })
-    };
-
-    // Find the section.
-    let mut line = 0;
-    loop {
-        let Ok(row) = next_row("", line) else {
-            return Err(err(
-                "whole file".into(),
-                "expected a \"Trajectories\" section (a Vicon Nexus CSV export), found none".into(),
-            ));
-        };
-        line = row.line;
-        if row.cell(0).eq_ignore_ascii_case("Trajectories") && row.used_width() == 1 {
-            break;
-        }
-    }
-
-    let rate_row = next_row("the frame rate after \"Trajectories\"", line)?;
-    let rate_hz = match csv_text::number(path, &rate_row, 0)? {
-        Some(r) if r > 0.0 => r,
-        other => {
-            return Err(err(
-                csv_text::place(rate_row.line, 0),
-                format!(
-                    "expected the frame rate in Hz, found {}",
-                    other.map_or("an empty cell".to_string(), |r| r.to_string())
-                ),
-            ));
-        }
-    };
-    let label_row = next_row("the trajectory label row", rate_row.line)?;
-    let axis_row = next_row("the row \"Frame,Sub Frame,X,Y,Z,…\"", label_row.line)?;
+    let line = find_section(&mut rows).ok_or_else(|| {
+        ImportError::format(
+            path,
+            "whole file",
+            "expected a \"Trajectories\" section (a Vicon Nexus CSV export), found none",
+        )
+    })?;
+    let rate_row = next_row(
+        path,
+        &mut rows,
+        "the frame rate after \"Trajectories\"",
+        line,
+    )?;
+    let rate_hz = frame_rate(path, &rate_row)?;
+    let label_row = next_row(path, &mut rows, "the trajectory label row", rate_row.line)?;
+    let axis_row = next_row(
+        path,
+        &mut rows,
+        "the row \"Frame,Sub Frame,X,Y,Z,…\"",
+        label_row.line,
+    )?;
     if !axis_row.cell(0).eq_ignore_ascii_case("Frame") {
-        return Err(err(
+        return Err(ImportError::format(
+            path,
             csv_text::place(axis_row.line, 0),
             format!(
                 "expected \"Frame\" (the row \"Frame,Sub Frame,X,Y,Z,…\"), found \"{}\"",
@@ -104,8 +85,84 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         ));
     }
     let width = axis_row.used_width().max(label_row.used_width());
+    let columns = trajectory_columns(path, &label_row, &axis_row, width)?;
 
-    // Trajectories.
+    // Units row (optional), then data.
+    let mut pending: Option<Row> = None;
+    let mut scales = vec![LengthUnit::Millimetre; columns.len()];
+    if let Some(row) = rows.next() {
+        if row.cell(0).is_empty() && !row.is_blank() {
+            read_units(path, &row, &columns, unit.is_some(), &mut scales)?;
+        } else {
+            pending = Some(row);
+        }
+    }
+    if let Some(u) = unit {
+        scales.iter_mut().for_each(|s| *s = u);
+    }
+    let file_unit = scales
+        .first()
+        .copied()
+        .or(unit)
+        .unwrap_or(LengthUnit::Millimetre);
+    let data = pending.into_iter().chain(rows);
+    let (tracks, frames) = read_data(path, data, &columns, &scales, width, axis_row.line)?;
+    Ok(Take {
+        source: path.to_path_buf(),
+        rate_hz,
+        frames,
+        file_unit: file_unit.symbol().to_string(),
+        tracks,
+        notes: Vec::new(),
+    })
+}
+
+/// The next row, or an error saying `what` was expected after line `after`.
+fn next_row<'a>(
+    path: &Path,
+    rows: &mut impl Iterator<Item = Row<'a>>,
+    what: &str,
+    after: usize,
+) -> Result<Row<'a>, ImportError> {
+    rows.next().ok_or_else(|| {
+        ImportError::format(
+            path,
+            format!("line {}", after + 1),
+            format!("expected {what}, found the end of the file"),
+        )
+    })
+}
+
+/// Skip to the `Trajectories` section's name row (the name alone on its line); its line
+/// number, or `None` at the end of the file.
+fn find_section<'a>(rows: &mut impl Iterator<Item = Row<'a>>) -> Option<usize> {
+    rows.find(|row| row.cell(0).eq_ignore_ascii_case("Trajectories") && row.used_width() == 1)
+        .map(|row| row.line)
+}
+
+/// The frame rate in the row after the section name, Hz (above 0).
+fn frame_rate(path: &Path, rate_row: &Row) -> Result<f64, ImportError> {
+    match csv_text::number(path, rate_row, 0)? {
+        Some(r) if r > 0.0 => Ok(r),
+        other => Err(ImportError::format(
+            path,
+            csv_text::place(rate_row.line, 0),
+            format!(
+                "expected the frame rate in Hz, found {}",
+                other.map_or("an empty cell".to_string(), |r| r.to_string())
+            ),
+        )),
+    }
+}
+
+/// Each trajectory's label and X, Y, Z columns: a label's columns run up to the next
+/// label, and of them the ones headed exactly `X`, `Y`, `Z` are its position.
+fn trajectory_columns(
+    path: &Path,
+    label_row: &Row,
+    axis_row: &Row,
+    width: usize,
+) -> Result<Vec<Columns>, ImportError> {
     let label_cols: Vec<usize> = (2..width)
         .filter(|&c| !label_row.cell(c).is_empty())
         .collect();
@@ -114,7 +171,8 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         let end = label_cols.get(i + 1).copied().unwrap_or(width);
         let find = |axis: &str| (c..end).find(|&k| axis_row.cell(k).eq_ignore_ascii_case(axis));
         let (Some(x), Some(y), Some(z)) = (find("X"), find("Y"), find("Z")) else {
-            return Err(err(
+            return Err(ImportError::format(
+                path,
                 csv_text::place(label_row.line, c),
                 format!(
                     "expected X, Y and Z columns under \"{}\" (line {}), found only some or none",
@@ -128,53 +186,60 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
             xyz: [x, y, z],
         });
     }
+    Ok(columns)
+}
 
-    // Units row (optional), then data.
-    let mut pending: Option<Row> = None;
-    let mut scales = vec![LengthUnit::Millimetre; columns.len()];
-    if let Some(row) = rows.next() {
-        let is_units = row.cell(0).is_empty() && !row.is_blank();
-        if is_units {
-            for (c, s) in columns.iter().zip(scales.iter_mut()) {
-                let cells = c.xyz.map(|k| row.cell(k));
-                let parsed = cells.map(LengthUnit::parse);
-                match parsed {
-                    [Some(a), Some(b), Some(d)] if a == b && b == d => *s = a,
-                    _ if unit.is_some() => {}
-                    _ => {
-                        return Err(err(
-                            csv_text::place(row.line, c.xyz[0]),
-                            format!(
-                                "expected the same unit mm, cm or m for X, Y and Z of \"{}\", \
-                                 found \"{}\", \"{}\", \"{}\" (give a unit override if the data \
-                                 are in one of these)",
-                                c.label, cells[0], cells[1], cells[2]
-                            ),
-                        ));
-                    }
-                }
+/// Read the units row into `scales`, one unit per trajectory (the same for its X, Y and
+/// Z); with `overridden` (a unit override given) unreadable units are let pass.
+fn read_units(
+    path: &Path,
+    row: &Row,
+    columns: &[Columns],
+    overridden: bool,
+    scales: &mut [LengthUnit],
+) -> Result<(), ImportError> {
+    for (c, s) in columns.iter().zip(scales.iter_mut()) {
+        let cells = c.xyz.map(|k| row.cell(k));
+        let parsed = cells.map(LengthUnit::parse);
+        match parsed {
+            [Some(a), Some(b), Some(d)] if a == b && b == d => *s = a,
+            _ if overridden => {}
+            _ => {
+                return Err(ImportError::format(
+                    path,
+                    csv_text::place(row.line, c.xyz[0]),
+                    format!(
+                        "expected the same unit mm, cm or m for X, Y and Z of \"{}\", found \
+                         \"{}\", \"{}\", \"{}\" (give a unit override if the data are in one of \
+                         these)",
+                        c.label, cells[0], cells[1], cells[2]
+                    ),
+                ));
             }
-        } else {
-            pending = Some(row);
         }
     }
-    if let Some(u) = unit {
-        scales.iter_mut().for_each(|s| *s = u);
-    }
-    let file_unit = scales
-        .first()
-        .copied()
-        .or(unit)
-        .unwrap_or(LengthUnit::Millimetre);
+    Ok(())
+}
 
+/// Read the data rows up to a blank line or the next section's name into one track per
+/// trajectory (positions in metres from `scales`); also the number of frames (1 or more).
+/// Frame numbers must rise by one per row; `axis_line` is the line of the `Frame` row.
+fn read_data<'a>(
+    path: &Path,
+    rows: impl Iterator<Item = Row<'a>>,
+    columns: &[Columns],
+    scales: &[LengthUnit],
+    width: usize,
+    axis_line: usize,
+) -> Result<(Vec<Track>, usize), ImportError> {
     let mut tracks: Vec<Track> = columns
         .iter()
         .map(|c| Track::empty(c.label.clone()))
         .collect();
     let mut prev_frame: Option<f64> = None;
     let mut frames = 0usize;
-    let mut last_line = axis_row.line;
-    for row in pending.into_iter().chain(rows) {
+    let mut last_line = axis_line;
+    for row in rows {
         last_line = row.line;
         // A blank line or the next section's name ends the section.
         if row.is_blank() || is_section_name(row.cell(0)) {
@@ -185,7 +250,8 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         if let Some(p) = prev_frame
             && frame != p + 1.0
         {
-            return Err(err(
+            return Err(ImportError::format(
+                path,
                 csv_text::place(row.line, 0),
                 format!(
                     "expected frame {} after frame {p} (one row per frame), found {frame}",
@@ -194,7 +260,7 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
             ));
         }
         prev_frame = Some(frame);
-        for ((c, track), s) in columns.iter().zip(tracks.iter_mut()).zip(&scales) {
+        for ((c, track), s) in columns.iter().zip(tracks.iter_mut()).zip(scales) {
             track
                 .positions
                 .push(csv_text::position(path, &row, c.xyz, s.metres())?);
@@ -202,19 +268,13 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         frames += 1;
     }
     if frames == 0 {
-        return Err(err(
+        return Err(ImportError::format(
+            path,
             format!("line {}", last_line),
-            "expected data rows in the Trajectories section, found none".into(),
+            "expected data rows in the Trajectories section, found none",
         ));
     }
-    Ok(Take {
-        source: path.to_path_buf(),
-        rate_hz,
-        frames,
-        file_unit: file_unit.symbol().to_string(),
-        tracks,
-        notes: Vec::new(),
-    })
+    Ok((tracks, frames))
 }
 
 #[cfg(test)]

@@ -3,12 +3,12 @@
 //! posture and gains, and the stick-tip RMS error is reported per mode with its standard
 //! deviation across trials.
 
-use super::model::BodyModel;
-use super::sim::{Motion, Pipeline, Reference, SimParams, rms_error, simulate};
-use super::skeleton::JOINT_COUNT;
+use crate::base::rng::Rng;
+use crate::body::model::BodyModel;
+use crate::body::sim::{Motion, Pipeline, Reference, SimError, SimParams, rms_error, simulate};
+use crate::body::skeleton::JOINT_COUNT;
 use crate::kit::Side;
 use crate::mocap::db::{MotionDb, UnitEntry};
-use crate::rng::Rng;
 use crate::score::{Dynamic, Grip, ImpactLocation, PlayingMode};
 use glam::DQuat;
 use serde::Serialize;
@@ -18,7 +18,7 @@ use serde::Serialize;
 /// anthropometry only approximates the performer's, so replaying captured joint angles
 /// (ID) misplaces the tips while tracking the tips (HIMC) does not.
 pub fn simulated_body() -> BodyModel {
-    BodyModel::new(super::skeleton::Skeleton::new(1.72, 0.37), 69.0)
+    BodyModel::new(crate::body::skeleton::Skeleton::new(1.72, 0.37), 69.0)
 }
 
 /// How trials are randomised.
@@ -106,17 +106,40 @@ pub fn units_for(db: &MotionDb, mode: PlayingMode, count: usize) -> Vec<&UnitEnt
         .collect()
 }
 
+/// A pipeline lost control of a captured stroke.
+#[derive(Debug, thiserror::Error)]
+#[error("{pipeline}: {source}")]
+pub struct PipelineFailed {
+    pub pipeline: &'static str,
+    #[source]
+    pub source: SimError,
+}
+
+/// Why the evaluation stopped.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum EvalError {
+    /// A pipeline failed on a stroke of `mode` in trial `trial`.
+    #[error("{mode} trial {trial}: {source}")]
+    Trial {
+        mode: &'static str,
+        trial: usize,
+        #[source]
+        source: PipelineFailed,
+    },
+}
+
 /// Run one trial of every pipeline on `reference`; `Err` names the pipeline that failed.
 pub fn trial(
     model: &BodyModel,
     reference: &Reference,
     params: &EvalParams,
     rng: &mut Rng,
-) -> Result<[Motion; 3], String> {
+) -> Result<[Motion; 3], PipelineFailed> {
     let start = reference
         .poses
         .as_ref()
-        .map_or(super::skeleton::REST, |p| p[0]);
+        .map_or(crate::body::skeleton::REST, |p| p[0]);
     let initial: [DQuat; JOINT_COUNT] = std::array::from_fn(|j| {
         let axis =
             glam::DVec3::new(rng.normal(), rng.normal(), rng.normal()).normalize_or(glam::DVec3::X);
@@ -126,14 +149,22 @@ pub fn trial(
     let scale: [f64; JOINT_COUNT] =
         std::array::from_fn(|_| rng.uniform(1.0 - params.gain_spread, 1.0 + params.gain_spread));
     let run = |p: Pipeline| {
-        simulate(model, reference, p, &params.sim, &initial, &scale)
-            .map_err(|e| format!("{}: {e}", p.name()))
+        simulate(model, reference, p, &params.sim, &initial, &scale).map_err(|source| {
+            PipelineFailed {
+                pipeline: p.name(),
+                source,
+            }
+        })
     };
     Ok([run(Pipeline::Ik)?, run(Pipeline::Id)?, run(Pipeline::Himc)?])
 }
 
 /// Evaluate every playing mode on `db`.
-pub fn evaluate(db: &MotionDb, model: &BodyModel, params: &EvalParams) -> Result<Report, String> {
+pub fn evaluate(
+    db: &MotionDb,
+    model: &BodyModel,
+    params: &EvalParams,
+) -> Result<Report, EvalError> {
     let root = Rng::new(params.seed);
     let mut modes = Vec::new();
     for (m, mode) in PlayingMode::ALL.into_iter().enumerate() {
@@ -156,8 +187,12 @@ pub fn evaluate(db: &MotionDb, model: &BodyModel, params: &EvalParams) -> Result
             let mut rng = root.fork((m * 1000 + t) as u64);
             let mut sums = [0.0; 3];
             for r in &references {
-                let motions = trial(model, r, params, &mut rng)
-                    .map_err(|e| format!("{} trial {t}: {e}", mode.name()))?;
+                let motions =
+                    trial(model, r, params, &mut rng).map_err(|source| EvalError::Trial {
+                        mode: mode.name(),
+                        trial: t,
+                        source,
+                    })?;
                 for (p, motion) in motions.iter().enumerate() {
                     sums[p] += rms_error(&motion.tips[1], &r.tips[1]) / references.len() as f64;
                 }

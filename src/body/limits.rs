@@ -141,7 +141,7 @@ pub fn symmetric_eigen(m: DMat3) -> ([f64; 3], [DVec3; 3]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rng::Rng;
+    use crate::base::rng::Rng;
 
     /// Jacobi recovers a known symmetric matrix's eigen-decomposition.
     #[test]

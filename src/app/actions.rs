@@ -1,0 +1,85 @@
+//! Carrying out what the panels and the keyboard asked this frame: the queued
+//! [`Command`]s are drained once, score changes go through the document's history, and a
+//! changed score is sent to the pipeline once, however many edits the frame made.
+
+use super::command::Command;
+use super::keys::Action;
+use super::selection::Selection;
+use super::{AfterConfirm, EditorApp};
+
+impl EditorApp {
+    /// Apply the queued commands (once per frame).
+    pub(super) fn drain(&mut self) {
+        let mut edited = false;
+        for cmd in std::mem::take(&mut self.pending) {
+            match cmd {
+                Command::Gesture => {
+                    if let Some(d) = &mut self.doc {
+                        d.begin_gesture();
+                    }
+                }
+                Command::Edit(e) => {
+                    if let Some(d) = &mut self.doc {
+                        d.apply(e);
+                        edited = true;
+                    }
+                }
+                Command::Select(s) => {
+                    if let Some(d) = &mut self.doc {
+                        d.selection = s;
+                    }
+                }
+                Command::Do(a) => edited |= self.act(a),
+                Command::Seek(t) => self.transport.seek(t),
+                Command::SetLoop(r) => self.transport.set_loop(r),
+            }
+        }
+        if edited {
+            if let Some(d) = &mut self.doc {
+                d.clamp_selection();
+            }
+            self.recompose();
+        }
+    }
+
+    /// Do `action`; true if the score changed.
+    fn act(&mut self, action: Action) -> bool {
+        match action {
+            Action::PlayPause => {
+                if let Some(status) = self.transport.play_pause() {
+                    self.messages.status = status;
+                }
+            }
+            Action::New => self.after_confirm(AfterConfirm::New),
+            Action::Open => self.after_confirm(AfterConfirm::OpenDialog),
+            Action::Save => {
+                self.save(false);
+            }
+            Action::SaveAs => {
+                self.save(true);
+            }
+            Action::ToggleHelp => self.views.show_help = !self.views.show_help,
+            Action::ClearSelection => {
+                if let Some(d) = &mut self.doc {
+                    d.selection = Selection::default();
+                }
+                self.views.show_help = false;
+            }
+            edit => return self.edit(edit),
+        }
+        false
+    }
+
+    /// Do an editing action on the document; true if the score changed.
+    fn edit(&mut self, action: Action) -> bool {
+        let Some(doc) = &mut self.doc else {
+            return false;
+        };
+        let grid = self.views.timeline.grid_ticks(&doc.loaded);
+        let outcome = doc.act(action, grid, self.transport.playhead_s, &mut self.clipboard);
+        if let Some(status) = outcome.status {
+            self.messages.status = status;
+        }
+        outcome.changed
+    }
+}

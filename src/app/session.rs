@@ -1,0 +1,278 @@
+//! The document's life in the window: opening (files, drops, the demo, new scores),
+//! saving and exporting through background jobs, asking before unsaved changes are lost,
+//! and quitting only once every file being written is written. Also where the pipeline's
+//! and the jobs' results are taken in, once per frame.
+
+use super::document::Document;
+use super::export::{self, Export};
+use super::files::{self, FileKind, kind_of};
+use super::jobs::{Done, Finished};
+use super::{AfterConfirm, DEMO_SCORE_PATH, DEMO_SCORE_TEXT, EditorApp};
+use crate::kit::Kit;
+use crate::score::{LoadedScore, Score};
+use eframe::egui;
+use std::path::{Path, PathBuf};
+
+impl EditorApp {
+    pub(super) fn open_demo(&mut self) {
+        let on_disk = Path::new(DEMO_SCORE_PATH);
+        if on_disk.exists() {
+            return self.open_path(on_disk);
+        }
+        match LoadedScore::parse(on_disk, DEMO_SCORE_TEXT) {
+            Ok(loaded) => {
+                self.set_document(loaded, None);
+                self.messages.status = "opened the bundled demo score".into();
+            }
+            Err(e) => self.messages.error = Some(e.to_string()),
+        }
+    }
+
+    fn set_document(&mut self, loaded: LoadedScore, path: Option<PathBuf>) {
+        self.doc = Some(Document::new(loaded, path));
+        self.transport.reset();
+        self.views.timeline.fit();
+        self.views.simulated = None;
+        self.messages.error = None;
+        self.pipeline.forget_rendering();
+        self.recompose();
+    }
+
+    /// Ask the pipeline for the score as it is now.
+    pub(super) fn recompose(&mut self) {
+        match &self.doc {
+            Some(d) => self.pipeline.request(&d.loaded),
+            None => self.pipeline.clear(),
+        }
+    }
+
+    /// Take what the pipeline and the writing jobs finished.
+    pub(super) fn take_results(&mut self) {
+        if let Some(r) = self.pipeline.poll() {
+            self.views.simulated = Some(r.simulated);
+            self.messages.status = r.summary;
+            // Swaps are seamless (a crossfade under the playhead), so every rendering is
+            // heard at once, a new version or more of the one playing.
+            if let Err(e) = self.transport.load(&r.rendering) {
+                self.pipeline.playback_failed(format!("playback: {e}"));
+            }
+        }
+        for finished in self.jobs.poll() {
+            self.job_finished(finished);
+        }
+    }
+
+    pub(super) fn job_finished(&mut self, Finished { done, result }: Finished) {
+        match result {
+            Ok(status) => self.messages.status = status,
+            Err(e) => {
+                self.messages.error = Some(e.to_string());
+                self.after_save = None;
+                self.quitting = false;
+                return;
+            }
+        }
+        if let Done::Saved { path, revision } = done {
+            if let Some(doc) = &mut self.doc {
+                doc.mark_saved(revision, path.clone());
+            }
+            if let Err(e) = self.recent.add(&path) {
+                self.messages.status = e.to_string();
+            }
+            if let Some(what) = self.after_save.take() {
+                self.run_confirmed(what);
+            }
+        }
+    }
+
+    /// Open a score (`.ron`) or import a MIDI file (`.mid`); errors go to the window.
+    /// Unsaved changes are dropped (the UI asks first).
+    pub fn open_path(&mut self, path: &Path) {
+        match files::read(path) {
+            Ok(opened) => {
+                self.set_document(opened.loaded, opened.path.clone());
+                self.messages.status = opened.message;
+                if let Some(p) = &opened.path
+                    && let Err(e) = self.recent.add(p)
+                {
+                    self.messages.status = e.to_string();
+                }
+            }
+            Err(e) => self.messages.error = Some(e.to_string()),
+        }
+    }
+
+    /// Handle a file dropped on the window: scores open, MIDI files import, anything else
+    /// is an error shown in the window. Asks first if there are unsaved changes.
+    pub fn handle_dropped(&mut self, path: &Path) {
+        match kind_of(path) {
+            FileKind::Other => {
+                self.messages.error = Some(format!(
+                    "{}: drop a score (.ron) or a MIDI file (.mid)",
+                    path.display()
+                ))
+            }
+            _ => self.after_confirm(AfterConfirm::Open(path.to_path_buf())),
+        }
+    }
+
+    /// Save the score to `path` (Save As without a dialog) on a background job; the
+    /// outcome goes to the status bar, or the error to the window.
+    pub fn save_to(&mut self, path: &Path) {
+        let Some(doc) = &self.doc else { return };
+        let text = doc.loaded.score.to_ron();
+        let target = path.to_path_buf();
+        let done = Done::Saved {
+            path: target.clone(),
+            revision: doc.revision(),
+        };
+        self.jobs
+            .spawn(format!("saving {}", path.display()), done, move || {
+                crate::base::ron_file::write_atomic(&target, text.as_bytes())
+                    .map(|()| format!("saved {}", target.display()))
+            });
+    }
+
+    /// Save where the score is saved, or ask where (always with `ask`); false if the user
+    /// cancelled the dialog.
+    pub(super) fn save(&mut self, ask: bool) -> bool {
+        let Some(doc) = &self.doc else { return false };
+        let target = match (&doc.path, ask) {
+            (Some(p), false) => Some(p.clone()),
+            _ => rfd::FileDialog::new()
+                .add_filter("timpanist score", &["ron"])
+                .save_file(),
+        };
+        match target {
+            Some(t) => {
+                self.save_to(&t);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Export `what` to `path` on a background job (File > Export without the dialog);
+    /// refused with the reason when there is nothing current to export.
+    pub fn export_to(&mut self, what: Export, path: &Path) {
+        let Some(doc) = &self.doc else {
+            self.messages.error = Some("cannot export: no score is open".into());
+            return;
+        };
+        if let Some(why) = what
+            .needs_rendering()
+            .then(|| self.export_blocked())
+            .flatten()
+        {
+            self.messages.error = Some(format!("cannot export: {why}"));
+            return;
+        }
+        let score = doc.loaded.score.clone();
+        let kit = score.settings.kit(&doc.loaded.kit).into_owned();
+        let rendering = self.pipeline.rendering().map(|(r, _)| r.clone());
+        let target = path.to_path_buf();
+        let label = format!("exporting {}", path.display());
+        self.jobs.spawn(label, Done::Exported, move || {
+            export::write(what, (&score, &kit), rendering.as_deref(), &target)
+        });
+    }
+
+    /// Ask where to export, then export.
+    pub(super) fn export_dialog(&mut self, what: Export) {
+        let Some(doc) = &self.doc else { return };
+        if let Some(p) = export::ask_path(what, doc.path.as_deref(), &doc.loaded.score.title) {
+            self.export_to(what, &p);
+        }
+    }
+
+    fn new_document(&mut self) {
+        let kit = Kit::bundled("standard").expect("the standard kit is bundled");
+        let loaded = LoadedScore {
+            score: Score::new("Untitled"),
+            kit,
+            kit_source: "bundled kit \"standard\"".into(),
+            notices: Vec::new(),
+        };
+        self.set_document(loaded, None);
+        self.messages.status = "new score".into();
+    }
+
+    /// Ask to quit: true if the editor may close now. With unsaved changes it asks first;
+    /// while files are being written it waits for them, then closes.
+    pub fn request_quit(&mut self) -> bool {
+        if self.jobs.is_busy() {
+            self.quitting = true;
+            false
+        } else if self.is_dirty() {
+            self.quitting = false;
+            self.confirm = Some(AfterConfirm::Quit);
+            false
+        } else {
+            true
+        }
+    }
+
+    /// Run `what` now, or ask first when there are unsaved changes.
+    pub(super) fn after_confirm(&mut self, what: AfterConfirm) {
+        if self.is_dirty() {
+            self.confirm = Some(what);
+        } else {
+            self.run_confirmed(what);
+        }
+    }
+
+    fn run_confirmed(&mut self, what: AfterConfirm) {
+        match what {
+            AfterConfirm::Quit => {
+                self.quitting = true;
+                if let Some(ctx) = &self.ctx
+                    && !self.jobs.is_busy()
+                {
+                    ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+                }
+            }
+            AfterConfirm::New => self.new_document(),
+            AfterConfirm::Open(p) => self.open_path(&p),
+            AfterConfirm::OpenDialog => {
+                if let Some(p) = rfd::FileDialog::new()
+                    .add_filter("score or MIDI", &["ron", "mid", "midi"])
+                    .pick_file()
+                {
+                    self.open_path(&p);
+                }
+            }
+        }
+    }
+
+    /// The "unsaved changes" answer: save first (then go on once saved), discard, or
+    /// cancel.
+    pub(super) fn answer_confirm(&mut self, answer: ConfirmAnswer) {
+        let Some(what) = self.confirm.take() else {
+            return;
+        };
+        match answer {
+            ConfirmAnswer::Save => {
+                if self.save(false) {
+                    self.after_save = Some(what);
+                } else {
+                    self.confirm = Some(what);
+                }
+            }
+            ConfirmAnswer::Discard => {
+                if let Some(d) = &mut self.doc {
+                    d.history.set_saved();
+                }
+                self.run_confirmed(what);
+            }
+            ConfirmAnswer::Cancel => {}
+        }
+    }
+}
+
+/// The answers to "unsaved changes".
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ConfirmAnswer {
+    Save,
+    Discard,
+    Cancel,
+}

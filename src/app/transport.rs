@@ -1,0 +1,129 @@
+//! The transport: the playhead, the loop region and the playback clock it follows, and
+//! Space's rule — play at once if the audio past the playhead is rendered, else wait for
+//! it (the rendering worker delivers the edited part first, then the rest).
+
+use super::playback::{Playback, PlaybackError};
+use super::tape::StereoSource;
+use crate::render::Rendering;
+use crate::score::Score;
+use std::sync::Arc;
+
+/// Space plays at once only if this much audio past the playhead is ready, s.
+const PLAY_AHEAD_S: f64 = 0.3;
+
+/// Where playback is and what it plays.
+pub struct Transport {
+    pub playback: Playback,
+    /// The playhead, s.
+    pub playhead_s: f64,
+    /// The loop region, ticks.
+    pub loop_ticks: Option<(u64, u64)>,
+    pub looping: bool,
+    /// Score time up to which the audio given to playback is final, s (infinite once a
+    /// whole rendering, or none, is in).
+    audio_ready_s: f64,
+    /// Space was pressed where the audio is not ready yet: play once it is.
+    waiting_to_play: bool,
+}
+
+impl Transport {
+    /// Stopped at 0 s on `playback`.
+    pub fn new(playback: Playback) -> Transport {
+        Transport {
+            playback,
+            playhead_s: 0.0,
+            loop_ticks: None,
+            looping: false,
+            audio_ready_s: f64::INFINITY,
+            waiting_to_play: false,
+        }
+    }
+
+    /// Stop and go back to the start, with no loop (a new document).
+    pub fn reset(&mut self) {
+        self.playback.pause();
+        self.playback.seek(0.0);
+        self.playhead_s = 0.0;
+        self.loop_ticks = None;
+        self.waiting_to_play = false;
+    }
+
+    /// Move the playhead to `t_s` (clamped at 0), s.
+    pub fn seek(&mut self, t_s: f64) {
+        self.playhead_s = t_s.max(0.0);
+        self.playback.seek(self.playhead_s);
+    }
+
+    /// Set or clear the loop region, ticks.
+    pub fn set_loop(&mut self, region: Option<(u64, u64)>) {
+        self.loop_ticks = region;
+        self.looping = region.is_some();
+    }
+
+    /// Space: pause, cancel a wait, wait for audio not yet rendered, or play. Returns a
+    /// message for the status bar, if any.
+    pub fn play_pause(&mut self) -> Option<String> {
+        if self.playback.is_playing() {
+            self.playback.pause();
+            self.playhead_s = self.playback.position_s();
+            None
+        } else if self.waiting_to_play {
+            self.waiting_to_play = false;
+            Some("playback cancelled".into())
+        } else if self.playhead_s + PLAY_AHEAD_S > self.audio_ready_s {
+            self.waiting_to_play = true;
+            Some(format!(
+                "waiting for the audio at {:.1} s (ready to {:.1} s)",
+                self.playhead_s, self.audio_ready_s
+            ))
+        } else {
+            self.playback.play_from(self.playhead_s);
+            None
+        }
+    }
+
+    /// Play `rendering`'s audio (shared, not copied), and start playing if Space waits
+    /// for audio that is now ready.
+    pub fn load(&mut self, rendering: &Arc<Rendering>) -> Result<(), PlaybackError> {
+        let ready_s = if rendering.complete {
+            f64::INFINITY
+        } else {
+            rendering.ready_s
+        };
+        self.playback
+            .set_audio(Arc::clone(rendering) as Arc<dyn StereoSource>)?;
+        self.audio_ready_s = ready_s;
+        if self.waiting_to_play && self.playhead_s + PLAY_AHEAD_S <= self.audio_ready_s {
+            self.waiting_to_play = false;
+            self.playback.play_from(self.playhead_s);
+        }
+        Ok(())
+    }
+
+    /// Whether Space waits for audio not yet rendered.
+    pub fn is_waiting_to_play(&self) -> bool {
+        self.waiting_to_play
+    }
+
+    /// Follow the playback clock through `score`: move the playhead, wrap at the loop end,
+    /// stop past the end. The tick at the playhead while playing (for the timeline).
+    pub fn follow(&mut self, score: Option<&Score>) -> Option<f64> {
+        if !self.playback.is_playing() {
+            return None;
+        }
+        self.playhead_s = self.playback.position_s();
+        let score = score?;
+        let map = score.tempo_map();
+        if self.looping
+            && let Some((a, b)) = self.loop_ticks
+            && self.playhead_s >= map.seconds_at(b as f64)
+        {
+            let start = map.seconds_at(a as f64);
+            self.playback.play_from(start);
+            self.playhead_s = start;
+        } else if self.playhead_s > score.duration_s() + 1.0 {
+            self.playback.pause();
+        }
+        Some(map.tick_at(self.playhead_s))
+    }
+}

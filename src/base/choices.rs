@@ -1,0 +1,112 @@
+//! The choices a score's settings make and the layers above carry out: the control
+//! pipeline (IK, ID or HIMC, seed 000 §3), the IK method, where membrane mode frequencies
+//! come from, how many modes a head has, and the sound model. Named here, below the
+//! score, so the score can save them without importing the physics or the sound.
+
+use std::fmt;
+use std::str::FromStr;
+
+/// A name that names none of the choices (e.g. `--sound loud`).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown {what} `{name}` (expected {expected})")]
+pub struct UnknownName {
+    /// What kind of choice was asked for, e.g. "sound model".
+    pub what: &'static str,
+    pub name: String,
+    /// The names that would do, e.g. "modal, sample or signal".
+    pub expected: &'static str,
+}
+
+/// A control pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Pipeline {
+    Ik,
+    Id,
+    Himc,
+}
+
+impl Pipeline {
+    /// Lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Pipeline::Ik => "ik",
+            Pipeline::Id => "id",
+            Pipeline::Himc => "himc",
+        }
+    }
+}
+
+/// How each iteration turns the tip error into joint steps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum IkMethod {
+    /// Δθ = α·Jᵀe (α chosen by the optimal step along Jᵀe).
+    Transpose,
+    /// Δθ = Jᵀ(JJᵀ)⁻¹e.
+    PseudoInverse,
+    /// Δθ = Jᵀ(JJᵀ + λ²I)⁻¹e.
+    DampedLeastSquares,
+}
+
+/// Default number of mode orientations per head.
+pub const DEFAULT_MODE_COUNT: usize = 24;
+/// Largest number of mode orientations per head.
+pub const MAX_MODE_COUNT: usize = 200;
+
+/// Where mode frequencies come from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum FrequencySource {
+    /// The kit's measured ratios to the (1,1) for the modes it lists (kettledrum
+    /// 1.50, 1.98, 2.44, 2.94 by default), the in-vacuo membrane for the others.
+    #[default]
+    Measured,
+    /// The ideal membrane, f_mn = air_loading · j_mn/(2πa) · √(T/σ), for every mode.
+    Membrane,
+}
+
+/// Which sound model renders.
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
+)]
+pub enum SoundModel {
+    /// Modal voices driven by the simulated contact force.
+    #[default]
+    Modal,
+    /// A recorded note per drum, pitched and scaled by impact speed.
+    Sample,
+    /// Decaying partials at the kit's modes plus a noise burst.
+    Signal,
+}
+
+impl SoundModel {
+    /// Every model with its command-line name.
+    pub const ALL: [(SoundModel, &'static str); 3] = [
+        (SoundModel::Modal, "modal"),
+        (SoundModel::Sample, "sample"),
+        (SoundModel::Signal, "signal"),
+    ];
+}
+
+impl fmt::Display for SoundModel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let name = Self::ALL
+            .iter()
+            .find(|(m, _)| m == self)
+            .map_or("?", |(_, n)| n);
+        f.write_str(name)
+    }
+}
+
+impl FromStr for SoundModel {
+    type Err = UnknownName;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .iter()
+            .find(|(_, n)| n.eq_ignore_ascii_case(s.trim()))
+            .map(|(m, _)| *m)
+            .ok_or_else(|| UnknownName {
+                what: "sound model",
+                name: s.to_string(),
+                expected: "modal, sample or signal",
+            })
+    }
+}

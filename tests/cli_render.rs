@@ -1,0 +1,142 @@
+//! `timpanist render` and `timpanist edit` as a user runs them: the render writes WAV,
+//! motion (CSV, C3D), events and a plot, and refuses bad scores cleanly. These also run
+//! against the headless build (`--no-default-features`), whose `edit` says how to get the
+//! editor instead of opening it.
+
+use std::path::Path;
+use std::process::Command;
+use timpanist::score::{Beat, Hand, ImpactLocation, Score};
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// `timpanist render` writes a WAV, the motion CSV and C3D, the events JSON with the
+/// issue's fields and a PNG plot, and prints its statistics.
+#[test]
+fn cli_render_writes_wav_motion_and_events() {
+    let dir = tempfile::tempdir().unwrap();
+    let (wav, csv, json, png) = (
+        dir.path().join("out.wav"),
+        dir.path().join("motion.csv"),
+        dir.path().join("events.json"),
+        dir.path().join("plot.png"),
+    );
+    let out = Command::new(env!("CARGO_BIN_EXE_timpanist"))
+        .current_dir(root())
+        .args(["render", "scores/improvisation.ron", "--stats", "--wav"])
+        .arg(&wav)
+        .arg("--motion")
+        .arg(&csv)
+        .arg("--c3d")
+        .arg(dir.path().join("motion.c3d"))
+        .arg("--events")
+        .arg(&json)
+        .arg("--plot")
+        .arg(&png)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("real time") && stdout.contains("drums"),
+        "{stdout}"
+    );
+    let reader = hound::WavReader::open(&wav).unwrap();
+    assert_eq!(
+        (reader.spec().sample_rate, reader.spec().channels),
+        (48_000, 2)
+    );
+    let events: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let first = &events.as_array().unwrap()[0];
+    for key in [
+        "beat",
+        "hand",
+        "drum",
+        "scheduled_s",
+        "contact_s",
+        "duration_ms",
+        "peak_force_n",
+        "impact_speed_mps",
+        "x_m",
+        "y_m",
+    ] {
+        assert!(first.get(key).is_some(), "{key} missing in {first}");
+    }
+    let motion = std::fs::read_to_string(&csv).unwrap();
+    assert!(motion.starts_with("time_s,left_tip_x_m"));
+    assert!(motion.lines().count() > 250);
+    let c3d = dir.path().join("motion.c3d");
+    let take =
+        timpanist::mocap::import::c3d::read(&c3d, &std::fs::read(&c3d).unwrap(), None).unwrap();
+    assert_eq!(
+        take.frames,
+        motion.lines().count() - 1,
+        "a frame per CSV row"
+    );
+    assert!(take.track("LTIP_TARGET").is_some() && take.track("ELBOW_R").is_some());
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+}
+
+/// A malformed score, or one with a stroke out of reach, fails with its name and the
+/// place or beat, a non-zero exit, and no WAV.
+#[test]
+fn cli_render_refuses_bad_scores_cleanly() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.ron");
+    std::fs::write(&bad, "Score(version: 2, title: \"x\", beats: [oops])").unwrap();
+    let wav = dir.path().join("out.wav");
+    // Renders `score`: it must fail, write no WAV, and say why (returned).
+    let refused = |score: &Path| {
+        let out = Command::new(env!("CARGO_BIN_EXE_timpanist"))
+            .current_dir(root())
+            .arg("render")
+            .arg(score)
+            .arg("--wav")
+            .arg(&wav)
+            .output()
+            .unwrap();
+        assert!(!out.status.success());
+        assert!(!wav.exists());
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let stderr = refused(&bad);
+    assert!(stderr.contains("bad.ron:1:"), "{stderr}");
+
+    // A stroke the body cannot reach: the right hand on the far-left drum's centre.
+    let mut score = Score::new("reach");
+    let mut beat = Beat::plain(960, 0);
+    beat.hand = Hand::Right;
+    beat.location = ImpactLocation::Centre;
+    score.beats.push(beat);
+    let far = dir.path().join("far.ron");
+    score.save(&far).unwrap();
+    let stderr = refused(&far);
+    assert!(
+        stderr.contains("far.ron: beat 0 is out of the right hand's reach"),
+        "{stderr}"
+    );
+}
+
+/// Without the `editor` feature, `timpanist edit` fails at once and says how to get the
+/// editor (with it, the editor would open a window: not run here).
+#[cfg(not(feature = "editor"))]
+#[test]
+fn headless_edit_says_how_to_get_the_editor() {
+    let out = Command::new(env!("CARGO_BIN_EXE_timpanist"))
+        .args(["edit", "scores/etude-modes.ron"])
+        .current_dir(root())
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("built without the editor") && stderr.contains("cargo"),
+        "{stderr}"
+    );
+}
