@@ -10,7 +10,7 @@ use crate::io::plot::{Figure, Panel, Series};
 use crate::io::{motion_c3d, motion_csv};
 use crate::mocap::db::MotionDb;
 use crate::motion::plan::PlanParams;
-use crate::render::{Progress, RenderParams, Rendering, render};
+use crate::render::{Progress, RenderParams, Rendering, render, strikes};
 use crate::score::LoadedScore;
 use crate::sound::SoundModel;
 use plotters::style::RGBColor;
@@ -198,6 +198,26 @@ fn print_stats(r: &Rendering) {
         t.missed,
         t.strokes,
         r.audio.gain
+    );
+    let forces = strikes::forces_by_dynamic(&r.events);
+    let recontacts: usize = forces.iter().map(|f| f.recontacts).sum();
+    println!("force by dynamic (peak force of each stroke's contact; re-contacts ≥ 5 N after it):");
+    for f in &forces {
+        println!(
+            "  {:>2}: {:3} strokes, median {:6.1} N ({:+4.0} % to {:+4.0} %), contact {:.1}–{:.1} ms, {} re-contacts",
+            f.dynamic,
+            f.strokes,
+            f.median_n,
+            (f.low - 1.0) * 100.0,
+            (f.high - 1.0) * 100.0,
+            f.shortest_ms,
+            f.longest_ms,
+            f.recontacts
+        );
+    }
+    println!(
+        "re-contacts: {recontacts} after {} strokes",
+        forces.iter().map(|f| f.strokes).sum::<usize>()
     );
 }
 

@@ -1,7 +1,9 @@
 //! Which simulated contact is which scored stroke, and the per-contact event records
 //! (`timpanist render --events`): a stroke's contact is the first strong touch of its
 //! hand on its drum near its scheduled time; other touches (rebounds, double bounces) are
-//! events with no beat.
+//! events with no beat, and the strong ones after a stroke's contact count as its
+//! *re-contacts* (the stick falling back onto the head: heard as a buzz or a flam).
+//! Also the per-dynamic force report of `timpanist render --stats`.
 
 use crate::drum::ContactEvent;
 use crate::kit::Side;
@@ -15,6 +17,9 @@ pub const MATCH_WINDOW_S: f64 = 0.06;
 /// A stroke's contact is the first touch in its window whose peak force is at least this fraction
 /// of the strongest there (a weaker earlier one is a graze; later ones are bounces).
 const MAIN_FRACTION: f64 = 0.2;
+
+/// A touch after a stroke's contact counts as a re-contact from this peak force, N.
+pub const RECONTACT_MIN_N: f64 = 5.0;
 
 /// One contact of a stick with a head, as written by `--events` (times in score seconds).
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -35,6 +40,13 @@ pub struct StrikeEvent {
     /// Where it first touched, performer frame, m.
     pub x_m: f64,
     pub y_m: f64,
+    /// For a stroke's contact: the touches of at least [`RECONTACT_MIN_N`] by the same
+    /// stick on the same drum after it and before the hand's next stroke (0 for a clean
+    /// stroke; always 0 for a rebound's own event).
+    pub recontacts: usize,
+    /// The stroke's playing mode and nearest dynamic marking (`null` for a rebound).
+    pub mode: Option<&'static str>,
+    pub dynamic: Option<&'static str>,
 }
 
 /// For each stroke, the index of its contact in `contacts` (whose times are in score
@@ -118,10 +130,72 @@ pub fn events(
             impact_speed_mps: c.impact_speed_mps,
             x_m: c.point.x,
             y_m: c.point.y,
+            recontacts: 0,
+            mode: s.map(|i| strokes[i].mode.name()),
+            dynamic: s.map(|i| strokes[i].dynamic.nearest_mark()),
         })
         .collect();
     out.sort_by(|a, b| a.contact_s.total_cmp(&b.contact_s));
+    count_recontacts(&mut out);
     out
+}
+
+/// Set each stroke event's [`StrikeEvent::recontacts`] (`events` in time order).
+fn count_recontacts(events: &mut [StrikeEvent]) {
+    for i in 0..events.len() {
+        if events[i].beat.is_none() {
+            continue;
+        }
+        let (hand, drum) = (events[i].hand, events[i].drum);
+        events[i].recontacts = events[i + 1..]
+            .iter()
+            .filter(|e| e.hand == hand)
+            .take_while(|e| e.beat.is_none())
+            .filter(|e| e.drum == drum && e.peak_force_n >= RECONTACT_MIN_N)
+            .count();
+    }
+}
+
+/// The peak forces of the strokes of one dynamic marking.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DynamicForces {
+    /// The nearest marking, e.g. "mf".
+    pub dynamic: &'static str,
+    pub strokes: usize,
+    /// Median peak force of the strokes' contacts, N.
+    pub median_n: f64,
+    /// The lowest and highest peak force as a fraction of the median (0.8 = 20 % below).
+    pub low: f64,
+    pub high: f64,
+    /// Shortest and longest contact, ms.
+    pub shortest_ms: f64,
+    pub longest_ms: f64,
+    /// Re-contacts after these strokes (see [`StrikeEvent::recontacts`]).
+    pub recontacts: usize,
+}
+
+/// Per dynamic marking, soft to loud, the force of the strokes that sounded in `events`.
+pub fn forces_by_dynamic(events: &[StrikeEvent]) -> Vec<DynamicForces> {
+    crate::score::Dynamic::MARKS
+        .iter()
+        .filter_map(|&(_, _, mark)| {
+            let of: Vec<&StrikeEvent> = events.iter().filter(|e| e.dynamic == Some(mark)).collect();
+            let mut forces: Vec<f64> = of.iter().map(|e| e.peak_force_n).collect();
+            forces.sort_by(f64::total_cmp);
+            let median = *forces.get(forces.len() / 2)?;
+            let durations = of.iter().map(|e| e.duration_ms);
+            Some(DynamicForces {
+                dynamic: mark,
+                strokes: of.len(),
+                median_n: median,
+                low: forces[0] / median,
+                high: forces[forces.len() - 1] / median,
+                shortest_ms: durations.clone().fold(f64::INFINITY, f64::min),
+                longest_ms: durations.fold(0.0, f64::max),
+                recontacts: of.iter().map(|e| e.recontacts).sum(),
+            })
+        })
+        .collect()
 }
 
 /// How well contacts kept time.
@@ -219,6 +293,9 @@ mod tests {
         let e = events(&strokes, &contacts, &m);
         assert_eq!(e.len(), 4);
         assert_eq!(e[1].beat, None);
+        assert_eq!(e[0].recontacts, 1, "the 10 N bounce after the first stroke");
+        assert_eq!(e[3].recontacts, 0);
+        assert_eq!((e[0].mode, e[0].dynamic), (Some("legato"), Some("mf")));
         assert_eq!(e[3].scheduled_s, Some(2.0));
         let t = timing(&errors(&strokes, &contacts, &m));
         assert_eq!((t.strokes, t.missed), (3, 1));

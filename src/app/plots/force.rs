@@ -149,6 +149,9 @@ mod tests {
             impact_speed_mps: 3.0,
             x_m: 0.0,
             y_m: 0.5,
+            recontacts: 0,
+            mode: None,
+            dynamic: None,
         };
         let events = [
             event("left", 1.0, 50.0),

@@ -253,6 +253,9 @@ mod tests {
             impact_speed_mps: 3.0,
             x_m: 0.0,
             y_m: 0.5,
+            recontacts: 0,
+            mode: None,
+            dynamic: None,
         }
     }
 
