@@ -7,7 +7,8 @@ use std::path::Path;
 use timpanist::base::rng::Rng;
 use timpanist::body::control::{Gains, limit_torques, pd_torques};
 use timpanist::body::dynamics::{Dynamics, State};
-use timpanist::body::limits::JointLimit;
+use timpanist::body::limits::JointLimits;
+
 use timpanist::body::model::BodyModel;
 use timpanist::body::sim::{Pipeline, SimParams, simulate};
 use timpanist::body::skeleton::{JOINT_COUNT, Joint};
@@ -60,22 +61,19 @@ fn himc_beats_id_for_every_mode() {
 }
 
 /// A joint driven toward a rotation far outside its limit ellipsoid is held near the
-/// limit by the corrective torques (radius stays below 1.1 with a 20 000 N·m stiffness).
+/// limit by the corrective torques (radius stays below 1.1), with the PD saturated against
+/// it.
 #[test]
 fn joint_limits_hold() {
     let db = db();
-    let samples: Vec<DQuat> = db
-        .takes
-        .iter()
-        .filter_map(|t| t.joints.as_ref())
-        .flat_map(|p| p.iter().map(|q| q[Joint::ElbowR.index()]))
-        .collect();
-    let limit = JointLimit::estimate(&samples).unwrap();
-    let mut limits: [Option<JointLimit>; JOINT_COUNT] = [None; JOINT_COUNT];
-    limits[Joint::ElbowR.index()] = Some(limit);
+    let limits = db.joint_limits(timpanist::score::Grip::French);
+    let elbow = Joint::ElbowR.index();
+    let limit = limits[elbow].unwrap();
+    let mut only_elbow: JointLimits = [None; JOINT_COUNT];
+    only_elbow[elbow] = Some(limit);
     let mut dynamics = Dynamics::new(BodyModel::default());
     let mut state = State::rest();
-    state.q[Joint::ElbowR.index()] = limit.mean;
+    state.q[elbow] = limit.mean;
     let gains = Gains::from_effective_inertia(
         &mut dynamics,
         &state,
@@ -84,7 +82,7 @@ fn joint_limits_hold() {
         300.0,
     );
     let mut target = state.q;
-    target[Joint::ElbowR.index()] = limit.mean * DQuat::from_rotation_x(1.5);
+    target[elbow] = limit.mean * DQuat::from_rotation_x(1.5);
     let mut worst: f64 = 0.0;
     for _ in 0..10_000 {
         let pd = pd_torques(
@@ -94,12 +92,63 @@ fn joint_limits_hold() {
             &[DVec3::ZERO; JOINT_COUNT],
             &[DVec3::ZERO; JOINT_COUNT],
         );
-        let lim = limit_torques(&limits, &state, 20_000.0, 50.0);
+        let lim = limit_torques(
+            &gains,
+            &only_elbow,
+            &state,
+            SimParams::default().limit_stiffness,
+        );
         let tau: [DVec3; JOINT_COUNT] = std::array::from_fn(|j| pd[j] + lim[j]);
         dynamics.step(&mut state, &tau, &[], 1e-4);
-        worst = worst.max(limit.radius(state.q[Joint::ElbowR.index()]));
+        worst = worst.max(limit.radius(state.q[elbow]));
     }
     assert!(worst < 1.1, "elbow reached {worst} of its limit ellipsoid");
+}
+
+/// In the simulation (ID following a captured stroke whose right elbow target is turned
+/// far beyond the elbow's limit), the database's limits keep the elbow within 1.15 of its
+/// ellipsoid; without them the simulated elbow goes far past it.
+#[test]
+fn a_target_beyond_a_limit_is_not_reached_in_the_simulation() {
+    let db = db();
+    let limits = db.joint_limits(timpanist::score::Grip::French);
+    let elbow = Joint::ElbowR.index();
+    let limit = limits[elbow].unwrap();
+    let unit = evaluate::units_for(&db, timpanist::score::PlayingMode::Legato, 1)[0];
+    let mut reference = evaluate::reference_of(&db, unit);
+    let start = reference.poses.as_ref().unwrap()[0];
+    for pose in reference.poses.as_mut().unwrap() {
+        pose[elbow] = limit.mean * DQuat::from_rotation_x(1.2);
+    }
+    let model = evaluate::simulated_body();
+    let worst = |limits: JointLimits| {
+        let params = SimParams {
+            limits,
+            // The target is out of reach on purpose: follow it however far the tip is.
+            max_tracking_error_m: f64::INFINITY,
+            ..SimParams::default()
+        };
+        let motion = simulate(
+            &model,
+            &reference,
+            Pipeline::Id,
+            &params,
+            &start,
+            &[1.0; JOINT_COUNT],
+        )
+        .unwrap();
+        (motion.poses.iter())
+            .map(|p| limit.radius(p[elbow]))
+            .fold(0.0, f64::max)
+    };
+    let held = worst(limits);
+    let free = worst([None; JOINT_COUNT]);
+    println!("elbow ellipsoid radius: {held:.3} with limits, {free:.3} without");
+    assert!(held < 1.15, "the elbow reached {held} of its ellipsoid");
+    assert!(
+        free > 2.0,
+        "without limits the elbow should pass its limit: {free}"
+    );
 }
 
 /// No NaN or divergence over many randomised runs (random strokes, initial postures,

@@ -7,7 +7,7 @@
 
 use super::dynamics::{Dynamics, State};
 use super::skeleton::{JOINT_COUNT, Pose};
-use crate::body::limits::{JointLimit, quat_log};
+use crate::body::limits::{JointLimits, quat_log};
 use glam::{DMat3, DQuat, DVec3};
 
 /// PD gains and torque limits per joint: ks = ω²·I and kd = 2ζω·I with I the joint's
@@ -117,26 +117,37 @@ pub fn gravity_compensation(dynamics: &mut Dynamics, pose: &Pose) -> [DVec3; JOI
     dynamics.inverse_dynamics(&state, &[DVec3::ZERO; JOINT_COUNT])
 }
 
-/// Corrective torques pushing joints back inside their limit ellipsoids: beyond the
-/// ellipsoid (radius r > 1) a spring of `stiffness` (N·m per unit of radius) toward the
-/// mean, damped by `damping` (N·m·s/rad) along that direction.
+/// How many times a joint's (muscular) torque limit its limit stop may apply.
+pub const LIMIT_TORQUE_FACTOR: f64 = 10.0;
+
+/// Corrective torques pushing joints back inside their limit ellipsoids (seed 000 §3.2):
+/// beyond its ellipsoid a joint meets a spring toward the ellipsoid's surface (along the ray
+/// from its centre) `stiffness` times as stiff as the joint's PD loop, damped by √stiffness
+/// times its PD damping along that direction, and at most [`LIMIT_TORQUE_FACTOR`] times the
+/// joint's torque limit (a stop outlasts the muscles pulling against it, but tissue gives
+/// way too); inside, nothing. Scaling with each joint's own gains
+/// keeps the stop as fast relative to the joint everywhere, and stable for the light stick
+/// as for the heavy trunk.
 pub fn limit_torques(
-    limits: &[Option<JointLimit>; JOINT_COUNT],
+    gains: &Gains,
+    limits: &JointLimits,
     state: &State,
     stiffness: f64,
-    damping: f64,
 ) -> [DVec3; JOINT_COUNT] {
     std::array::from_fn(|j| {
         let Some(limit) = &limits[j] else {
             return DVec3::ZERO;
         };
-        let r = limit.radius(state.q[j]);
-        if r <= 1.0 {
+        let q = state.q[j];
+        if limit.radius(q) <= 1.0 {
             return DVec3::ZERO;
         }
-        let toward_mean = rotation_error(state.q[j], limit.mean).normalize_or_zero();
-        let closing = state.w[j].dot(toward_mean);
-        toward_mean * (stiffness * (r - 1.0) - damping * closing.min(0.0))
+        let e = quaternion_error(q, limit.boundary(q));
+        let inward = e.normalize_or_zero();
+        let closing = state.w[j].dot(inward);
+        let tau = stiffness * (gains.stiffness[j] * e)
+            - stiffness.sqrt() * (gains.damping[j] * (inward * closing));
+        tau.clamp_length_max(LIMIT_TORQUE_FACTOR * gains.max_torque[j])
     })
 }
 

@@ -21,6 +21,9 @@ pub struct JointLimit {
     pub centre: DVec3,
 }
 
+/// A limit per joint (`None`: that joint is free), in [`crate::body::Joint`] order.
+pub type JointLimits = [Option<JointLimit>; crate::body::skeleton::JOINT_COUNT];
+
 /// The quaternion log map, half-angle rotation vector (rad), shortest arc.
 pub fn quat_log(q: DQuat) -> DVec3 {
     let q = if q.w < 0.0 { -q } else { q };
@@ -87,6 +90,27 @@ impl JointLimit {
             .map(|k| (d.dot(self.axes[k]) / self.semi_axes[k].max(1e-12)).powi(2))
             .sum::<f64>()
             .sqrt()
+    }
+
+    /// This limit with every semi-axis at least `min_rotation_rad` of rotation (half of it
+    /// in the tangent space): a capture that never moved a joint about some axis (a
+    /// planar synthetic performer, a still head) would otherwise pin it there.
+    pub fn at_least(&self, min_rotation_rad: f64) -> JointLimit {
+        JointLimit {
+            semi_axes: self.semi_axes.map(|a| a.max(0.5 * min_rotation_rad)),
+            ..*self
+        }
+    }
+
+    /// The rotation on the ellipsoid's surface on the ray from its centre through `q`
+    /// (`q` itself when it is inside).
+    pub fn boundary(&self, q: DQuat) -> DQuat {
+        let r = self.radius(q);
+        if r <= 1.0 {
+            return q;
+        }
+        let d = quat_log(self.mean.inverse() * q) - self.centre;
+        (self.mean * quat_exp(self.centre + d / r)).normalize()
     }
 
     /// Whether `q` lies within the limit.

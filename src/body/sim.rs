@@ -16,9 +16,10 @@
 //! Task rate 250 Hz and simulation rate 10 kHz by default (40 sub-steps). The run stops
 //! with an error naming the time if the state becomes non-finite or diverges.
 
-use super::control::{Gains, pd_torques, rotation_error};
+use super::control::{Gains, limit_torques, pd_torques, rotation_error};
 use super::dynamics::{Dynamics, State};
 use super::ik::{self, IkParams};
+use super::limits::JointLimits;
 use super::model::BodyModel;
 use super::skeleton::{JOINT_COUNT, Joint, Pose};
 pub use crate::base::choices::Pipeline;
@@ -46,6 +47,11 @@ pub struct SimParams {
     /// flailing, typically at the edge of its reach), m: the demo scores stay within
     /// 0.16 m.
     pub max_tracking_error_m: f64,
+    /// Joint limits the body cannot pass (seed 000 Alg. 1 ellipsoids, e.g. from the
+    /// motion database: `MotionDb::joint_limits`); none by default.
+    pub limits: JointLimits,
+    /// How many times stiffer than a joint's PD loop its limit stop is.
+    pub limit_stiffness: f64,
 }
 
 impl Default for SimParams {
@@ -66,6 +72,8 @@ impl Default for SimParams {
             nested_iterations: 1,
             max_angular_speed: 500.0,
             max_tracking_error_m: 0.5,
+            limits: [None; JOINT_COUNT],
+            limit_stiffness: 16.0,
         }
     }
 }
@@ -291,6 +299,10 @@ impl Simulator {
     ) -> Result<Simulator, SimError> {
         let substeps = (params.sim_hz / reference.rate_hz).round().max(1.0) as usize;
         let mut dynamics = Dynamics::new(model.clone());
+        // The body starts within its limits (a stop met at full depth would fling it).
+        let initial: &Pose = &std::array::from_fn(|j| {
+            params.limits[j].map_or(initial[j], |limit| limit.boundary(initial[j]))
+        });
         let state = State {
             q: *initial,
             w: [DVec3::ZERO; JOINT_COUNT],
@@ -501,7 +513,20 @@ impl Simulator {
                     }
                 }
             }
-            let tau = pd_torques(&self.gains, &self.state, &goal, &target_w, &bias);
+            let mut tau = pd_torques(&self.gains, &self.state, &goal, &target_w, &bias);
+            if self.params.limits.iter().any(Option::is_some) {
+                let stops = limit_torques(
+                    &self.gains,
+                    &self.params.limits,
+                    &self.state,
+                    self.params.limit_stiffness,
+                );
+                for (t, stop) in tau.iter_mut().zip(stops) {
+                    if stop != DVec3::ZERO {
+                        *t += stop;
+                    }
+                }
+            }
             self.dynamics.step_with_tip_forces(
                 &mut self.state,
                 &tau,

@@ -14,19 +14,24 @@ use crate::score::PlayingMode;
 use plotters::style::RGBColor;
 use std::path::Path;
 
-/// Run the evaluation and report it.
+/// Run the evaluation with `trials` per mode (joints held within the database's limits if
+/// `joint_limits`) and report it, also as JSON and PNG figures when asked.
 pub fn run(
     db_dir: &Path,
     trials: usize,
-    json: Option<&Path>,
-    plot: Option<&Path>,
+    joint_limits: bool,
+    (json, plot): (Option<&Path>, Option<&Path>),
 ) -> anyhow::Result<()> {
     let db = MotionDb::load(db_dir)?;
     let model = evaluate::simulated_body();
-    let params = EvalParams {
+    let mut params = EvalParams {
         trials: trials.max(1),
         ..EvalParams::default()
     };
+    if joint_limits {
+        // The evaluated strokes are French-grip units (`evaluate::units_for`).
+        params.sim.limits = db.joint_limits(crate::score::Grip::French);
+    }
     let started = std::time::Instant::now();
     let report = evaluate::evaluate(&db, &model, &params)?;
     let took = started.elapsed().as_secs_f64();

@@ -1,7 +1,6 @@
 //! `timpanist mocap synth | stats`: build the synthetic motion database and summarise a
 //! database (per playing mode and grip, per dynamic, and joint limits).
 
-use crate::body::limits::JointLimit;
 use crate::body::skeleton::Joint;
 use crate::mocap::db::MotionDb;
 use crate::mocap::import::Format;
@@ -105,31 +104,15 @@ pub fn stats(dir: &Path) -> anyhow::Result<()> {
 /// Joint limits of one grip from the frames of its motion units (each arm only while it
 /// plays), beside Table 1 of seed 000.
 fn print_limits(db: &MotionDb, grip: Grip) {
-    let units: Vec<_> = db
-        .index
-        .units
-        .iter()
-        .filter(|u| u.grip == grip && db.takes[u.take].joints.is_some())
-        .collect();
-    if units.is_empty() {
+    let limits = db.estimated_joint_limits(grip);
+    if limits.iter().all(Option::is_none) {
         return;
     }
     println!(
         "\n{grip:?} grip joint limits (seed 000 Alg. 1): semi-axes of the bounding ellipsoid as rotation angles, degrees"
     );
-    for joint in Joint::ALL {
-        let samples: Vec<_> = units
-            .iter()
-            .filter(|u| !Joint::arm(u.hand.other()).contains(&joint))
-            .flat_map(|u| {
-                let poses = db.takes[u.take].joints.as_deref().unwrap_or_default();
-                poses[u.start..=u.end]
-                    .iter()
-                    .step_by(5)
-                    .map(move |p| p[joint.index()])
-            })
-            .collect();
-        let Some(limit) = JointLimit::estimate(&samples) else {
+    for (joint, limit) in Joint::ALL.into_iter().zip(limits) {
+        let Some(limit) = limit else {
             continue;
         };
         let deg = limit.semi_axes.map(|a| (2.0 * a).to_degrees());

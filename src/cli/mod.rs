@@ -154,6 +154,10 @@ pub enum Command {
         /// database].
         #[arg(long)]
         db: Option<PathBuf>,
+        /// Hold every joint within the limits estimated from the database's captured
+        /// joints (seed 000 Alg. 1 ellipsoids as restoring torques).
+        #[arg(long)]
+        joint_limits: bool,
     },
     /// Motion-capture database: build, inspect, import.
     #[command(subcommand)]
@@ -337,10 +341,12 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 events: events.as_deref(),
                 plot: plot.as_deref(),
             },
-            control.map(Into::into),
-            sound.map(Into::into),
-            seed,
-            stats,
+            &render::Choices {
+                control: control.map(Into::into),
+                sound: sound.map(Into::into),
+                seed,
+                stats,
+            },
         )
         .map(|()| ExitCode::SUCCESS),
         Some(Command::Evaluate {
@@ -348,8 +354,14 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             json,
             plot,
             db,
-        }) => evaluate::run(&db_or_default(db), trials, json.as_deref(), plot.as_deref())
-            .map(|()| ExitCode::SUCCESS),
+            joint_limits,
+        }) => evaluate::run(
+            &db_or_default(db),
+            trials,
+            joint_limits,
+            (json.as_deref(), plot.as_deref()),
+        )
+        .map(|()| ExitCode::SUCCESS),
         Some(Command::Mocap(MocapCommand::Synth { output, seed })) => {
             mocap::synth(&output, seed).map(|()| ExitCode::SUCCESS)
         }

@@ -27,15 +27,30 @@ pub struct Outputs<'a> {
 }
 
 /// Render `score` and write `outputs`.
+/// How to render, as asked on the command line.
+pub struct Choices {
+    /// The control pipeline (default: the score's settings).
+    pub control: Option<Pipeline>,
+    /// The sound model (default: the score's settings).
+    pub sound: Option<SoundModel>,
+    /// Seed of the choice among near-equal motion units.
+    pub seed: u64,
+    /// Print where the time went and the force by dynamic.
+    pub stats: bool,
+}
+
 pub fn run(
     score: &Path,
     db_dir: &Path,
     outputs: &Outputs,
-    control: Option<Pipeline>,
-    sound: Option<SoundModel>,
-    seed: u64,
-    stats: bool,
+    choices: &Choices,
 ) -> anyhow::Result<()> {
+    let Choices {
+        control,
+        sound,
+        seed,
+        stats,
+    } = *choices;
     let loaded = LoadedScore::load(score)?;
     for notice in &loaded.notices {
         eprintln!("note: {notice}");

@@ -12,6 +12,7 @@
 //! the performer frame (metres; +x right, +y forward, +z up).
 
 use crate::base::ron_file::{self, FileError};
+use crate::body::limits::{JointLimit, JointLimits};
 use crate::body::skeleton::{JOINT_COUNT, Joint, Pose};
 use crate::kit::Side;
 use crate::score::{Dynamic, Grip, ImpactLocation, PlayingMode};
@@ -123,7 +124,45 @@ pub fn joint_names() -> Vec<String> {
     Joint::ALL.iter().map(|j| j.name().to_string()).collect()
 }
 
+/// The narrowest range of rotation a joint limit allows about any axis, degrees.
+pub const MIN_LIMIT_ROTATION_DEG: f64 = 20.0;
+
 impl MotionDb {
+    /// The joint limits the simulation holds a player of `grip` to: the
+    /// [estimates](MotionDb::estimated_joint_limits), each axis at least
+    /// [`MIN_LIMIT_ROTATION_DEG`] wide.
+    pub fn joint_limits(&self, grip: Grip) -> JointLimits {
+        self.estimated_joint_limits(grip)
+            .map(|l| l.map(|l| l.at_least(MIN_LIMIT_ROTATION_DEG.to_radians())))
+    }
+
+    /// The joint limits of `grip` estimated from the captured joint rotations of its
+    /// units (seed 000 Alg. 1; each arm only while it plays, every fifth frame); `None`
+    /// for every joint when no unit of that grip has captured joints (tip-only captures).
+    pub fn estimated_joint_limits(&self, grip: Grip) -> JointLimits {
+        let units: Vec<&UnitEntry> = self
+            .index
+            .units
+            .iter()
+            .filter(|u| u.grip == grip && self.takes[u.take].joints.is_some())
+            .collect();
+        std::array::from_fn(|j| {
+            let joint = Joint::ALL[j];
+            let samples: Vec<_> = units
+                .iter()
+                .filter(|u| !Joint::arm(u.hand.other()).contains(&joint))
+                .flat_map(|u| {
+                    let poses = self.takes[u.take].joints.as_deref().unwrap_or_default();
+                    poses[u.start..=u.end.min(poses.len().saturating_sub(1))]
+                        .iter()
+                        .step_by(5)
+                        .map(move |p| p[j])
+                })
+                .collect();
+            JointLimit::estimate(&samples)
+        })
+    }
+
     /// A database with no takes yet.
     pub fn empty(description: &str) -> MotionDb {
         MotionDb {
