@@ -309,3 +309,49 @@ fn randomised_scores_never_explode() {
     assert!(rendered > 500, "only {rendered} of 1000 rendered");
     assert!(lost <= 10, "{lost} of 1000 lost control");
 }
+
+/// The head follows the hands: before each stroke that moves to another drum after a
+/// pause (0.6 s or more), the simulated face is turned toward that stroke's point on its
+/// head — its bearing from the pelvis, as far as the neck and head turn (70°; the eyes
+/// do the rest), within 15° 50 ms before the stroke — and the face turns by tens of
+/// degrees over the study (it is not simply held still).
+#[test]
+fn the_face_turns_to_the_drum_about_to_be_struck() {
+    let db = db();
+    let r = render_file(&root().join("scores/minute-study.ron"), &db);
+    let skeleton = r.skeleton();
+    let yaw = |v: glam::DVec3| (-v.x).atan2(v.y).to_degrees();
+    let face_at = |t: f64| {
+        let k =
+            (((t - r.start_s) * r.motion.rate_hz).round() as usize).min(r.motion.poses.len() - 1);
+        let frames = skeleton.forward(&r.motion.poses[k]);
+        let neck = timpanist::body::Joint::Neck.index();
+        let head = timpanist::body::Joint::Head.index();
+        (
+            frames.rotation[head] * glam::DVec3::Y,
+            frames.position[neck],
+        )
+    };
+    let strokes = &r.composition.strokes;
+    let (mut checked, mut worst, mut span) = (0, 0.0f64, (f64::INFINITY, f64::NEG_INFINITY));
+    for pair in strokes.windows(2) {
+        let (before, s) = (&pair[0], &pair[1]);
+        let (face, pelvis) = face_at(s.time_s - 0.05);
+        span = (span.0.min(yaw(face)), span.1.max(yaw(face)));
+        if s.drum == before.drum || s.time_s - before.time_s < 0.6 {
+            continue;
+        }
+        // The face turns at most MAX_YAW_RAD off the body's front (the eyes do the rest).
+        let most = timpanist::body::gaze::MAX_YAW_RAD.to_degrees();
+        let off = (yaw(face) - yaw(s.target - pelvis).clamp(-most, most)).abs();
+        worst = worst.max(off);
+        checked += 1;
+    }
+    println!("{checked} drum changes: face within {worst:.1}° of the drum; yaw {span:?}°");
+    assert!(checked >= 5, "only {checked} drum changes checked");
+    assert!(
+        worst < 15.0,
+        "the face was {worst:.1}° off the drum about to be struck"
+    );
+    assert!(span.1 - span.0 > 20.0, "the face hardly turns: {span:?}");
+}

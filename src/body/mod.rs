@@ -5,6 +5,7 @@
 
 pub mod control;
 pub mod dynamics;
+pub mod gaze;
 pub mod ik;
 pub mod limits;
 pub mod model;

@@ -90,6 +90,9 @@ pub struct Reference {
     /// Scored impact times (s, from the first sample) with their beat index, in time
     /// order, so that a failure can name the beat it happened in.
     pub beats: Vec<(f64, usize)>,
+    /// Where the performer looks per sample (m, performer frame): the neck and head turn
+    /// toward it ([`super::gaze::look_at`]); `None` keeps them as the posture has them.
+    pub gaze: Option<Vec<DVec3>>,
 }
 
 /// What the body did, at the task rate.
@@ -231,6 +234,10 @@ fn ik_target(
             &params.ik,
         )
         .pose;
+    }
+    if let Some(gaze) = &reference.gaze {
+        let frames = model.skeleton.forward(&pose);
+        super::gaze::look_at(&frames, &mut pose, gaze[k]);
     }
     pose
 }
@@ -498,6 +505,12 @@ impl Simulator {
                 // the task-rate IK posture; PD then tracks that.
                 let reference_pose = goal;
                 goal = self.state.q;
+                if reference.gaze.is_some() {
+                    // The arms' IK leaves the neck and head: they follow the gaze targets.
+                    for j in [Joint::Neck, Joint::Head] {
+                        goal[j.index()] = reference_pose[j.index()];
+                    }
+                }
                 for _ in 0..self.params.nested_iterations {
                     let frames = self.model.skeleton.forward(&goal);
                     for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
@@ -617,6 +630,7 @@ mod tests {
             tips: [hold(Side::Left, false), hold(Side::Right, true)],
             poses: None,
             beats: vec![(0.02, 3), (0.06, 4)],
+            gaze: None,
         };
         let params = SimParams {
             frequency_hz: [2000.0; JOINT_COUNT],
@@ -656,6 +670,7 @@ mod tests {
             tips: [tips(Side::Left, 0.0), tips(Side::Right, 2.0)],
             poses: None,
             beats: vec![(1.9, 7)],
+            gaze: None,
         };
         let run = |limit: f64| {
             let params = SimParams {
@@ -697,6 +712,7 @@ mod tests {
             tips: path(late),
             poses: None,
             beats: Vec::new(),
+            gaze: None,
         };
         let params = SimParams::default();
         let (a, b) = (reference(0.0), reference(0.5));

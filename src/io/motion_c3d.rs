@@ -86,6 +86,7 @@ mod tests {
             tips: tips(0.75),
             poses: None,
             beats: Vec::new(),
+            gaze: None,
         };
         let bytes = to_c3d(&motion, &reference, &skeleton);
         let back = read(Path::new("motion.c3d"), &bytes, None).unwrap();

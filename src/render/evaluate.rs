@@ -87,6 +87,7 @@ pub fn reference_of(db: &MotionDb, unit: &UnitEntry) -> Reference {
         tips: [tip(Side::Left), tip(Side::Right)],
         poses: take.joints.as_ref().map(|j| j[range.clone()].to_vec()),
         beats: vec![((unit.impact - unit.start) as f64 / take.rate_hz, 0)],
+        gaze: None,
     }
 }
 

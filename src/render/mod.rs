@@ -13,6 +13,7 @@
 
 pub mod compensate;
 pub mod evaluate;
+pub mod gaze;
 pub mod reach;
 pub mod reference;
 pub mod strikes;
@@ -261,9 +262,11 @@ pub const RESUME_STEP_S: f64 = 4.0;
 pub struct Resume {
     performance: Performance,
     sound: SoundState,
-    /// The composition performed: its strokes and target tips, its start and rate.
+    /// The composition performed: its strokes and target tips, its start and rate, and
+    /// where the performer looked.
     strokes: Vec<PlannedStroke>,
     tips: [Vec<DVec3>; 2],
+    gaze: Vec<DVec3>,
     start_s: f64,
     rate_hz: f64,
     params: RenderParams,
@@ -431,6 +434,7 @@ impl Run<'_> {
         let (comp, params, kit) = (self.composition, self.params, self.kit);
         let (start_s, rate) = (comp.start_s, comp.rate_hz);
         let strokes = comp.strokes.len();
+        let gaze = targets.gaze().to_vec();
         let resumable = previous
             .as_ref()
             .and_then(|p| self.resume_point(p, &targets));
@@ -475,6 +479,7 @@ impl Run<'_> {
                 sound,
                 strokes: comp.strokes.clone(),
                 tips: comp.tips.clone(),
+                gaze,
                 start_s,
                 rate_hz: rate,
                 params: params.clone(),
@@ -500,8 +505,12 @@ impl Run<'_> {
         }
         let old_len = previous.tips[0].len();
         let common = old_len.min(comp.len());
+        let gaze = targets.gaze();
         let same_until = (0..common)
-            .find(|&k| (0..2).any(|h| previous.tips[h][k] != comp.tips[h][k]))
+            .find(|&k| {
+                (0..2).any(|h| previous.tips[h][k] != comp.tips[h][k])
+                    || previous.gaze.get(k) != gaze.get(k)
+            })
             .unwrap_or(common);
         let at = previous.performance.resumable(
             &previous.strokes,

@@ -53,6 +53,8 @@ pub struct Targets {
     dips: Vec<Dip>,
     /// Scored impacts (s from sample 0, beat), in time order.
     beats: Vec<(f64, usize)>,
+    /// Where the performer looks, per sample (see `render::gaze`), m.
+    gaze: Vec<DVec3>,
 }
 
 impl Targets {
@@ -112,11 +114,17 @@ impl Targets {
             raised,
             dips,
             beats,
+            gaze: super::gaze::gaze_points(comp),
         };
         for i in 0..targets.dips.len() {
             targets.set_depth(i, depth_m);
         }
         targets
+    }
+
+    /// Where the performer looks, per sample, m.
+    pub fn gaze(&self) -> &[DVec3] {
+        &self.gaze
     }
 
     /// Samples per hand.
@@ -182,6 +190,7 @@ impl Targets {
             tips: std::array::from_fn(|h| self.shaped[h].clone()),
             poses: None,
             beats: self.beats.clone(),
+            gaze: Some(self.gaze.clone()),
         }
     }
 
@@ -295,6 +304,7 @@ mod tests {
             shaped: [line.clone(), line],
             dips: Vec::new(),
             beats: Vec::new(),
+            gaze: Vec::new(),
         }
     }
 
