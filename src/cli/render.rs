@@ -179,6 +179,9 @@ fn figure(r: &Rendering, title: &str) -> Figure {
     }
 }
 
+/// `--stats` lists the strokes whose peak force is off its aim by more than this fraction.
+const FORCE_AIM_TOLERANCE: f64 = 0.2;
+
 fn print_stats(r: &Rendering) {
     let s = &r.stats;
     println!(
@@ -233,6 +236,28 @@ fn print_stats(r: &Rendering) {
     println!(
         "re-contacts: {recontacts} after {} strokes",
         forces.iter().map(|f| f.strokes).sum::<usize>()
+    );
+    let strokes = &r.composition.strokes;
+    let off: Vec<String> = (r.events.iter())
+        .filter_map(|e| {
+            let stroke = strokes.iter().find(|s| Some(s.beat) == e.beat)?;
+            let aim = r.params.force_aim_n(stroke.dynamic);
+            let ratio = e.peak_force_n / aim;
+            ((ratio - 1.0).abs() > FORCE_AIM_TOLERANCE).then(|| {
+                format!(
+                    "beat {} {:.0} N for {:.0}",
+                    stroke.beat, e.peak_force_n, aim
+                )
+            })
+        })
+        .collect();
+    println!(
+        "force aims (15 N + 95 N x velocity): {} of {} strokes off by more than {:.0} %{}{}",
+        off.len(),
+        strokes.len(),
+        FORCE_AIM_TOLERANCE * 100.0,
+        if off.is_empty() { "" } else { ": " },
+        off.iter().take(8).cloned().collect::<Vec<_>>().join(", ")
     );
 }
 

@@ -79,6 +79,11 @@ pub struct RenderParams {
 }
 
 impl RenderParams {
+    /// The peak contact force aimed at for a stroke of `dynamic`, N.
+    pub fn force_aim_n(&self, dynamic: crate::score::Dynamic) -> f64 {
+        self.force_at_silence_n + self.force_range_n * dynamic.velocity()
+    }
+
     /// The defaults with a score's settings (control, IK, gains, sound, modes).
     pub fn for_score(settings: &Settings) -> RenderParams {
         let sim = SimParams::default();
@@ -544,7 +549,7 @@ impl Run<'_> {
             force_n: comp
                 .strokes
                 .iter()
-                .map(|s| params.force_at_silence_n + params.force_range_n * s.dynamic.velocity())
+                .map(|s| params.force_aim_n(s.dynamic))
                 .collect(),
             force_tolerance: params.force_tolerance,
             tolerance_s: params.timing_tolerance_s,
