@@ -4,7 +4,9 @@
 //! than [`CLUSTER_GAP_S`] (either hand) are settled together: from a saved state before
 //! the cluster, the body and the drums are simulated a little past its last stroke, the
 //! contacts measured, the cluster's shifts and depths corrected and the span simulated
-//! again, a few times; the best attempt is kept and the performance moves on. Each
+//! again, a few times; the best attempt is kept (fewest strokes missed, then far off
+//! their force, then re-contacts — the stick falling back on a head —, then the worst
+//! timing) and the performance moves on. Each
 //! cluster starts from its predecessors' settled shifts and depths (same hand, mode and
 //! dynamic), so repeated material settles at once.
 //!
@@ -28,6 +30,9 @@ const LOOKAHEAD_S: f64 = 0.035;
 /// The most a stroke's target is played earlier or later, s (with the gap and the
 /// look-ahead, it keeps the next cluster's dips out of a cluster's targets).
 const MAX_SHIFT_S: f64 = 0.035;
+/// A contact weaker than this fraction of its stroke's aimed force is a graze, ranked with
+/// a stroke that did not sound when the compensation picks its best attempt.
+const GRAZE_FRACTION: f64 = 0.25;
 /// The deepest a stroke aims below the head, m.
 const MAX_DEPTH_M: f64 = 0.06;
 /// The shift moves to a cluster's over at most this long before its first dip, s.
@@ -335,7 +340,7 @@ impl Performance {
         self.commits.push(commit.clone());
         let last_s = self.targets.knots(cluster.end - 1, 0.0)[1].0;
         let until = (((last_s + LOOKAHEAD_S) * rate).ceil() as usize).clamp(commit.samples, n);
-        type Attempt = ((usize, usize, f64), Vec<f64>, Vec<f64>, usize);
+        type Attempt = ((usize, usize, usize, f64), Vec<f64>, Vec<f64>, usize);
         let mut best: Option<Attempt> = None;
         let mut attempt = 0;
         let mut diverged = false;
@@ -377,15 +382,25 @@ impl Performance {
                         worst = worst.max((contacts[*c].start_s - strokes[i].time_s).abs());
                         let ratio = contacts[*c].peak_force_n / aims.force_n[i];
                         on_force &= (ratio - 1.0).abs() <= aims.force_tolerance;
-                        if !(0.5..=2.0).contains(&ratio) {
+                        if ratio < GRAZE_FRACTION {
+                            // A graze is not a stroke: as bad as none.
+                            missed += 1;
+                        } else if !(0.5..=2.0).contains(&ratio) {
                             far_off += 1;
                         }
                     }
                     None => missed += 1,
                 }
             }
+            // The touches after the cluster's contacts: the stick falling back on a head.
+            let claimed: Vec<usize> = matches.iter().flatten().copied().collect();
+            let recontacts = (commit.drums.contacts()..contacts.len())
+                .filter(|c| {
+                    !claimed.contains(c) && contacts[*c].peak_force_n >= strikes::RECONTACT_MIN_N
+                })
+                .count();
             // A stroke that does not sound is worse than one whose force is off.
-            let key = (missed, far_off, worst);
+            let key = (missed, far_off, recontacts, worst);
             if best.as_ref().is_none_or(|b| key <= b.0) {
                 best = Some((
                     key,
@@ -394,8 +409,8 @@ impl Performance {
                     attempt,
                 ));
             }
-            let on_time = missed == 0 && worst <= aims.tolerance_s;
-            let acceptable = missed + far_off == 0
+            let on_time = missed + recontacts == 0 && worst <= aims.tolerance_s;
+            let acceptable = missed + far_off + recontacts == 0
                 && worst <= aims.acceptable_s
                 && attempt >= aims.settle_attempts;
             if (on_time && on_force) || acceptable || attempt >= aims.max_attempts {
