@@ -164,11 +164,7 @@ impl EditorApp {
     pub fn set_rendering(&mut self, rendering: Arc<Rendering>) {
         let r = Rendered::new(rendering);
         self.pipeline.accept_rendering(&r, true);
-        self.messages.status = r.summary;
-        self.views.simulated = Some(r.simulated);
-        if let Err(e) = self.transport.load(&r.rendering) {
-            self.pipeline.playback_failed(format!("playback: {e}"));
-        }
+        self.show_rendering(r);
     }
 
     /// The latest rendering received, if any (possibly of an older version of the score).

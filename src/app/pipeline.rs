@@ -17,13 +17,14 @@ use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
 /// Why the composing worker has no composition.
-#[derive(Clone, Debug, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ComposeFailure {
+    /// The database failed to load (once; every composition reports it).
     #[error("no motion database: {0}")]
     NoDatabase(Arc<FileError>),
     #[error(transparent)]
-    Compose(Arc<RenderError>),
+    Compose(#[from] RenderError),
 }
 
 /// A composition (or why there is none) and how long it took on the worker.
@@ -249,7 +250,7 @@ fn compose_job(
         let result = match db {
             Ok(db) => crate::render::compose(&loaded, db, &params)
                 .map(Arc::new)
-                .map_err(|e| ComposeFailure::Compose(Arc::new(e))),
+                .map_err(ComposeFailure::from),
             Err(e) => Err(ComposeFailure::NoDatabase(Arc::clone(e))),
         };
         made.fetch_add(1, Ordering::SeqCst);

@@ -7,6 +7,7 @@ use super::document::Document;
 use super::export::{self, Export};
 use super::files::{self, FileKind, kind_of};
 use super::jobs::{Done, Finished};
+use super::renderer::Rendered;
 use super::{AfterConfirm, DEMO_SCORE_PATH, DEMO_SCORE_TEXT, EditorApp};
 use crate::kit::Kit;
 use crate::score::{LoadedScore, Score};
@@ -49,16 +50,21 @@ impl EditorApp {
     /// Take what the pipeline and the writing jobs finished.
     pub(super) fn take_results(&mut self) {
         if let Some(r) = self.pipeline.poll() {
-            self.views.simulated = Some(r.simulated);
-            self.messages.status = r.summary;
-            // Swaps are seamless (a crossfade under the playhead), so every rendering is
-            // heard at once, a new version or more of the one playing.
-            if let Err(e) = self.transport.load(&r.rendering) {
-                self.pipeline.playback_failed(format!("playback: {e}"));
-            }
+            self.show_rendering(r);
         }
         for finished in self.jobs.poll() {
             self.job_finished(finished);
+        }
+    }
+
+    /// Show a rendering the pipeline took: its body in the view, its summary in the status
+    /// bar, its audio to playback. Swaps are seamless (a crossfade under the playhead), so
+    /// every rendering is heard at once, a new version or more of the one playing.
+    pub(super) fn show_rendering(&mut self, r: Rendered) {
+        self.views.simulated = Some(r.simulated);
+        self.messages.status = r.summary;
+        if let Err(e) = self.transport.load(&r.rendering) {
+            self.pipeline.playback_failed(format!("playback: {e}"));
         }
     }
 

@@ -48,14 +48,13 @@ impl<Req> Clone for Requester<Req> {
 
 impl<Req> Requester<Req> {
     /// Ask for `request`, replacing any request not yet started and making the job in
-    /// progress stale; returns its generation.
-    pub fn request(&self, request: Req) -> u64 {
+    /// progress stale.
+    pub fn request(&self, request: Req) {
         let mut slot = self.shared.slot.lock().expect("worker lock");
         let generation = self.shared.latest.fetch_add(1, Ordering::SeqCst) + 1;
         self.shared.requested.store(generation, Ordering::SeqCst);
         slot.request = Some((generation, request));
         self.shared.wake.notify_one();
-        generation
     }
 
     /// Make the job in progress stale and drop any request not yet started.
@@ -153,8 +152,8 @@ impl<Req, Out> Worker<Req, Out> {
     }
 
     /// Ask for `request` (see [`Requester::request`]).
-    pub fn request(&self, request: Req) -> u64 {
-        self.requester.request(request)
+    pub fn request(&self, request: Req) {
+        self.requester.request(request);
     }
 
     /// Make the job in progress stale (see [`Requester::cancel`]).

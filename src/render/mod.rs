@@ -359,6 +359,7 @@ pub fn render_composition(
     let targets = Targets::new(&composition, &shape, params.strike_depth_m);
     let run = Run {
         kit,
+        mallet,
         params,
         composition: &composition,
     };
@@ -414,6 +415,8 @@ pub fn render_composition(
 /// One rendering's fixed inputs.
 struct Run<'a> {
     kit: &'a Kit,
+    /// The kit's mallet the params name.
+    mallet: &'a crate::kit::Mallet,
     params: &'a RenderParams,
     composition: &'a Composition,
 }
@@ -468,8 +471,7 @@ impl Run<'_> {
                 )
                 .map_err(|e| RenderError::of_simulation(e, start_s))?;
                 let dt = 1.0 / (rate * (params.sim.sim_hz / rate).round().max(1.0));
-                let mallet = &kit.mallets[params.mallet];
-                let drums = DrumSet::new(kit, mallet, &params.modes, dt)?;
+                let drums = DrumSet::new(kit, self.mallet, &params.modes, dt)?;
                 let sound = previous
                     .filter(|r| r.kit == *kit && r.params.modes == params.modes)
                     .map(|r| r.sound)
