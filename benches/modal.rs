@@ -17,6 +17,7 @@ fn bank(n: usize) -> VoiceBank {
             freq_hz: 100.0 + 37.0 * k as f64,
             t60_s: 2.0 - 0.02 * k as f64,
             gain: 1.0 / (1.0 + k as f64),
+            glide: 0.0,
         })
         .collect();
     let mut b = VoiceBank::new(&voices, f64::from(SAMPLE_RATE_HZ));

@@ -34,6 +34,8 @@ fn cli_render_writes_wav_motion_and_events() {
         .arg(&json)
         .arg("--plot")
         .arg(&png)
+        .arg("--stems")
+        .arg(dir.path().join("stems"))
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -46,11 +48,24 @@ fn cli_render_writes_wav_motion_and_events() {
         stdout.contains("real time") && stdout.contains("drums"),
         "{stdout}"
     );
-    let reader = hound::WavReader::open(&wav).unwrap();
+    let mut reader = hound::WavReader::open(&wav).unwrap();
     assert_eq!(
         (reader.spec().sample_rate, reader.spec().channels),
         (48_000, 2)
     );
+    // One stereo stem per drum, panned as in the mix (the solo kit has one drum): the
+    // stems sum to the mix.
+    let stems: Vec<_> = std::fs::read_dir(dir.path().join("stems"))
+        .unwrap()
+        .collect();
+    assert_eq!(stems.len(), 1);
+    let mut stem = hound::WavReader::open(dir.path().join("stems/1-23-inch.wav")).unwrap();
+    assert_eq!(stem.spec().channels, 2);
+    let stem: Vec<i16> = stem.samples::<i16>().map(Result::unwrap).collect();
+    let mix: Vec<i16> = reader.samples::<i16>().map(Result::unwrap).collect();
+    assert_eq!(mix.len(), stem.len());
+    assert!(stem.iter().any(|s| s.abs() > 1000));
+    assert!(mix.iter().zip(&stem).all(|(m, s)| (m - s).abs() <= 1));
     let events: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let first = &events.as_array().unwrap()[0];

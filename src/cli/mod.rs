@@ -9,6 +9,7 @@ mod evaluate;
 mod midi;
 mod mocap;
 mod render;
+mod sound;
 mod sticking;
 
 use args::{
@@ -121,6 +122,10 @@ pub enum Command {
         /// Also draw target and simulated tip heights and each contact's peak force (PNG).
         #[arg(long)]
         plot: Option<PathBuf>,
+        /// Also write one WAV per drum into this folder (`1-32-inch.wav`, …): what each
+        /// head radiates, panned and scaled as in the mix (the stems sum to the mix).
+        #[arg(long)]
+        stems: Option<PathBuf>,
         /// The control pipeline driving the body [default: the score's settings, himc].
         #[arg(long, value_enum)]
         control: Option<ControlArg>,
@@ -162,6 +167,46 @@ pub enum Command {
     /// Motion-capture database: build, inspect, import.
     #[command(subcommand)]
     Mocap(MocapCommand),
+    /// Sound: measure notes, fit the modal model to recordings.
+    #[command(subcommand)]
+    Sound(SoundCommand),
+}
+
+#[derive(Debug, Subcommand)]
+pub enum SoundCommand {
+    /// Measure struck notes (WAV): onset, (1,1) pitch, octave-band shares 63 Hz-4 kHz and
+    /// spectral centroid over the first second, the (1,1)'s T60 and pitch glide.
+    Analyse {
+        /// WAV files, one note each (the first onset is measured).
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+    },
+    /// Render one scripted stroke (legato, playing spot, general mallet) on the standard
+    /// drum nearest a pitch, to audition the modal sound or compare it with a recording.
+    Stroke {
+        /// The pitch, e.g. D3.
+        #[arg(long, default_value = "D3")]
+        pitch: String,
+        /// The dynamic.
+        #[arg(long, value_enum, default_value_t = DynamicArg::Mf)]
+        dynamic: DynamicArg,
+        /// Length, s.
+        #[arg(long, default_value_t = 2.0)]
+        seconds: f64,
+        /// The WAV to write (48 kHz mono).
+        #[arg(long)]
+        wav: PathBuf,
+    },
+    /// Fit the modal sound to recorded notes: band radiation corrections and decays,
+    /// the listed partials' decays (README "Sound calibration").
+    Fit {
+        /// Recorded notes (WAV), one struck timpani note each [default: the embedded
+        /// FluidR3 timpani notes].
+        files: Vec<PathBuf>,
+        /// The calibration file to write.
+        #[arg(short, long, default_value = "kits/sound/modal.ron")]
+        output: PathBuf,
+    },
 }
 
 /// The sticking methods, as named on the command line.
@@ -326,6 +371,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             c3d,
             events,
             plot,
+            stems,
             control,
             sound,
             stats,
@@ -340,6 +386,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 c3d: c3d.as_deref(),
                 events: events.as_deref(),
                 plot: plot.as_deref(),
+                stems: stems.as_deref(),
             },
             &render::Choices {
                 control: control.map(Into::into),
@@ -397,6 +444,18 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         .map(|()| ExitCode::SUCCESS),
         Some(Command::Mocap(MocapCommand::Stats { dir })) => {
             mocap::stats(&dir).map(|()| ExitCode::SUCCESS)
+        }
+        Some(Command::Sound(SoundCommand::Analyse { files })) => {
+            sound::analyse(&files).map(|()| ExitCode::SUCCESS)
+        }
+        Some(Command::Sound(SoundCommand::Stroke {
+            pitch,
+            dynamic,
+            seconds,
+            wav,
+        })) => sound::stroke(&pitch, dynamic.into(), seconds, &wav).map(|()| ExitCode::SUCCESS),
+        Some(Command::Sound(SoundCommand::Fit { files, output })) => {
+            sound::fit(&files, &output).map(|()| ExitCode::SUCCESS)
         }
         Some(Command::ExportMidi { score, output }) => {
             midi::export(&score, &output).map(|()| ExitCode::SUCCESS)

@@ -24,6 +24,8 @@ pub struct Outputs<'a> {
     pub c3d: Option<&'a Path>,
     pub events: Option<&'a Path>,
     pub plot: Option<&'a Path>,
+    /// A folder for one WAV per drum.
+    pub stems: Option<&'a Path>,
 }
 
 /// Render `score` and write `outputs`.
@@ -92,7 +94,35 @@ pub fn run(
     let figure = outputs
         .plot
         .map(|_| figure(&rendering, &loaded.score.title));
+    let stems = outputs
+        .stems
+        .map(|_| {
+            crate::sound::stems(
+                &rendering.kit,
+                &rendering.drums,
+                rendering.audio.frames() as f64 / f64::from(rendering.audio.rate_hz),
+                rendering.params.sound,
+            )
+        })
+        .transpose()?;
     crate::sound::write_wav(outputs.wav, &rendering.audio)?;
+    if let (Some(dir), Some(stems)) = (outputs.stems, stems) {
+        std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
+        for (j, (stem, drum)) in stems.iter().zip(&rendering.kit.drums).enumerate() {
+            let name: String = drum
+                .name
+                .chars()
+                .map(|c| {
+                    if c.is_alphanumeric() || c == '-' {
+                        c
+                    } else {
+                        '_'
+                    }
+                })
+                .collect();
+            crate::sound::write_wav(&dir.join(format!("{}-{name}.wav", j + 1)), stem)?;
+        }
+    }
     if let (Some(path), Some(figure)) = (outputs.plot, figure) {
         figure.save_png(path)?;
     }

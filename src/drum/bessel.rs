@@ -5,6 +5,11 @@
 //! J_m(x) = (1/2π)∫₀^{2π} cos(mτ − x·sin τ) dτ is evaluated with the trapezoidal rule,
 //! which converges exponentially for this periodic analytic integrand: with N points the
 //! error is of the order of J_{N−m}(x), negligible once N exceeds x + m by a margin.
+//!
+//! High modes (zeros above [`EXACT_ZERO_LIMIT`], the dense part of a full-band head) use
+//! Debye's asymptotic form instead: for x > m, J_m(x) ≈ √(2/(π w))·cos(φ(x) − π/4) with
+//! w = √(x² − m²) and φ(x) = w − m·arccos(m/x), and J_m ≈ 0 for x ≤ m; the zeros solve
+//! φ(j) = (n − ¼)π (within 0.3 % of the exact ones from j ≈ 14 up, better higher).
 
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
@@ -141,6 +146,91 @@ pub fn radial_profile(m: u32, n: u32) -> Arc<RadialProfile> {
         .clone()
 }
 
+/// Zeros below this use exact Bessel functions and tables; above it, Debye's form.
+pub const EXACT_ZERO_LIMIT: f64 = 30.0;
+
+/// Debye's phase φ(x) = √(x² − m²) − m·arccos(m/x) for x > m (0 at and below m).
+fn debye_phase(m: f64, x: f64) -> f64 {
+    if x <= m {
+        return 0.0;
+    }
+    (x * x - m * m).sqrt() - m * (m / x).acos()
+}
+
+/// The n-th zero of J_m by Debye's asymptotic form: φ(j) = (n − ¼)π solved by Newton
+/// (φ' = w/x), bracketed above m.
+pub fn debye_zero(m: u32, n: u32) -> f64 {
+    let (mf, target) = (f64::from(m), (f64::from(n) - 0.25) * std::f64::consts::PI);
+    // φ ≥ w − m·π/2 gives a start above the root; φ is increasing and concave there.
+    let mut x = ((target + mf * std::f64::consts::FRAC_PI_2).powi(2) + mf * mf).sqrt();
+    for _ in 0..60 {
+        let w = (x * x - mf * mf).max(1e-300).sqrt();
+        let next = (x - (debye_phase(mf, x) - target) * x / w).max(mf + 1e-9);
+        if (next - x).abs() < 1e-12 * x {
+            return next;
+        }
+        x = next;
+    }
+    x
+}
+
+/// J_m(x) by Debye's asymptotic form (see the module docs).
+pub fn debye_j(m: u32, x: f64) -> f64 {
+    let mf = f64::from(m);
+    if x <= mf {
+        return 0.0;
+    }
+    let w = (x * x - mf * mf).sqrt();
+    (2.0 / (std::f64::consts::PI * w)).sqrt()
+        * (debye_phase(mf, x) - std::f64::consts::FRAC_PI_4).cos()
+}
+
+/// The radial factor of a mode: an exact table, or Debye's form for a high mode.
+#[derive(Clone, Debug)]
+pub enum Radial {
+    Table(Arc<RadialProfile>),
+    Debye { m: u32, zero: f64 },
+}
+
+impl Radial {
+    /// The radial factor of mode (m, n): exact when j_mn < [`EXACT_ZERO_LIMIT`].
+    pub fn of(m: u32, n: u32, zero: f64) -> Radial {
+        if zero < EXACT_ZERO_LIMIT {
+            Radial::Table(radial_profile(m, n))
+        } else {
+            Radial::Debye { m, zero }
+        }
+    }
+
+    /// The zero j_mn.
+    pub fn zero(&self) -> f64 {
+        match self {
+            Radial::Table(p) => p.zero,
+            Radial::Debye { zero, .. } => *zero,
+        }
+    }
+
+    /// J_m(j_mn·s) for s = r/a in [0, 1]; 0 outside.
+    pub fn at(&self, s: f64) -> f64 {
+        match self {
+            Radial::Table(p) => p.at(s),
+            Radial::Debye { m, zero } if (0.0..=1.0).contains(&s) => debye_j(*m, zero * s),
+            Radial::Debye { .. } => 0.0,
+        }
+    }
+
+    /// J_{m+1}(j_mn)², which gives the modal mass; Debye: J'_m(j)² ≈ 2w/(π j²).
+    pub fn j_next_squared(&self) -> f64 {
+        match self {
+            Radial::Table(p) => p.j_next_at_zero.powi(2),
+            Radial::Debye { m, zero } => {
+                let w = (zero * zero - f64::from(*m).powi(2)).max(0.0).sqrt();
+                2.0 * w / (std::f64::consts::PI * zero * zero)
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -186,6 +276,31 @@ mod tests {
         let below = bessel_zeros_below(0, 9.0);
         assert_eq!(below.len(), 3);
         assert!((below[2] - 8.653_727_912_911_013).abs() < 1e-9);
+    }
+
+    /// Debye's zeros lie within 0.3 % of the exact ones near the limit (low n, high m the
+    /// hardest), its J_m within 0.02 of the exact one there, and its modal-mass factor
+    /// within 5 %.
+    #[test]
+    fn debye_form_near_the_limit() {
+        for (m, n) in [(0, 9), (5, 6), (12, 3), (20, 1), (24, 1), (8, 7)] {
+            let exact = bessel_zero(m, n);
+            let debye = debye_zero(m, n);
+            assert!(
+                (debye / exact - 1.0).abs() < 3e-3,
+                "j{m},{n}: {debye} vs {exact}"
+            );
+            for s in [0.3, 0.6, 0.9] {
+                let (a, b) = (bessel_j(m, exact * s), debye_j(m, exact * s));
+                assert!((a - b).abs() < 0.02, "J{m}({}): {b} vs {a}", exact * s);
+            }
+            let table = Radial::Table(radial_profile(m, n)).j_next_squared();
+            let asym = Radial::Debye { m, zero: exact }.j_next_squared();
+            assert!(
+                (asym / table - 1.0).abs() < 0.05,
+                "{m},{n}: {asym} vs {table}"
+            );
+        }
     }
 
     /// The tabulated profile interpolates J_m to 1e-5, is 0 at the rim and outside.

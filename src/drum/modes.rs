@@ -13,12 +13,11 @@
 //! scaled from the kit's highest listed mode by f_last/f (higher modes die faster and
 //! radiate less), and axisymmetric (m = 0) modes a quarter of that T60 (they die fast, guide §5).
 
-use super::bessel::{RadialProfile, bessel_zeros_below, radial_profile};
+use super::bessel::{EXACT_ZERO_LIMIT, Radial, bessel_zeros_below, debye_zero};
 use super::{DrumError, FrequencySource, ModeConfig};
 use crate::kit::Drum;
 use glam::{DVec2, DVec3};
 use std::f64::consts::{PI, TAU};
-use std::sync::Arc;
 
 /// Which of a degenerate pair: the shape's angular factor cos(mθ) or sin(mθ) (m = 0 modes
 /// have only `Cos`, whose factor is 1).
@@ -47,13 +46,13 @@ pub struct HeadMode {
     pub modal_mass_kg: f64,
     /// Whether the kit's mode table lists this (m, n).
     pub listed: bool,
-    radial: Arc<RadialProfile>,
+    radial: Radial,
 }
 
 impl HeadMode {
     /// The zero j_mn of this mode's radial profile.
     pub fn bessel_zero(&self) -> f64 {
-        self.radial.zero
+        self.radial.zero()
     }
 
     /// Mode shape Φ at head-local polar coordinates (s = r/a, θ rad); 0 outside the head.
@@ -68,6 +67,38 @@ impl HeadMode {
             Orientation::Sin => radial * sin,
         }
     }
+}
+
+/// How many modes a head gets: a count, or all below a frequency (Hz).
+#[derive(Clone, Copy, Debug)]
+enum Extent {
+    Count(usize),
+    BelowHz(f64),
+}
+
+/// Unlisted (zero, m, n) with j_mn below `x_max`: exact zeros below [`EXACT_ZERO_LIMIT`],
+/// Debye's above, each (m, n) once.
+fn unlisted_zeros(x_max: f64, is_listed: &dyn Fn(u32, u32) -> bool) -> Vec<(f64, u32, u32)> {
+    let mut found = Vec::new();
+    for m in (0..).take_while(|&m| f64::from(m) < x_max) {
+        let exact = bessel_zeros_below(m, x_max.min(EXACT_ZERO_LIMIT));
+        let mut n = exact.len() as u32;
+        for (i, z) in exact.into_iter().enumerate() {
+            found.push((z, m, i as u32 + 1));
+        }
+        if x_max > EXACT_ZERO_LIMIT {
+            loop {
+                n += 1;
+                let z = debye_zero(m, n);
+                if z >= x_max {
+                    break;
+                }
+                found.push((z, m, n));
+            }
+        }
+    }
+    found.retain(|&(_, m, n)| !is_listed(m, n));
+    found
 }
 
 /// The modes of one head and where it is.
@@ -85,6 +116,21 @@ impl HeadModes {
     /// (in kit order, cos then sin), then the others by rising frequency.
     pub fn new(drum: &Drum, config: &ModeConfig) -> Result<HeadModes, DrumError> {
         config.check()?;
+        Self::build(drum, config.source, Extent::Count(config.count))
+    }
+
+    /// Every mode orientation of `drum` below `max_hz` (the listed ones first, then the
+    /// others by rising frequency): a full-band head for sound. Zeros above
+    /// [`EXACT_ZERO_LIMIT`] come from Debye's asymptotic form.
+    pub fn below_hz(
+        drum: &Drum,
+        source: FrequencySource,
+        max_hz: f64,
+    ) -> Result<HeadModes, DrumError> {
+        Self::build(drum, source, Extent::BelowHz(max_hz))
+    }
+
+    fn build(drum: &Drum, source: FrequencySource, extent: Extent) -> Result<HeadModes, DrumError> {
         let a = drum.radius_m();
         let mem = &drum.membrane;
         if !(a > 0.0 && mem.tension_n_per_m > 0.0 && mem.areal_density_kg_per_m2 > 0.0) {
@@ -93,40 +139,45 @@ impl HeadModes {
         let f11 = drum.tuning.hz();
         let wave_hz_per_zero =
             (mem.tension_n_per_m / mem.areal_density_kg_per_m2).sqrt() / (TAU * a);
+        let unlisted_hz_per_zero = match source {
+            FrequencySource::Measured => wave_hz_per_zero,
+            FrequencySource::Membrane => mem.air_loading * wave_hz_per_zero,
+        };
         let sigma_eff = mem.areal_density_kg_per_m2 / (mem.air_loading * mem.air_loading);
         let last = drum
             .modes
             .last()
             .ok_or_else(|| DrumError::InvalidDrum(drum.name.clone()))?;
         let last_hz = last.ratio * f11;
+        let is_listed = |m: u32, n: u32| drum.modes.iter().any(|k| (k.m, k.n) == (m, n));
 
-        // Candidate unlisted (m, n) pairs with their exact zeros, enough of them: the
-        // zeros below x_max, widening x_max until they hold the orientations needed.
-        let need = config.count;
-        let mut x_max = 12.0;
-        let unlisted = loop {
-            let mut found: Vec<(f64, u32, u32)> = Vec::new();
-            for m in (0..).take_while(|&m| f64::from(m) < x_max) {
-                for (i, z) in bessel_zeros_below(m, x_max).into_iter().enumerate() {
-                    let n = i as u32 + 1;
-                    if !drum.modes.iter().any(|k| (k.m, k.n) == (m, n)) {
-                        found.push((z, m, n));
+        // Candidate unlisted (m, n) pairs with their zeros, rising.
+        let mut unlisted = match extent {
+            Extent::Count(need) => {
+                // The exact zeros below x_max, widening x_max until they hold the
+                // orientations needed.
+                let mut x_max = 12.0;
+                loop {
+                    let found = unlisted_zeros(x_max, &is_listed);
+                    let orientations: usize = found
+                        .iter()
+                        .map(|&(_, m, _)| if m == 0 { 1 } else { 2 })
+                        .sum();
+                    if orientations >= need {
+                        break found;
                     }
+                    x_max *= 1.5;
                 }
             }
-            let orientations: usize = found
-                .iter()
-                .map(|&(_, m, _)| if m == 0 { 1 } else { 2 })
-                .sum();
-            if orientations >= need {
-                break found;
-            }
-            x_max *= 1.5;
+            Extent::BelowHz(max_hz) => unlisted_zeros(max_hz / unlisted_hz_per_zero, &is_listed),
         };
-        let mut unlisted = unlisted;
         unlisted.sort_by(|x, y| x.0.total_cmp(&y.0).then((x.1, x.2).cmp(&(y.1, y.2))));
 
-        let mut modes = Vec::with_capacity(config.count);
+        let mut modes = Vec::new();
+        let room = |modes: &Vec<HeadMode>| match extent {
+            Extent::Count(count) => modes.len() < count,
+            Extent::BelowHz(_) => true,
+        };
         let orientations = |m: u32| {
             if m == 0 {
                 &[Orientation::Cos][..]
@@ -134,53 +185,59 @@ impl HeadModes {
                 &[Orientation::Cos, Orientation::Sin][..]
             }
         };
-        let push =
-            |m: u32, n: u32, listed: Option<&crate::kit::Mode>, modes: &mut Vec<HeadMode>| {
-                let radial = radial_profile(m, n);
-                let membrane_hz = wave_hz_per_zero * radial.zero;
-                let (freq_hz, t60_s, gain) = match (listed, config.source) {
-                    (Some(k), FrequencySource::Measured) => (k.ratio * f11, k.decay_s, k.gain),
-                    (Some(k), FrequencySource::Membrane) => {
-                        (mem.air_loading * membrane_hz, k.decay_s, k.gain)
-                    }
-                    (None, source) => {
-                        let f = match source {
-                            FrequencySource::Measured => membrane_hz,
-                            FrequencySource::Membrane => mem.air_loading * membrane_hz,
-                        };
-                        let scale = last_hz / f;
-                        let t60 = last.decay_s * scale * if m == 0 { 0.25 } else { 1.0 };
-                        (f, t60, last.gain * scale.min(1.0))
-                    }
-                };
-                // ∫ Φ² dA = π a² J1(j)² for m = 0, π a²/2 · J_{m+1}(j)² otherwise.
-                let angular = if m == 0 { PI } else { PI / 2.0 };
-                let norm = angular * a * a * radial.j_next_at_zero.powi(2);
-                for &orientation in orientations(m) {
-                    if modes.len() == config.count {
-                        return;
-                    }
-                    modes.push(HeadMode {
-                        m,
-                        n,
-                        orientation,
-                        freq_hz,
-                        t60_s,
-                        gain,
-                        modal_mass_kg: sigma_eff * norm,
-                        listed: listed.is_some(),
-                        radial: Arc::clone(&radial),
-                    });
+        let push = |m: u32,
+                    n: u32,
+                    zero: f64,
+                    listed: Option<&crate::kit::Mode>,
+                    modes: &mut Vec<HeadMode>| {
+            let radial = Radial::of(m, n, zero);
+            let membrane_hz = wave_hz_per_zero * zero;
+            let (freq_hz, t60_s, gain) = match (listed, source) {
+                (Some(k), FrequencySource::Measured) => (k.ratio * f11, k.decay_s, k.gain),
+                (Some(k), FrequencySource::Membrane) => {
+                    (mem.air_loading * membrane_hz, k.decay_s, k.gain)
+                }
+                (None, _) => {
+                    let f = unlisted_hz_per_zero * zero;
+                    let scale = last_hz / f;
+                    let t60 = last.decay_s * scale * if m == 0 { 0.25 } else { 1.0 };
+                    (f, t60, last.gain * scale.min(1.0))
                 }
             };
+            // ∫ Φ² dA = π a² J1(j)² for m = 0, π a²/2 · J_{m+1}(j)² otherwise.
+            let angular = if m == 0 { PI } else { PI / 2.0 };
+            let norm = angular * a * a * radial.j_next_squared();
+            for &orientation in orientations(m) {
+                if !room(modes) {
+                    return;
+                }
+                if let Extent::BelowHz(max_hz) = extent
+                    && freq_hz >= max_hz
+                {
+                    return;
+                }
+                modes.push(HeadMode {
+                    m,
+                    n,
+                    orientation,
+                    freq_hz,
+                    t60_s,
+                    gain,
+                    modal_mass_kg: sigma_eff * norm,
+                    listed: listed.is_some(),
+                    radial: radial.clone(),
+                });
+            }
+        };
         for k in &drum.modes {
-            push(k.m, k.n, Some(k), &mut modes);
+            let zero = super::bessel::bessel_zero(k.m, k.n);
+            push(k.m, k.n, zero, Some(k), &mut modes);
         }
-        for &(_, m, n) in &unlisted {
-            if modes.len() >= config.count {
+        for &(zero, m, n) in &unlisted {
+            if !room(&modes) {
                 break;
             }
-            push(m, n, None, &mut modes);
+            push(m, n, zero, None, &mut modes);
         }
         Ok(HeadModes {
             radius_m: a,
@@ -190,6 +247,17 @@ impl HeadModes {
                 .unwrap_or(DVec2::NEG_Y),
             modes,
         })
+    }
+
+    /// Keep only the modes at `indices` (rising), in that order.
+    pub fn retain_indices(&mut self, indices: &[usize]) {
+        let mut keep = indices.iter().peekable();
+        let mut k = 0;
+        self.modes.retain(|_| {
+            let hit = keep.next_if_eq(&&k).is_some();
+            k += 1;
+            hit
+        });
     }
 
     /// The mode orientations, listed modes first.

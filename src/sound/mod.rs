@@ -4,7 +4,12 @@
 //! fixed calibration, mixed with a constant-power pan from each drum's placement x, then
 //! checked for NaN and held below −1 dBFS by scaling the whole render down if needed.
 
+pub mod analysis;
+pub mod calibration;
+pub mod fit;
 pub mod modal;
+pub mod partials;
+pub mod radiation;
 pub mod sample;
 pub mod signal;
 pub mod spectrum;
@@ -122,6 +127,37 @@ pub struct SoundState {
     peaks: Vec<f32>,
 }
 
+/// Each drum's own sound, panned and scaled exactly as in the mix (stereo): what its
+/// head radiates. The stems sum to the mix, to the rounding. One [`Audio`] per kit drum.
+pub fn stems(
+    kit: &Kit,
+    drums: &DrumSet,
+    duration_s: f64,
+    model: SoundModel,
+) -> Result<Vec<Audio>, SoundError> {
+    let (mix, state) = render_resuming(kit, drums, duration_s, model, None)?;
+    Ok(state
+        .drums
+        .iter()
+        .zip(&kit.drums)
+        .map(|((mono, _, _), drum)| {
+            let (l, r) = pan_gains(drum.placement.x_m);
+            Audio {
+                rate_hz: SAMPLE_RATE_HZ,
+                channels: 2,
+                samples: mono
+                    .iter()
+                    .flat_map(|s| {
+                        let s = f64::from(*s) * mix.gain;
+                        [(s * l) as f32, (s * r) as f32]
+                    })
+                    .collect(),
+                gain: mix.gain,
+            }
+        })
+        .collect())
+}
+
 /// Render `duration_s` of sound from what `drums` recorded (excitation, contacts).
 pub fn render(
     kit: &Kit,
@@ -141,6 +177,23 @@ pub fn render_resuming(
     drums: &DrumSet,
     duration_s: f64,
     model: SoundModel,
+    previous: Option<SoundState>,
+) -> Result<(Audio, SoundState), SoundError> {
+    render_calibrated(
+        kit,
+        drums,
+        duration_s,
+        (model, calibration::Calibration::shipped()),
+        previous,
+    )
+}
+
+/// [`render_resuming`] with the modal model under `calibration` (the fit tries its own).
+pub fn render_calibrated(
+    kit: &Kit,
+    drums: &DrumSet,
+    duration_s: f64,
+    (model, calibration): (SoundModel, &calibration::Calibration),
     previous: Option<SoundState>,
 ) -> Result<(Audio, SoundState), SoundError> {
     if !(duration_s.is_finite() && (0.0..=86_400.0).contains(&duration_s)) {
@@ -173,7 +226,9 @@ pub fn render_resuming(
     for (j, drum) in kit.drums.iter().enumerate() {
         let (mono, synth, heard) = &mut state.drums[j];
         let (touched, from) = match model {
-            SoundModel::Modal => modal::resynthesise(drums, j, mono, frames, synth),
+            SoundModel::Modal => {
+                modal::resynthesise((drum, calibration), drums, j, mono, frames, synth)
+            }
             SoundModel::Sample => {
                 *mono = vec![0.0; frames];
                 (sample::render_drum(drum, drums, j, mono)?, 0)

@@ -11,13 +11,18 @@
 //! in the simulation).
 
 use super::SAMPLE_RATE_HZ;
+use super::calibration::Calibration;
+use super::partials::SoundHead;
 use super::voices::{BankState, Voice, VoiceBank};
 use crate::drum::{DrumSet, HeadModes, Orientation};
+use crate::kit::Drum;
 use glam::DVec2;
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
 
-/// Output per unit of Σ gain × modal velocity, 1/(m/s): an ff strike (3.5 m/s) at the
+/// Output per unit of Σ gain × modal velocity (gains: [`super::partials`]): an ff strike at the
 /// playing spot of the standard 26-inch drum peaks near −6 dBFS.
-pub const MODAL_CALIBRATION: f64 = 0.083;
+pub const MODAL_CALIBRATION: f64 = 0.011;
 /// Samples per processing block.
 const BLOCK: usize = 128;
 /// States below this (m/s, about −200 dB re 1 m/s) are flushed to zero.
@@ -40,11 +45,50 @@ pub fn voices_for(head: &HeadModes, calibration: f64) -> (Vec<usize>, Vec<Voice>
                     freq_hz: m.freq_hz,
                     t60_s: m.t60_s,
                     gain: m.gain * calibration,
+                    glide: 0.0,
                 },
             )
         })
         .unzip()
 }
+
+/// The sounding modes of `drum` under `calibration`, built once per process per drum
+/// definition, frequency source and calibration (a full-band head takes a while to build).
+pub fn sound_head(
+    drum: &Drum,
+    drums: &DrumSet,
+    calibration: &Calibration,
+) -> Option<Arc<SoundHead>> {
+    type Cache = Mutex<HashMap<String, Arc<SoundHead>>>;
+    static CACHE: OnceLock<Cache> = OnceLock::new();
+    let source = drums.config().source;
+    let key = format!("{drum:?}{source:?}{calibration:?}");
+    let cache = CACHE.get_or_init(Default::default);
+    if let Some(h) = cache.lock().expect("cache lock").get(&key) {
+        return Some(Arc::clone(h));
+    }
+    let head = Arc::new(SoundHead::new(drum, source, calibration).ok()?);
+    cache
+        .lock()
+        .expect("cache lock")
+        .insert(key, Arc::clone(&head));
+    Some(head)
+}
+
+/// The voices of a sounding head with the model's calibration applied.
+fn calibrated(head: &SoundHead) -> Vec<Voice> {
+    head.voices
+        .iter()
+        .map(|v| Voice {
+            gain: v.gain * MODAL_CALIBRATION,
+            ..*v
+        })
+        .collect()
+}
+
+/// Contact points are taken to the centre of a square cell this wide for their mode
+/// shapes, m (the felt ball is ≈ 36 mm across).
+const SHAPE_GRID_M: f64 = 5e-4;
 
 /// Blocks between saved synthesis states (8192 frames, 0.17 s).
 const SAVE_EVERY_BLOCKS: usize = 64;
@@ -85,6 +129,7 @@ pub struct DrumSynth {
 /// output) reaches; the output before it is kept. Bit for bit a whole render. Returns
 /// whether anything touched the drum and the first frame rewritten.
 pub fn resynthesise(
+    (drum, calibration): (&Drum, &Calibration),
     drums: &DrumSet,
     j: usize,
     out: &mut Vec<f32>,
@@ -100,14 +145,14 @@ pub fn resynthesise(
         let hi = (c + dt * fs).ceil().max(0.0) as usize; // exclusive
         (c, lo, hi)
     };
-    let head = drums.head(j);
+    let head = sound_head(drum, drums, calibration);
     let mut entries: Vec<_> = drums.excitation().iter().filter(|e| e.drum == j).collect();
     entries.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
     let heard: Vec<(f64, DVec2, f64)> = entries
         .iter()
         .map(|e| (e.time_s, e.point, e.force_n))
         .collect();
-    let voices = head.map_or(Vec::new(), |h| voices_for(h, MODAL_CALIBRATION).1);
+    let voices = head.as_deref().map_or(Vec::new(), calibrated);
     // The first frame a difference reaches: none before the end of the previous output
     // when the drum is silent now and was then, or heard the same entries with the same
     // voices.
@@ -144,8 +189,13 @@ pub fn resynthesise(
         synth.saved.clear();
         return (false, start);
     };
-    let (index, voices) = voices_for(head, MODAL_CALIBRATION);
-    let mut bank = VoiceBank::new(&voices, f64::from(SAMPLE_RATE_HZ));
+    let mut bank = VoiceBank::new(&synth.voices, f64::from(SAMPLE_RATE_HZ));
+    let inv_mass: Vec<f64> = head
+        .modes
+        .modes()
+        .iter()
+        .map(|m| 1.0 / m.modal_mass_kg)
+        .collect();
     let saved = &mut synth.saved;
     let mut silent = true;
     if let Some(s) = saved.pop() {
@@ -153,7 +203,10 @@ pub fn resynthesise(
         silent = s.silent;
     }
     let stride = bank.stride();
-    let mut shapes = vec![0.0; head.modes().len()];
+    let mut shapes = vec![0.0; inv_mass.len()];
+    // The grid cell the shapes were last evaluated at: a contact moves little, so its
+    // entries share them (a function of the entry alone, so resuming changes nothing).
+    let mut shapes_cell: Option<DVec2> = None;
     let mut row = vec![0.0f32; stride];
     let mut input = vec![0.0f32; BLOCK * stride];
     let mut first = 0;
@@ -179,9 +232,13 @@ pub fn resynthesise(
             if lo >= hi {
                 continue;
             }
-            head.shapes_at(e.point, &mut shapes);
-            for (r, &k) in row.iter_mut().zip(&index) {
-                *r = (e.force_n * shapes[k] / head.modes()[k].modal_mass_kg) as f32;
+            let cell = (e.point / SHAPE_GRID_M).round();
+            if shapes_cell != Some(cell) {
+                head.shapes_at(cell * SHAPE_GRID_M, &mut shapes);
+                shapes_cell = Some(cell);
+            }
+            for ((r, s), im) in row.iter_mut().zip(&shapes).zip(&inv_mass) {
+                *r = (e.force_n * s * im) as f32;
             }
             for n in lo..hi {
                 let w = (1.0 - (n as f64 - c).abs() / (dt * fs)).max(0.0) as f32;
@@ -192,6 +249,7 @@ pub fn resynthesise(
             }
             driven = true;
         }
+        bank.retune(bank.glide());
         if driven {
             bank.render_driven(&input[..(n1 - n0) * stride], &mut out[n0..n1]);
             input.fill(0.0);

@@ -3,8 +3,18 @@
 //! the impulse-invariant r·e^{±iω_d/fs}, r = exp(−1/(τ·fs)), τ = T60/ln 1000 — laid out as
 //! a struct of arrays in lanes of 8 f32 so the per-sample update *and* the sum over modes
 //! (per-lane partial sums) vectorise (guide §5). Output = Σ gain_k × modal velocity_k.
+//!
+//! Pitch glide (tension modulation, Avanzini & Marogna, IEEE TASLP 2010): a loud stroke
+//! stretches the head, raising its tension and every mode's frequency by the same factor
+//! 1 + δ with δ = Σ_k c_k·(x1_k² + x2_k²) (the voices' `glide` weights, from the head's
+//! stretching; see [`crate::sound::partials`]). [`VoiceBank::retune`] sets δ for the next
+//! block by turning each voice's step by the extra angle ε = ω_k·δ·dt (a small rotation
+//! applied after the step: exact to O(ε²) for the damped step, ε < 1e-3 here).
 
 use crate::drum::oscillator::ModeStep;
+
+/// Largest relative frequency rise of a glide (5 %).
+pub const MAX_GLIDE: f32 = 0.05;
 
 /// Modes per SIMD chunk.
 pub const LANES: usize = 8;
@@ -19,6 +29,9 @@ pub struct Voice {
     pub t60_s: f64,
     /// Output weight of the modal velocity (output units per m/s).
     pub gain: f64,
+    /// Glide weight c: this voice's share of the relative frequency rise per (m/s)² of
+    /// its state, s²/m² (0: no glide).
+    pub glide: f64,
 }
 
 /// The state of a [`VoiceBank`]'s voices.
@@ -41,6 +54,12 @@ pub struct VoiceBank {
     gain: Vec<Lane>,
     x1: Vec<Lane>,
     x2: Vec<Lane>,
+    /// The untuned step matrices, the glide weights and ω·dt per voice.
+    base: [Vec<Lane>; 4],
+    glide: Vec<Lane>,
+    omega_dt: Vec<Lane>,
+    /// Whether any voice glides.
+    glides: bool,
 }
 
 impl VoiceBank {
@@ -58,7 +77,11 @@ impl VoiceBank {
             b2: zero.clone(),
             gain: zero.clone(),
             x1: zero.clone(),
-            x2: zero,
+            x2: zero.clone(),
+            base: [zero.clone(), zero.clone(), zero.clone(), zero.clone()],
+            glide: zero.clone(),
+            omega_dt: zero,
+            glides: voices.iter().any(|v| v.glide > 0.0),
         };
         for (k, v) in voices.iter().enumerate() {
             let s = ModeStep::new(v.freq_hz, v.t60_s, 1.0 / rate_hz);
@@ -70,8 +93,51 @@ impl VoiceBank {
             bank.b1[c][l] = s.b[0] as f32;
             bank.b2[c][l] = s.b[1] as f32;
             bank.gain[c][l] = v.gain as f32;
+            bank.glide[c][l] = v.glide as f32;
+            bank.omega_dt[c][l] = (std::f64::consts::TAU * v.freq_hz / rate_hz) as f32;
         }
+        bank.base = [
+            bank.a11.clone(),
+            bank.a12.clone(),
+            bank.a21.clone(),
+            bank.a22.clone(),
+        ];
         bank
+    }
+
+    /// The relative frequency rise δ = Σ c_k·(x1_k² + x2_k²) the voices' state calls for.
+    pub fn glide(&self) -> f32 {
+        if !self.glides {
+            return 0.0;
+        }
+        let mut acc = [0.0f32; LANES];
+        for ((c, x1), x2) in self.glide.iter().zip(&self.x1).zip(&self.x2) {
+            for l in 0..LANES {
+                acc[l] += c[l] * (x1[l] * x1[l] + x2[l] * x2[l]);
+            }
+        }
+        acc.iter().sum()
+    }
+
+    /// Ring every voice `1 + delta` times its own frequency from now on (see the module
+    /// docs; δ is held within ±[`MAX_GLIDE`]: the stretching law is a small-strain one);
+    /// `retune(0.0)` restores the voices. The extra turn is an exact rotation, so a
+    /// retuned voice never gains energy.
+    pub fn retune(&mut self, delta: f32) {
+        if !self.glides {
+            return;
+        }
+        let delta = delta.clamp(-MAX_GLIDE, MAX_GLIDE);
+        let [b11, b12, b21, b22] = &self.base;
+        for c in 0..self.a11.len() {
+            for l in 0..LANES {
+                let (s, k) = (self.omega_dt[c][l] * delta).sin_cos();
+                self.a11[c][l] = b11[c][l] * k - b12[c][l] * s;
+                self.a12[c][l] = b11[c][l] * s + b12[c][l] * k;
+                self.a21[c][l] = b21[c][l] * k - b22[c][l] * s;
+                self.a22[c][l] = b21[c][l] * s + b22[c][l] * k;
+            }
+        }
     }
 
     /// The voices' state, to [`restore`](VoiceBank::restore) later.
@@ -206,6 +272,48 @@ impl VoiceBank {
 mod tests {
     use super::*;
 
+    /// A gliding voice kicked hard rings sharp by δ = c·|x|² and settles as it decays;
+    /// retune(0) restores the voice exactly.
+    #[test]
+    fn glide_follows_the_state() {
+        let rate = 48_000.0;
+        let v = Voice {
+            freq_hz: 200.0,
+            t60_s: 0.3,
+            gain: 1.0,
+            glide: 1e-4,
+        };
+        let mut bank = VoiceBank::new(&[v], rate);
+        let plain = bank.clone();
+        bank.kick(&[10.0]);
+        assert!((bank.glide() - 1e-2).abs() < 1e-6, "{}", bank.glide());
+        bank.retune(bank.glide());
+        assert_ne!(bank.a11, plain.a11);
+        // Its fifth upward zero crossing comes ≥ 4 samples (≈ 0.4 %) before a plain
+        // voice's (δ starts at 1 % and falls with the energy, T60 0.3 s).
+        let run = |b: &mut VoiceBank, glide: bool| {
+            let mut out = vec![0.0f32; 2400];
+            for chunk in out.chunks_mut(128) {
+                if glide {
+                    b.retune(b.glide());
+                }
+                b.render_free(chunk);
+            }
+            out.windows(2)
+                .enumerate()
+                .filter(|(_, w)| w[0] < 0.0 && w[1] >= 0.0)
+                .nth(4)
+                .unwrap()
+                .0
+        };
+        let mut reference = plain.clone();
+        reference.kick(&[10.0]);
+        let (sharp, flat) = (run(&mut bank, true), run(&mut reference, false));
+        assert!(sharp + 4 <= flat && flat - sharp < 20, "{sharp} vs {flat}");
+        bank.retune(0.0);
+        assert_eq!((bank.a11.clone(), bank.a22.clone()), (plain.a11, plain.a22));
+    }
+
     /// A kicked voice rings at its frequency and its envelope falls 60 dB in T60 (2 %),
     /// and padding lanes stay silent; driven and free rendering agree for zero input.
     #[test]
@@ -216,11 +324,13 @@ mod tests {
                 freq_hz: 220.0,
                 t60_s: 0.5,
                 gain: 1.0,
+                glide: 0.0,
             },
             Voice {
                 freq_hz: 1000.0,
                 t60_s: 0.2,
                 gain: 0.0,
+                glide: 0.0,
             },
         ];
         let mut bank = VoiceBank::new(&voices, rate);

@@ -1,0 +1,129 @@
+//! `timpanist sound …`: measure notes ([`crate::sound::analysis`]).
+
+use crate::sound::analysis::{self, OCTAVE_CENTRES_HZ};
+use crate::sound::calibration::{Calibration, Residual};
+use crate::sound::fit::{self, Note};
+use std::path::{Path, PathBuf};
+
+/// Render one scripted stroke at `pitch` and `dynamic` to a mono WAV.
+pub fn stroke(
+    pitch: &str,
+    dynamic: crate::score::Dynamic,
+    seconds: f64,
+    wav: &Path,
+) -> anyhow::Result<()> {
+    let pitch: crate::base::pitch::Pitch = pitch.parse()?;
+    if !(seconds.is_finite() && (0.1..=60.0).contains(&seconds)) {
+        anyhow::bail!("--seconds {seconds} is outside 0.1-60 s");
+    }
+    let kit = fit::kit_for(pitch.hz());
+    let mono = fit::stroke(&kit, dynamic, Calibration::shipped(), seconds)?;
+    let audio = crate::sound::Audio {
+        rate_hz: crate::sound::SAMPLE_RATE_HZ,
+        channels: 1,
+        samples: mono,
+        gain: 1.0,
+    };
+    crate::sound::write_wav(wav, &audio)?;
+    println!(
+        "{} on the {} tuned to {pitch}: {:?}",
+        wav.display(),
+        kit.drums[0].name,
+        dynamic
+    );
+    Ok(())
+}
+
+/// Fit the modal sound to `files` (default: the embedded recordings) and write `output`.
+pub fn fit(files: &[PathBuf], output: &Path) -> anyhow::Result<()> {
+    let notes: Vec<Note> = if files.is_empty() {
+        fit::embedded_notes()?
+    } else {
+        files
+            .iter()
+            .map(|path| {
+                let (samples, rate_hz) = analysis::read_mono(path)?;
+                Ok(Note {
+                    name: path.display().to_string(),
+                    samples,
+                    rate_hz,
+                })
+            })
+            .collect::<anyhow::Result<_>>()?
+    };
+    let worst = |r: &[Residual]| {
+        r.iter()
+            .flat_map(|r| r.bands_db)
+            .fold(0.0f64, |m, d| m.max(d.abs()))
+    };
+    let cal = fit::fit(&notes, &mut |round, residuals| {
+        eprintln!(
+            "round {round}: worst band residual {:.1} dB",
+            worst(residuals)
+        );
+    })?;
+    cal.save(output)?;
+    println!(
+        "{} notes -> {}: worst band residual {:.1} dB",
+        notes.len(),
+        output.display(),
+        worst(&cal.residuals)
+    );
+    for r in &cal.residuals {
+        let bands: Vec<String> = r.bands_db.iter().map(|d| format!("{d:+.1}")).collect();
+        println!(
+            "  {}: model - recording {} dB",
+            r.recording,
+            bands.join(" ")
+        );
+    }
+    Ok(())
+}
+
+/// Print each file's measurements, one block per file.
+pub fn analyse(files: &[PathBuf]) -> anyhow::Result<()> {
+    for path in files {
+        let (samples, rate) = analysis::read_mono(path)?;
+        let p = analysis::profile(&samples, rate)
+            .ok_or_else(|| anyhow::anyhow!("{}: the file is silent", path.display()))?;
+        println!("{}", path.display());
+        let peak = samples.iter().fold(0.0f32, |m, s| m.max(s.abs()));
+        println!(
+            "  onset {:.3} s, rate {rate} Hz, peak {:.1} dBFS",
+            p.onset_s,
+            20.0 * peak.max(1e-12).log10()
+        );
+        let bands: Vec<String> = OCTAVE_CENTRES_HZ
+            .iter()
+            .zip(&p.bands_db)
+            .map(|(c, b)| format!("{c:.0} Hz {b:.1}"))
+            .collect();
+        println!("  octave bands (dB of the total): {}", bands.join(", "));
+        println!("  spectral centroid {:.0} Hz", p.centroid_hz);
+        let decays: Vec<String> = OCTAVE_CENTRES_HZ
+            .iter()
+            .map(|&c| {
+                analysis::band_t60(&samples, rate, c, (0.02, 1.0), 0.08)
+                    .map_or(format!("{c:.0} Hz -"), |t| format!("{c:.0} Hz {t:.2} s"))
+            })
+            .collect();
+        println!("  octave-band T60 over 0-1 s: {}", decays.join(", "));
+        match p.principal_hz {
+            Some(f) => {
+                let t0 = p.onset_s;
+                let t60 = analysis::partial_t60(&samples, rate, f, (t0 + 0.05, t0 + 1.5), 0.1);
+                let glide = analysis::glide_percent(&samples, rate, f);
+                print!("  (1,1) {f:.2} Hz");
+                if let Some(t60) = t60 {
+                    print!(", T60 {t60:.2} s");
+                }
+                if let Some(g) = glide {
+                    print!(", glide {g:+.2} % (10-70 ms against 0.5-0.6 s)");
+                }
+                println!();
+            }
+            None => println!("  no kettledrum (1,1) found between 40 and 400 Hz"),
+        }
+    }
+    Ok(())
+}

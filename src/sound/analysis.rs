@@ -1,0 +1,310 @@
+//! Measuring a struck note the way the guide's reference numbers were measured (guide §5,
+//! "Recorded timpani"): the onset, then over the first second after it the energy in
+//! the octave bands 63 Hz – 4 kHz as a share of the whole (dB), the spectral centroid, the
+//! (1,1) frequency over time (pitch glide) and the decay of a partial. Used by the
+//! calibration fit, `timpanist sound analyse`, the tests and the plots; the same code
+//! measures recordings and our own renders.
+
+use super::spectrum::{fft, hann, peak_in, principal_hz, spectrum};
+use std::path::Path;
+
+/// Nominal octave-band centres, Hz (band edges at centre/√2 and centre·√2).
+pub const OCTAVE_CENTRES_HZ: [f64; 7] = [63.0, 125.0, 250.0, 500.0, 1000.0, 2000.0, 4000.0];
+/// Span after the onset that the band energies and the centroid cover, s.
+pub const ANALYSIS_SPAN_S: f64 = 1.0;
+/// Onset: the first sample whose magnitude reaches this share of the note's peak.
+const ONSET_SHARE: f32 = 0.05;
+/// The onset is moved this long earlier so the attack's first rise is inside the span, s.
+const ONSET_LEAD_S: f64 = 0.002;
+
+/// Kettledrum ratios (1,1)…(5,1) used to recognise the (1,1) (guide §5, Fletcher & Rossing).
+pub const KETTLEDRUM_RATIOS: [f64; 5] = [1.0, 1.5, 1.98, 2.44, 2.94];
+
+/// What [`profile`] measures of one note.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Profile {
+    /// Onset, s from the start of the signal.
+    pub onset_s: f64,
+    /// Energy per octave band of [`OCTAVE_CENTRES_HZ`] over the total energy, dB.
+    pub bands_db: [f64; 7],
+    /// Power-weighted mean frequency, Hz.
+    pub centroid_hz: f64,
+    /// The principal (1,1) frequency, Hz, when the kettledrum pattern is found (40–400 Hz).
+    pub principal_hz: Option<f64>,
+}
+
+/// The first frame of the note: where the magnitude first reaches 5 % of its peak, less
+/// 2 ms. None for a silent signal.
+pub fn onset(samples: &[f32], rate_hz: u32) -> Option<usize> {
+    let peak = samples.iter().fold(0.0f32, |m, s| m.max(s.abs()));
+    if peak.is_nan() || peak <= 0.0 {
+        return None;
+    }
+    let first = samples.iter().position(|s| s.abs() >= ONSET_SHARE * peak)?;
+    Some(first.saturating_sub((ONSET_LEAD_S * f64::from(rate_hz)) as usize))
+}
+
+/// Power spectrum (no window: Parseval holds) of `samples` zero-padded to a power of two:
+/// (bin width Hz, power per bin for bins 0..=N/2).
+fn power_spectrum(samples: &[f32], rate_hz: u32) -> (f64, Vec<f64>) {
+    let n = samples.len().max(2).next_power_of_two();
+    let mut re: Vec<f64> = samples.iter().map(|&s| f64::from(s)).collect();
+    re.resize(n, 0.0);
+    let mut im = vec![0.0; n];
+    fft(&mut re, &mut im);
+    let power = (0..=n / 2).map(|k| re[k] * re[k] + im[k] * im[k]).collect();
+    (f64::from(rate_hz) / n as f64, power)
+}
+
+/// Octave-band shares (dB) and power-weighted centroid (Hz) of a power spectrum; DC left out.
+fn bands_and_centroid(bin_hz: f64, power: &[f64]) -> ([f64; 7], f64) {
+    let total: f64 = power.iter().skip(1).sum::<f64>().max(1e-300);
+    let mut bands = [0.0; 7];
+    for (band, &centre) in bands.iter_mut().zip(&OCTAVE_CENTRES_HZ) {
+        let (lo, hi) = (centre / 2f64.sqrt(), centre * 2f64.sqrt());
+        let energy: f64 = power
+            .iter()
+            .enumerate()
+            .skip(1)
+            .filter(|(k, _)| (lo..hi).contains(&(*k as f64 * bin_hz)))
+            .map(|(_, p)| p)
+            .sum();
+        *band = 10.0 * (energy / total).max(1e-30).log10();
+    }
+    let moment: f64 = power
+        .iter()
+        .enumerate()
+        .skip(1)
+        .map(|(k, p)| k as f64 * bin_hz * p)
+        .sum();
+    (bands, moment / total)
+}
+
+/// Measure one note (mono `samples` at `rate_hz`): the onset and, over the first second
+/// after it (or what there is), the octave-band shares, the centroid and the (1,1).
+/// None for a silent signal.
+pub fn profile(samples: &[f32], rate_hz: u32) -> Option<Profile> {
+    let start = onset(samples, rate_hz)?;
+    let len = ((ANALYSIS_SPAN_S * f64::from(rate_hz)) as usize).min(samples.len() - start);
+    let span = &samples[start..start + len];
+    let (bin_hz, power) = power_spectrum(span, rate_hz);
+    let (bands_db, centroid_hz) = bands_and_centroid(bin_hz, &power);
+    let principal = principal_hz(&spectrum(span, rate_hz), 40.0, 400.0, &KETTLEDRUM_RATIOS);
+    Some(Profile {
+        onset_s: start as f64 / f64::from(rate_hz),
+        bands_db,
+        centroid_hz,
+        principal_hz: principal,
+    })
+}
+
+/// The frequency of the partial near `near_hz` (searched within ±4 %) in a Hann window of
+/// `window_s` seconds starting `at_s` after the signal's start, by the peak of a zero-padded
+/// spectrum (×16) refined by parabolic interpolation. None when the window runs off the end.
+pub fn partial_at(
+    samples: &[f32],
+    rate_hz: u32,
+    at_s: f64,
+    window_s: f64,
+    near_hz: f64,
+) -> Option<f64> {
+    let fs = f64::from(rate_hz);
+    let (a, len) = (
+        (at_s * fs).round() as usize,
+        (window_s * fs).round() as usize,
+    );
+    if len < 16 || a + len > samples.len() {
+        return None;
+    }
+    let n = (16 * len).next_power_of_two();
+    let mut re = vec![0.0; n];
+    let mut im = vec![0.0; n];
+    for (i, (r, &s)) in re.iter_mut().zip(&samples[a..a + len]).enumerate() {
+        *r = f64::from(s) * hann(i, len);
+    }
+    fft(&mut re, &mut im);
+    let spec: Vec<(f64, f64)> = (0..=n / 2)
+        .map(|k| {
+            (
+                k as f64 * fs / n as f64,
+                (re[k] * re[k] + im[k] * im[k]).sqrt(),
+            )
+        })
+        .collect();
+    peak_in(&spec, near_hz * 0.96, near_hz * 1.04).map(|p| p.0)
+}
+
+/// Pitch glide of the partial near `near_hz`, %: its frequency 10–70 ms after the onset
+/// against 0.5–0.6 s (a 60 ms window resolves the (1,1) from the (0,1) and (2,1) that a
+/// 30 ms one smears together). None when the note is shorter.
+pub fn glide_percent(samples: &[f32], rate_hz: u32, near_hz: f64) -> Option<f64> {
+    let t0 = onset(samples, rate_hz)? as f64 / f64::from(rate_hz);
+    let early = partial_at(samples, rate_hz, t0 + 0.01, 0.06, near_hz)?;
+    let late = partial_at(samples, rate_hz, t0 + 0.5, 0.1, near_hz)?;
+    Some(100.0 * (early / late - 1.0))
+}
+
+/// Level (dB, arbitrary reference) of the partial near `near_hz` in successive Hann
+/// windows of `window_s` seconds from `from_s` to `to_s` after the signal's start, and
+/// the least-squares T60 (s) of that decay: 60 dB over the fitted slope. None when the
+/// span is too short or the partial does not decay.
+pub fn partial_t60(
+    samples: &[f32],
+    rate_hz: u32,
+    near_hz: f64,
+    (from_s, to_s): (f64, f64),
+    window_s: f64,
+) -> Option<f64> {
+    let fs = f64::from(rate_hz);
+    let len = (window_s * fs).round() as usize;
+    let mut points = Vec::new();
+    let mut t = from_s;
+    while t + window_s <= to_s {
+        let a = (t * fs).round() as usize;
+        if a + len > samples.len() {
+            break;
+        }
+        let spec = spectrum(&samples[a..a + len], rate_hz);
+        if let Some((_, amp)) = peak_in(&spec, near_hz * 0.97, near_hz * 1.03) {
+            points.push((t, 20.0 * amp.max(1e-12).log10()));
+        }
+        t += 0.5 * window_s;
+    }
+    t60_of(&points)
+}
+
+/// Energy of an octave band (centre `centre_hz`) in successive windows: the band's T60 (s)
+/// from a least-squares line through its level from `from_s` to `to_s` after the onset, in
+/// windows of `window_s` seconds. None when the band does not decay.
+pub fn band_t60(
+    samples: &[f32],
+    rate_hz: u32,
+    centre_hz: f64,
+    (from_s, to_s): (f64, f64),
+    window_s: f64,
+) -> Option<f64> {
+    let fs = f64::from(rate_hz);
+    let start = onset(samples, rate_hz)?;
+    let len = (window_s * fs).round() as usize;
+    let (lo, hi) = (centre_hz / 2f64.sqrt(), centre_hz * 2f64.sqrt());
+    let mut points = Vec::new();
+    let mut t = from_s;
+    while t + window_s <= to_s {
+        let a = start + (t * fs).round() as usize;
+        if a + len > samples.len() {
+            break;
+        }
+        let windowed: Vec<f32> = samples[a..a + len]
+            .iter()
+            .enumerate()
+            .map(|(i, &s)| s * hann(i, len) as f32)
+            .collect();
+        let (bin, power) = power_spectrum(&windowed, rate_hz);
+        let energy: f64 = power
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| (lo..hi).contains(&(*k as f64 * bin)))
+            .map(|(_, p)| p)
+            .sum();
+        if energy > 0.0 {
+            points.push((t, 10.0 * energy.log10()));
+        }
+        t += 0.5 * window_s;
+    }
+    t60_of(&points)
+}
+
+/// T60 (s) of levels (time s, dB) from their least-squares slope; None for fewer than three
+/// points or a level that does not fall.
+fn t60_of(points: &[(f64, f64)]) -> Option<f64> {
+    if points.len() < 3 {
+        return None;
+    }
+    let n = points.len() as f64;
+    let (mt, ml) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), p| (a + p.0 / n, b + p.1 / n));
+    let (sxy, sxx) = points.iter().fold((0.0, 0.0), |(a, b), p| {
+        (a + (p.0 - mt) * (p.1 - ml), b + (p.0 - mt) * (p.0 - mt))
+    });
+    let slope = sxy / sxx;
+    (slope < 0.0).then(|| -60.0 / slope)
+}
+
+/// Why a WAV could not be read for analysis.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {message}", path.display())]
+pub struct ReadError {
+    pub path: std::path::PathBuf,
+    pub message: String,
+}
+
+/// A WAV file's channels averaged to mono (PCM 8–32 bit or float), with its rate.
+pub fn read_mono(path: &Path) -> Result<(Vec<f32>, u32), ReadError> {
+    let bad = |message: String| ReadError {
+        path: path.to_path_buf(),
+        message,
+    };
+    let mut reader = hound::WavReader::open(path).map_err(|e| bad(e.to_string()))?;
+    let spec = reader.spec();
+    let ch = usize::from(spec.channels.max(1));
+    let raw: Vec<f32> = match spec.sample_format {
+        hound::SampleFormat::Float => reader
+            .samples::<f32>()
+            .collect::<Result<_, _>>()
+            .map_err(|e| bad(e.to_string()))?,
+        hound::SampleFormat::Int => {
+            let scale = 1.0 / (1u64 << (spec.bits_per_sample.clamp(8, 32) - 1)) as f32;
+            reader
+                .samples::<i32>()
+                .map(|s| s.map(|v| v as f32 * scale))
+                .collect::<Result<_, _>>()
+                .map_err(|e| bad(e.to_string()))?
+        }
+    };
+    if raw.is_empty() {
+        return Err(bad("the file holds no samples".into()));
+    }
+    let mono = raw
+        .chunks_exact(ch)
+        .map(|f| f.iter().sum::<f32>() / ch as f32)
+        .collect();
+    Ok((mono, spec.sample_rate))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::TAU;
+
+    /// A decaying sinusoid: its octave band holds almost all the energy, the centroid sits
+    /// on its frequency, the T60 is read back (5 %) and a gliding partial is tracked.
+    #[test]
+    fn measures_a_known_signal() {
+        let rate = 48_000;
+        let (f0, t60) = (250.0, 0.8);
+        let tau = t60 / 1000f64.ln();
+        let mut s = vec![0.0f32; 4800];
+        s.extend((0..96_000).map(|i| {
+            let t = i as f64 / 48_000.0;
+            ((TAU * f0 * t).sin() * (-t / tau).exp()) as f32
+        }));
+        let p = profile(&s, rate).unwrap();
+        assert!((p.onset_s - 0.1).abs() < 0.003, "{}", p.onset_s);
+        assert!(p.bands_db[2] > -0.5, "{:?}", p.bands_db);
+        assert!(
+            p.bands_db[0] < -20.0 && p.bands_db[6] < -40.0,
+            "{:?}",
+            p.bands_db
+        );
+        assert!((p.centroid_hz / f0 - 1.0).abs() < 0.1, "{}", p.centroid_hz);
+        let onset = p.onset_s;
+        let est = partial_t60(&s, rate, f0, (onset + 0.05, onset + 0.9), 0.1).unwrap();
+        assert!((est / t60 - 1.0).abs() < 0.05, "{est}");
+        let band = band_t60(&s, rate, 250.0, (0.05, 0.9), 0.1).unwrap();
+        assert!((band / t60 - 1.0).abs() < 0.05, "{band}");
+        let f = partial_at(&s, rate, 0.2, 0.05, 245.0).unwrap();
+        assert!((f / f0 - 1.0).abs() < 2e-3, "{f}");
+        assert!(super::onset(&[0.0; 10], rate).is_none());
+    }
+}

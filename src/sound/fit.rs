@@ -1,0 +1,252 @@
+//! Fitting the modal sound to recorded notes (`timpanist sound fit`): each recording is
+//! measured with [`super::analysis`] — its (1,1) pitch, octave-band shares and band T60s
+//! over the first second, and the T60 of the kit's listed partials — and the same note is
+//! played by a scripted mf stroke (legato, playing spot) on the standard-kit drum whose
+//! range is nearest, tuned to the recording. Then, a few rounds: each band's radiation
+//! correction moves by the mean (recording − model) band share, and each band's T60 by
+//! the geometric-mean ratio of the recordings' band T60 to the model's. The listed
+//! partials take the recordings' measured T60s directly. Deterministic: the same
+//! recordings give the same calibration.
+
+use super::analysis::{self, OCTAVE_CENTRES_HZ};
+use super::calibration::{Calibration, PartialDecay, Residual};
+use super::{SoundError, SoundModel};
+use crate::base::gesture::Dynamic;
+use crate::base::pitch::Pitch;
+use crate::drum::strike::{PLAYING_SPOT_FRACTION, SIM_RATE_HZ, impact_speed_mps, scripted};
+use crate::drum::{DrumSet, ModeConfig};
+use crate::kit::{Kit, Side};
+
+/// Rounds of the band fit.
+pub const ROUNDS: usize = 12;
+/// Length of the rendered comparison note, s.
+const NOTE_S: f64 = 1.6;
+/// The band-T60 span after the onset, s.
+const DECAY_SPAN_S: (f64, f64) = (0.02, 1.0);
+/// A band's radiation correction is fitted on the notes whose pitch lies this many times
+/// below the band's centre (lower bands are the listed partials' business).
+const BAND_FIT_ABOVE_PITCH: f64 = 4.0;
+/// Largest change of a band's correction per round, dB.
+const MAX_STEP_DB: f64 = 6.0;
+/// Bounds of a fitted T60, s: the guide's recordings fall 20 dB in 0.55–1.1 s.
+const MIN_T60_S: f64 = 0.1;
+const MAX_T60_S: f64 = 6.0;
+/// Window of the band-T60 measurement, s.
+const DECAY_WINDOW_S: f64 = 0.08;
+
+/// A recorded note.
+#[derive(Clone, Debug)]
+pub struct Note {
+    pub name: String,
+    /// Mono samples.
+    pub samples: Vec<f32>,
+    pub rate_hz: u32,
+}
+
+/// What a note measures: pitch (Hz), band shares (dB), band T60s (s).
+#[derive(Clone, Debug)]
+struct Measured {
+    pitch_hz: f64,
+    bands_db: [f64; 7],
+    band_t60_s: [Option<f64>; 7],
+}
+
+fn measure(samples: &[f32], rate_hz: u32) -> Option<Measured> {
+    let p = analysis::profile(samples, rate_hz)?;
+    let band_t60_s = OCTAVE_CENTRES_HZ
+        .map(|c| analysis::band_t60(samples, rate_hz, c, DECAY_SPAN_S, DECAY_WINDOW_S));
+    Some(Measured {
+        pitch_hz: p.principal_hz?,
+        bands_db: p.bands_db,
+        band_t60_s,
+    })
+}
+
+/// A one-drum kit playing `hz`: the standard-kit drum whose range is nearest the pitch
+/// (by semitones from its range), tuned to the nearest pitch.
+pub fn kit_for(hz: f64) -> Kit {
+    let mut kit = Kit::standard();
+    let midi = (69.0 + 12.0 * (hz / 440.0).log2())
+        .round()
+        .clamp(0.0, 127.0) as u8;
+    let pitch = Pitch(midi);
+    let distance = |d: &crate::kit::Drum| {
+        if d.in_range(pitch) {
+            0
+        } else {
+            (i32::from(d.lowest.0) - i32::from(midi))
+                .abs()
+                .min((i32::from(d.highest.0) - i32::from(midi)).abs())
+        }
+    };
+    let best = (0..kit.drums.len())
+        .min_by_key(|&i| distance(&kit.drums[i]))
+        .unwrap_or(0);
+    let mut drum = kit.drums.swap_remove(best);
+    drum.membrane.tension_n_per_m = drum.tension_for(pitch);
+    drum.tuning = pitch;
+    kit.drums = vec![drum];
+    kit
+}
+
+/// One scripted stroke at `dynamic` (legato, playing spot, general mallet, right hand) on
+/// the first drum of `kit`, rendered with the modal model under `calibration`: mono,
+/// 48 kHz, `duration_s` long.
+pub fn stroke(
+    kit: &Kit,
+    dynamic: Dynamic,
+    calibration: &Calibration,
+    duration_s: f64,
+) -> Result<Vec<f32>, SoundError> {
+    let (drum, mallet) = (&kit.drums[0], &kit.mallets[0]);
+    let mut drums = DrumSet::new(kit, mallet, &ModeConfig::default(), 1.0 / SIM_RATE_HZ)
+        .expect("the standard kit is valid");
+    let point = drum.point_on_head(PLAYING_SPOT_FRACTION, 0.0);
+    scripted(
+        &mut drums,
+        drum,
+        mallet,
+        Side::Right,
+        point,
+        impact_speed_mps(dynamic),
+        duration_s,
+    );
+    let (audio, _) = super::render_calibrated(
+        kit,
+        &drums,
+        duration_s,
+        (SoundModel::Modal, calibration),
+        None,
+    )?;
+    Ok(audio.mono())
+}
+
+/// The recordings embedded for the sample model, as notes to fit to.
+pub fn embedded_notes() -> Result<Vec<Note>, SoundError> {
+    Ok(super::sample::recordings()?
+        .iter()
+        .map(|r| Note {
+            name: r.name.to_string(),
+            samples: r.samples.clone(),
+            rate_hz: r.rate_hz,
+        })
+        .collect())
+}
+
+/// Why a fit could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum FitError {
+    #[error("{0}: no timpani (1,1) found (is it a struck timpani note?)")]
+    NoPitch(String),
+    #[error("no recordings to fit to")]
+    Empty,
+    #[error(transparent)]
+    Sound(#[from] SoundError),
+}
+
+/// Geometric mean of the positive ratios; 1 when there are none.
+fn geometric_mean(ratios: &[f64]) -> f64 {
+    let logs: Vec<f64> = ratios
+        .iter()
+        .filter(|r| r.is_finite() && **r > 0.0)
+        .map(|r| r.ln())
+        .collect();
+    if logs.is_empty() {
+        1.0
+    } else {
+        (logs.iter().sum::<f64>() / logs.len() as f64).exp()
+    }
+}
+
+/// Fit a calibration to `notes`, starting from [`Calibration::initial`]; `progress` hears
+/// each round's residuals.
+pub fn fit(
+    notes: &[Note],
+    progress: &mut dyn FnMut(usize, &[Residual]),
+) -> Result<Calibration, FitError> {
+    let start = Calibration::initial();
+    if notes.is_empty() {
+        return Err(FitError::Empty);
+    }
+    let measured: Vec<Measured> = notes
+        .iter()
+        .map(|n| measure(&n.samples, n.rate_hz).ok_or_else(|| FitError::NoPitch(n.name.clone())))
+        .collect::<Result<_, _>>()?;
+    let kits: Vec<Kit> = measured.iter().map(|m| kit_for(m.pitch_hz)).collect();
+    let mut cal = start.clone();
+    cal.fitted_from = notes.iter().map(|n| n.name.clone()).collect();
+    // The listed partials: each recording's T60 at the kit's ratio, geometric mean.
+    let listed = &kits[0].drums[0].modes;
+    cal.partials = listed
+        .iter()
+        .filter_map(|mode| {
+            let t60s: Vec<f64> = notes
+                .iter()
+                .zip(&measured)
+                .filter_map(|(n, m)| {
+                    let onset =
+                        analysis::onset(&n.samples, n.rate_hz)? as f64 / f64::from(n.rate_hz);
+                    analysis::partial_t60(
+                        &n.samples,
+                        n.rate_hz,
+                        m.pitch_hz * mode.ratio,
+                        (onset + 0.05, onset + 1.5),
+                        0.1,
+                    )
+                })
+                .collect();
+            (!t60s.is_empty()).then(|| PartialDecay {
+                m: mode.m,
+                n: mode.n,
+                t60_s: geometric_mean(&t60s).clamp(MIN_T60_S, MAX_T60_S),
+            })
+        })
+        .collect();
+    for round in 0..=ROUNDS {
+        let mut residuals = Vec::new();
+        let mut band_steps: [Vec<f64>; 7] = Default::default();
+        let mut t60_ratios: [Vec<f64>; 7] = Default::default();
+
+        for ((note, target), kit) in notes.iter().zip(&measured).zip(&kits) {
+            let audio = stroke(kit, Dynamic::Mf, &cal, NOTE_S)?;
+            let model = measure(&audio, super::SAMPLE_RATE_HZ)
+                .ok_or_else(|| FitError::NoPitch(format!("the model's {}", note.name)))?;
+
+            let mut bands_db = [0.0; 7];
+            for b in 0..7 {
+                bands_db[b] = model.bands_db[b] - target.bands_db[b];
+                if OCTAVE_CENTRES_HZ[b] >= BAND_FIT_ABOVE_PITCH * target.pitch_hz {
+                    band_steps[b].push(-bands_db[b]);
+                }
+                if let (Some(r), Some(m)) = (target.band_t60_s[b], model.band_t60_s[b]) {
+                    t60_ratios[b].push(r / m);
+                }
+            }
+            residuals.push(Residual {
+                recording: note.name.clone(),
+                bands_db,
+            });
+        }
+        progress(round, &residuals);
+        cal.residuals = residuals;
+        if round == ROUNDS {
+            break;
+        }
+        for b in 0..7 {
+            let steps = &band_steps[b];
+            if !steps.is_empty() {
+                let step = steps.iter().sum::<f64>() / steps.len() as f64;
+                cal.radiation_db[b] += step.clamp(-MAX_STEP_DB, MAX_STEP_DB);
+            }
+            // Bands the listed partials rule barely answer: small steps, bounded decays.
+            let step = geometric_mean(&t60_ratios[b]).clamp(0.7, 1.4);
+            cal.t60_s[b] = (cal.t60_s[b] * step).clamp(MIN_T60_S, MAX_T60_S);
+        }
+        // Bands below every note's fitted ones hold the lowest fitted band's value.
+        if let Some(first) = band_steps.iter().position(|s| !s.is_empty()) {
+            let held = cal.radiation_db[first];
+            cal.radiation_db[..first].fill(held);
+        }
+    }
+    Ok(cal)
+}

@@ -1,0 +1,73 @@
+//! The full-band modal sound and its calibration on recorded timpani (issue 16): the
+//! shipped calibration is what `timpanist sound fit` makes of the embedded recordings, the
+//! sound reaches the 4 kHz band, and loud strokes are brighter than soft ones.
+
+use timpanist::drum::FrequencySource;
+use timpanist::score::Dynamic;
+use timpanist::sound::SAMPLE_RATE_HZ;
+use timpanist::sound::analysis::{glide_percent, profile};
+use timpanist::sound::calibration::Calibration;
+use timpanist::sound::fit::{self, embedded_notes, kit_for};
+use timpanist::sound::partials::SoundHead;
+
+/// Fitting the embedded recordings again gives the shipped calibration bit for bit, and
+/// its residuals are what the file says.
+#[test]
+fn shipped_calibration_is_the_fit_of_the_recordings() {
+    let notes = embedded_notes().unwrap();
+    let mut rounds = 0;
+    let fitted = fit::fit(&notes, &mut |_, _| rounds += 1).unwrap();
+    assert_eq!(rounds, fit::ROUNDS + 1);
+    assert_eq!(&fitted, Calibration::shipped());
+    assert_eq!(fitted.fitted_from.len(), 3);
+}
+
+/// The D3 drum sounds with modes up to 6 kHz; an ff stroke puts energy in the 2 and 4 kHz
+/// octave bands (24 mechanical modes alone stopped near 530 Hz: −85 dB there).
+#[test]
+fn full_band_reaches_four_kilohertz() {
+    let kit = kit_for(146.83);
+    let head = SoundHead::new(
+        &kit.drums[0],
+        FrequencySource::Measured,
+        Calibration::shipped(),
+    )
+    .unwrap();
+    let top = head.voices.iter().map(|v| v.freq_hz).fold(0.0, f64::max);
+    assert!(top > 5000.0, "highest voice {top} Hz");
+    let ff = fit::stroke(&kit, Dynamic::Ff, Calibration::shipped(), 1.5).unwrap();
+    let p = profile(&ff, SAMPLE_RATE_HZ).unwrap();
+    assert!(
+        p.bands_db[5] > -45.0 && p.bands_db[6] > -60.0,
+        "{:?}",
+        p.bands_db
+    );
+}
+
+/// A harder stroke makes a shorter, harder contact whose force reaches higher modes: the
+/// 2 kHz band's share rises by at least 10 dB from p to ff.
+#[test]
+fn louder_strokes_are_brighter() {
+    let kit = kit_for(146.83);
+    let share = |d| {
+        let x = fit::stroke(&kit, d, Calibration::shipped(), 1.5).unwrap();
+        profile(&x, SAMPLE_RATE_HZ).unwrap().bands_db[5]
+    };
+    let (p, ff) = (share(Dynamic::P), share(Dynamic::Ff));
+    assert!(ff > p + 10.0, "2 kHz share p {p:.1} dB, ff {ff:.1} dB");
+}
+
+/// Tension modulation: an ff stroke's (1,1) starts at least 0.5 % sharp of where it is at
+/// 0.5 s; a p stroke's moves by under 0.2 %.
+#[test]
+fn loud_strokes_glide_down() {
+    let kit = kit_for(146.83);
+    let f11 = kit.drums[0].tuning.hz();
+    let glide = |d| {
+        let x = fit::stroke(&kit, d, Calibration::shipped(), 1.0).unwrap();
+        glide_percent(&x, SAMPLE_RATE_HZ, f11).unwrap()
+    };
+    let (p, ff) = (glide(Dynamic::P), glide(Dynamic::Ff));
+    assert!(ff >= 0.5, "ff glide {ff:.2} %");
+    assert!(p.abs() < 0.2, "p glide {p:.2} %");
+}
