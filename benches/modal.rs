@@ -1,6 +1,8 @@
 //! Modal synthesis speed: a bank of 64 voices rendering 1 s of audio at 48 kHz (free
 //! ringing, and driven by a force input every sample), and one DrumSet step of the
 //! standard kit with a tip held in contact (per 1000 steps). × real time = 1 s / time per iteration.
+//! And the whole modal sound of the one-minute study (64 s of audio, 109 strokes on four
+//! full-band heads; the performance is simulated once before timing).
 //! `cargo bench --bench modal`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -8,8 +10,12 @@ use std::hint::black_box;
 use timpanist::drum::strike::{PLAYING_SPOT_FRACTION, SIM_RATE_HZ, ScriptedStick};
 use timpanist::drum::{DrumSet, ModeConfig};
 use timpanist::kit::Kit;
+use timpanist::mocap::db::MotionDb;
+use timpanist::render::{RenderParams, render};
+use timpanist::score::LoadedScore;
 use timpanist::sound::SAMPLE_RATE_HZ;
 use timpanist::sound::voices::{Voice, VoiceBank};
+use timpanist::sound::{SoundModel, render as render_sound};
 
 fn bank(n: usize) -> VoiceBank {
     let voices: Vec<Voice> = (0..n)
@@ -88,9 +94,23 @@ fn bench(c: &mut Criterion) {
     );
 }
 
+fn minute_study(c: &mut Criterion) {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let db = MotionDb::load(&root.join("mocap")).expect("the shipped database");
+    let loaded = LoadedScore::load(&root.join("scores/minute-study.ron")).expect("demo score");
+    let r = render(&loaded, &db, &RenderParams::default(), &mut |_| true).expect("renders");
+    let seconds = r.audio.frames() as f64 / f64::from(r.audio.rate_hz);
+    // Build the heads once (a process does it on its first render).
+    render_sound(&r.kit, &r.drums, 1.0, SoundModel::Modal).expect("sound");
+    c.bench_function(
+        "modal sound of the one-minute study (64 s, full band)",
+        |b| b.iter(|| render_sound(&r.kit, &r.drums, seconds, SoundModel::Modal).expect("sound")),
+    );
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
-    targets = bench
+    targets = bench, minute_study
 }
 criterion_main!(benches);

@@ -147,7 +147,7 @@ pub fn radial_profile(m: u32, n: u32) -> Arc<RadialProfile> {
 }
 
 /// Zeros below this use exact Bessel functions and tables; above it, Debye's form.
-pub const EXACT_ZERO_LIMIT: f64 = 30.0;
+pub const EXACT_ZERO_LIMIT: f64 = 20.0;
 
 /// Debye's phase φ(x) = √(x² − m²) − m·arccos(m/x) for x > m (0 at and below m).
 fn debye_phase(m: f64, x: f64) -> f64 {

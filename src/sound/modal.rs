@@ -25,8 +25,9 @@ use std::sync::{Arc, Mutex, OnceLock};
 pub const MODAL_CALIBRATION: f64 = 0.011;
 /// Samples per processing block.
 const BLOCK: usize = 128;
-/// States below this (m/s, about −200 dB re 1 m/s) are flushed to zero.
-pub const FLUSH_FLOOR: f32 = 1e-10;
+/// States below this (m/s; with gains ≤ 0.2 per m/s, under −150 dBFS) are flushed to zero,
+/// and a chunk of voices that is all zero is skipped.
+pub const FLUSH_FLOOR: f32 = 1e-7;
 
 /// The audible modes of a head: their indices in `head.modes()` and their voices (gains
 /// include `MODAL_CALIBRATION`).
@@ -249,7 +250,9 @@ pub fn resynthesise(
             }
             driven = true;
         }
-        bank.retune(bank.glide());
+        if driven || !silent {
+            bank.retune(bank.glide());
+        }
         if driven {
             bank.render_driven(&input[..(n1 - n0) * stride], &mut out[n0..n1]);
             input.fill(0.0);

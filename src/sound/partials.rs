@@ -35,13 +35,13 @@ pub const HEAD_STRETCH_SHARE: f64 = 0.15;
 /// Highest mode frequency that sounds, Hz.
 pub const SOUND_MAX_HZ: f64 = 6000.0;
 /// Radiation below the head's loudest mode by more than this is left out, dB.
-pub const AUDIBLE_FLOOR_DB: f64 = 70.0;
+pub const AUDIBLE_FLOOR_DB: f64 = 50.0;
 /// Above this frequency modes are thinned per bin, Hz.
 pub const DENSE_FROM_HZ: f64 = 800.0;
 /// Thinning bins per octave.
 pub const BINS_PER_OCTAVE: f64 = 6.0;
 /// Modes kept per thinning bin.
-pub const KEEP_PER_BIN: usize = 12;
+pub const KEEP_PER_BIN: usize = 6;
 
 /// A head's sounding modes and their voices (gains in output units per m/s of modal
 /// velocity, before the model's overall calibration).

@@ -16,6 +16,9 @@ use crate::drum::oscillator::ModeStep;
 /// Largest relative frequency rise of a glide (5 %).
 pub const MAX_GLIDE: f32 = 0.05;
 
+/// The glide is applied in steps of this size (1e-6: 0.0017 cents).
+pub const GLIDE_STEP: f32 = 1e-6;
+
 /// Modes per SIMD chunk.
 pub const LANES: usize = 8;
 type Lane = [f32; LANES];
@@ -58,8 +61,12 @@ pub struct VoiceBank {
     base: [Vec<Lane>; 4],
     glide: Vec<Lane>,
     omega_dt: Vec<Lane>,
-    /// Whether any voice glides.
+    /// Whether any voice glides, and the glide the step matrices hold now (NaN: unknown,
+    /// after a restore).
     glides: bool,
+    tuned: f32,
+    /// Per chunk: whether any of its voices is ringing (all-zero chunks are skipped).
+    active: Vec<bool>,
 }
 
 impl VoiceBank {
@@ -82,6 +89,8 @@ impl VoiceBank {
             glide: zero.clone(),
             omega_dt: zero,
             glides: voices.iter().any(|v| v.glide > 0.0),
+            tuned: 0.0,
+            active: vec![false; chunks],
         };
         for (k, v) in voices.iter().enumerate() {
             let s = ModeStep::new(v.freq_hz, v.t60_s, 1.0 / rate_hz);
@@ -127,7 +136,14 @@ impl VoiceBank {
         if !self.glides {
             return;
         }
-        let delta = delta.clamp(-MAX_GLIDE, MAX_GLIDE);
+        // Quantised, so the matrices are a function of the state alone (resuming from a
+        // saved state retunes exactly as the whole run did) and are rebuilt only when the
+        // glide moves by a step.
+        let delta = ((delta.clamp(-MAX_GLIDE, MAX_GLIDE) / GLIDE_STEP).round()) * GLIDE_STEP;
+        if delta == self.tuned {
+            return;
+        }
+        self.tuned = delta;
         let [b11, b12, b21, b22] = &self.base;
         for c in 0..self.a11.len() {
             for l in 0..LANES {
@@ -152,6 +168,10 @@ impl VoiceBank {
     pub fn restore(&mut self, state: &BankState) {
         self.x1.clone_from(&state.x1);
         self.x2.clone_from(&state.x2);
+        self.tuned = f32::NAN;
+        for (a, (x1, x2)) in self.active.iter_mut().zip(self.x1.iter().zip(&self.x2)) {
+            *a = x1.iter().chain(x2).any(|v| *v != 0.0);
+        }
     }
 
     /// Number of voices.
@@ -177,7 +197,7 @@ impl VoiceBank {
         let chunks = self.x1.len();
         for block in out.chunks_mut(BLOCK) {
             let mut acc = [[0.0f32; LANES]; BLOCK];
-            for c in 0..chunks {
+            for c in (0..chunks).filter(|&c| self.active[c]) {
                 let (a11, a12, a21, a22, g) = (
                     self.a11[c],
                     self.a12[c],
@@ -208,6 +228,7 @@ impl VoiceBank {
     pub fn render_driven(&mut self, input: &[f32], out: &mut [f32]) {
         let stride = self.stride();
         assert!(input.len() >= out.len() * stride, "input too short");
+        self.active.fill(true);
         for (o, row) in out.iter_mut().zip(input.chunks_exact(stride)) {
             let mut acc = [0.0f32; LANES];
             for (c, u) in row.chunks_exact(LANES).enumerate() {
@@ -248,6 +269,7 @@ impl VoiceBank {
     pub fn kick(&mut self, dv: &[f32]) {
         for (k, d) in dv.iter().enumerate().take(self.len) {
             self.x2[k / LANES][k % LANES] += d;
+            self.active[k / LANES] |= *d != 0.0;
         }
     }
 
@@ -255,14 +277,22 @@ impl VoiceBank {
     /// arithmetic — and say whether the whole bank is now silent.
     pub fn flush(&mut self, floor: f32) -> bool {
         let mut silent = true;
-        for x in self.x1.iter_mut().chain(self.x2.iter_mut()) {
-            for v in x.iter_mut() {
+        for ((x1, x2), active) in self
+            .x1
+            .iter_mut()
+            .zip(self.x2.iter_mut())
+            .zip(self.active.iter_mut())
+        {
+            let mut ringing = false;
+            for v in x1.iter_mut().chain(x2.iter_mut()) {
                 if v.abs() < floor {
                     *v = 0.0;
                 } else {
-                    silent = false;
+                    ringing = true;
                 }
             }
+            *active = ringing;
+            silent &= !ringing;
         }
         silent
     }
