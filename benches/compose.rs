@@ -39,6 +39,7 @@ fn five_minute_score() -> Score {
                 length_ticks: 3 * 960,
                 strokes_per_quarter: 8,
             }),
+            damp: None,
         });
     }
     score

@@ -167,6 +167,25 @@ fn inspector_sets_mode_of_selection() {
     assert_eq!(h.state().undo_steps(), 1);
 }
 
+/// The inspector's Damping field makes the selected beats secco (the hand touches the
+/// head an 8th after the stroke), saved in the score as one undo step.
+#[test]
+fn inspector_sets_secco() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(Some(demo()), dir.path());
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    settle(&mut h);
+    h.get_by_label("Damping").click();
+    settle(&mut h);
+    h.get_by_label("secco: touch an 8th after").click();
+    settle(&mut h);
+    let s = &h.state().loaded().unwrap().score;
+    let eighth = u64::from(s.ticks_per_quarter) / 2;
+    assert!(s.beats.iter().all(|b| b.damp == Some(eighth)));
+    assert!(s.to_ron().contains(&format!("damp: Some({eighth})")));
+    assert_eq!(h.state().undo_steps(), 1);
+}
+
 /// Dragging on a composed trajectory in the 3D view adds a handle and moves it: one undo
 /// step; undo removes it.
 #[test]

@@ -71,3 +71,46 @@ fn loud_strokes_glide_down() {
     assert!(ff >= 0.5, "ff glide {ff:.2} %");
     assert!(p.abs() < 0.2, "p glide {p:.2} %");
 }
+
+/// A secco note: 200 ms after the hand touches the head, the (1,1) is at least 20 dB
+/// below the same note left to ring, in the modal and the sample models; re-rendering an
+/// undamped rendering with the touch added resumes and equals a whole damped render.
+#[test]
+fn a_hand_on_the_head_stops_it() {
+    use timpanist::drum::strike::{PLAYING_SPOT_FRACTION, SIM_RATE_HZ, impact_speed_mps};
+    use timpanist::drum::{DrumSet, ModeConfig};
+    use timpanist::kit::{Kit, Side};
+    use timpanist::sound::spectrum::{peak_in, spectrum};
+    use timpanist::sound::{SoundModel, Touch, render_touched};
+    let kit = Kit::standard();
+    let (d, mallet) = (2, &kit.mallets[0]);
+    let drum = &kit.drums[d];
+    let mut drums = DrumSet::new(&kit, mallet, &ModeConfig::default(), 1.0 / SIM_RATE_HZ).unwrap();
+    let point = drum.point_on_head(PLAYING_SPOT_FRACTION, 0.0);
+    let speed = impact_speed_mps(Dynamic::F);
+    timpanist::drum::strike::scripted(&mut drums, drum, mallet, Side::Right, point, speed, 0.3);
+    let touch = [Touch { drum: d, at_s: 0.5 }];
+    let f11 = drum.tuning.hz();
+    let level = |audio: &timpanist::sound::Audio| {
+        let mono = audio.mono();
+        let rate = f64::from(SAMPLE_RATE_HZ);
+        let w = &mono[(0.7 * rate) as usize..(0.8 * rate) as usize];
+        peak_in(&spectrum(w, SAMPLE_RATE_HZ), f11 * 0.97, f11 * 1.03)
+            .unwrap()
+            .1
+    };
+    for model in [SoundModel::Modal, SoundModel::Sample] {
+        let (free, state) = render_touched(&kit, &drums, &[], 1.5, model, None).unwrap();
+        let (damped, _) = render_touched(&kit, &drums, &touch, 1.5, model, None).unwrap();
+        let db = 20.0 * (level(&damped) / level(&free)).log10();
+        assert!(db < -20.0, "{model:?}: {db:.1} dB");
+        // The first half second is untouched.
+        let half = 2 * SAMPLE_RATE_HZ as usize / 2;
+        assert_eq!(free.samples[..half], damped.samples[..half]);
+        if model == SoundModel::Modal {
+            let (resumed, _) =
+                render_touched(&kit, &drums, &touch, 1.5, model, Some(state)).unwrap();
+            assert_eq!(resumed.samples, damped.samples);
+        }
+    }
+}

@@ -121,6 +121,23 @@ pub fn show(ui: &mut egui::Ui, doc: &LoadedScore, sel: &Selection, out: &mut Vec
             ) {
                 set_beats(doc, sel, out, |b| b.location = l);
             }
+            let tpq = u64::from(doc.score.ticks_per_quarter);
+            let mut damps: Vec<(Option<u64>, String)> = vec![
+                (None, "let ring".to_string()),
+                (Some(tpq / 4), "secco: touch a 16th after".to_string()),
+                (Some(tpq / 2), "secco: touch an 8th after".to_string()),
+                (Some(tpq), "secco: touch a quarter after".to_string()),
+                (Some(2 * tpq), "secco: touch a half after".to_string()),
+            ];
+            let current = common(beats.iter().map(|b| b.damp));
+            if let Some(Some(d)) = current
+                && !damps.iter().any(|(v, _)| *v == Some(d))
+            {
+                damps.push((Some(d), format!("secco: touch {d} ticks after")));
+            }
+            if let Some(d) = pick(ui, "Damping", current, &damps) {
+                set_beats(doc, sel, out, |b| b.damp = d);
+            }
             ui.label("Tick");
             match common(beats.iter().map(|b| b.tick)) {
                 Some(t) => ui.label(format!("{t} ({})", doc.score.meter_map().position(t))),

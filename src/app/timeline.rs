@@ -264,6 +264,7 @@ impl TimelineView {
                         tick,
                         hand,
                         roll: None,
+                        damp: None,
                         ..template
                     };
                     let at = beats.partition_point(|b| b.tick <= tick);

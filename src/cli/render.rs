@@ -99,7 +99,7 @@ pub fn run(
         .map(|_| {
             crate::sound::stems(
                 &rendering.kit,
-                &rendering.drums,
+                (&rendering.drums, &rendering.touches),
                 rendering.audio.frames() as f64 / f64::from(rendering.audio.rate_hz),
                 rendering.params.sound,
             )

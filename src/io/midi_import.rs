@@ -774,6 +774,8 @@ fn assign_drums(notes: &[Note], kit: &Kit) -> Vec<Beat> {
             pitch: (pitch != kit.drums[drum].tuning).then_some(pitch),
             location: data.3,
             roll: data.4,
+            // A MIDI note's length says nothing reliable about damping: let it ring.
+            damp: None,
         });
     }
     beats

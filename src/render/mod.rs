@@ -30,7 +30,7 @@ use crate::motion::compose::{ComposeParams, Composition};
 use crate::motion::perform;
 use crate::motion::plan::{PlanError, PlanParams, PlannedStroke};
 use crate::score::{LoadedScore, Settings};
-use crate::sound::{Audio, SoundError, SoundModel, SoundState};
+use crate::sound::{Audio, SoundError, SoundModel, SoundState, Touch};
 use compensate::{Aims, Performance, Stage};
 use glam::DVec3;
 use reference::{StrikeShape, Targets, Warp};
@@ -210,6 +210,8 @@ pub struct Rendering {
     /// What it was rendered with.
     pub params: RenderParams,
     pub kit: Kit,
+    /// Where hands damped heads (from the score's secco beats).
+    pub touches: Vec<Touch>,
 }
 
 /// Why a score could not be rendered.
@@ -357,8 +359,10 @@ pub fn render_composition(
         half_width_s: params.strike_half_width_s,
     };
     let targets = Targets::new(&composition, &shape, params.strike_depth_m);
+    let touches = touches(&loaded.score);
     let run = Run {
         kit,
+        touches: &touches,
         mallet,
         params,
         composition: &composition,
@@ -409,12 +413,15 @@ pub fn render_composition(
         ready_s: ready_s.max(0.0),
         params: params.clone(),
         kit: kit.clone(),
+        touches,
     })
 }
 
 /// One rendering's fixed inputs.
 struct Run<'a> {
     kit: &'a Kit,
+    /// Where hands damp heads (secco beats).
+    touches: &'a [Touch],
     /// The kit's mallet the params name.
     mallet: &'a crate::kit::Mallet,
     params: &'a RenderParams,
@@ -597,9 +604,10 @@ impl Run<'_> {
             (simulated_to_s, simulated_to_s - 2.0 * drums.dt_s())
         };
         let previous = std::mem::take(&mut state.sound);
-        let (audio, sound) = crate::sound::render_resuming(
+        let (audio, sound) = crate::sound::render_touched(
             self.kit,
             drums,
+            self.touches,
             end_s.max(0.0),
             self.params.sound,
             Some(previous),
@@ -607,6 +615,21 @@ impl Run<'_> {
         state.sound = sound;
         Ok((audio, ready_s))
     }
+}
+
+/// Where the score's secco beats have a hand damp their drum: the damp tick's time.
+pub fn touches(score: &crate::score::Score) -> Vec<Touch> {
+    let tempo = score.tempo_map();
+    score
+        .beats
+        .iter()
+        .filter_map(|b| {
+            b.damp_tick().map(|tick| Touch {
+                drum: b.drum,
+                at_s: tempo.seconds_at(tick as f64),
+            })
+        })
+        .collect()
 }
 
 impl Rendering {

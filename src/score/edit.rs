@@ -251,6 +251,7 @@ mod tests {
             pitch: None,
             location: ImpactLocation::PlayingSpot,
             roll: None,
+            damp: None,
         }
     }
 

@@ -55,6 +55,10 @@ pub struct Beat {
     /// A roll starting at this beat; `None` for a single stroke.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub roll: Option<Roll>,
+    /// Secco: this many ticks after the beat's (last) stroke the player's hand touches the
+    /// head and stops it ringing; `None` lets the drum ring (laissez vibrer).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damp: Option<u64>,
 }
 
 impl Beat {
@@ -69,7 +73,13 @@ impl Beat {
             pitch: None,
             location: ImpactLocation::PlayingSpot,
             roll: None,
+            damp: None,
         }
+    }
+
+    /// Tick at which the hand touches the head to stop it, if the beat is damped.
+    pub fn damp_tick(&self) -> Option<u64> {
+        self.damp.map(|d| self.end_tick() + d)
     }
 
     /// The pitch sounded: the beat's own or the drum's kit tuning.

@@ -85,6 +85,13 @@ pub fn problems(score: &Score, kit: &Kit) -> Vec<Problem> {
                 ));
             }
         }
+        if let Some(d) = beat.damp
+            && (d == 0 || d > MAX_DAMP_QUARTERS * u64::from(score.ticks_per_quarter))
+        {
+            bad(format!(
+                "damp {d} ticks: the hand touches the head 1 tick to {MAX_DAMP_QUARTERS} quarter notes after the stroke"
+            ));
+        }
     }
     for (i, h) in score.handles.iter().enumerate() {
         let size = h.offset_m.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -128,6 +135,9 @@ pub fn problems(score: &Score, kit: &Kit) -> Vec<Problem> {
     }
     out
 }
+
+/// Longest wait before a damping touch, quarter notes (after that the drum has died away).
+pub const MAX_DAMP_QUARTERS: u64 = 16;
 
 #[cfg(test)]
 mod tests {
@@ -182,6 +192,12 @@ mod tests {
             strokes_per_quarter: 8,
         });
         assert!(first_problem(&s).contains("beat 1 falls inside this roll"));
+
+        s.beats = vec![beat(0, 0)];
+        s.beats[0].damp = Some(0);
+        assert!(first_problem(&s).contains("damp 0 ticks"));
+        s.beats[0].damp = Some(960);
+        assert!(first_problem(&s).is_empty());
 
         s.beats = vec![beat(0, 0)];
         s.tempo[0].bpm = 2000.0;

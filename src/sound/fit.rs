@@ -113,7 +113,7 @@ pub fn stroke(
     );
     let (audio, _) = super::render_calibrated(
         kit,
-        &drums,
+        (&drums, &[]),
         duration_s,
         (SoundModel::Modal, calibration),
         None,

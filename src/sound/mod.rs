@@ -38,6 +38,26 @@ pub const REFERENCE_SPEED_MPS: f64 = 4.94;
 /// modal model's calibration puts a reference strike on the 26-inch drum there too.
 pub const REFERENCE_LEVEL: f64 = 0.5;
 
+/// A hand resting on a head to stop it ringing (a secco beat): drum `drum`, from `at_s`
+/// for [`TOUCH_S`], during which every mode of the head decays with T60 [`TOUCH_T60_S`]
+/// on top of its own decay (soft, lossy skin on the membrane).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Touch {
+    pub drum: usize,
+    /// s.
+    pub at_s: f64,
+}
+
+/// How long a damping hand rests on the head, s.
+pub const TOUCH_S: f64 = 0.25;
+/// T60 the resting hand gives every mode, s.
+pub const TOUCH_T60_S: f64 = 0.05;
+
+/// The damping factor per sample at `rate_hz` while a hand rests on the head.
+pub fn touch_factor(rate_hz: f64) -> f64 {
+    (-(1000f64.ln()) / (TOUCH_T60_S * rate_hz)).exp()
+}
+
 /// Rendered sound.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Audio {
@@ -127,15 +147,42 @@ pub struct SoundState {
     peaks: Vec<f32>,
 }
 
+/// Damp a replayed drum's output (sample and signal models, which hold no modal state):
+/// from each touch until the drum's next contact, the sound decays with the touch's
+/// T60 while the hand rests and stays at the level it reached after (the hand has
+/// stopped it).
+fn damp_replayed(mono: &mut [f32], touches: &[f64], drums: &DrumSet, j: usize) {
+    let fs = f64::from(SAMPLE_RATE_HZ);
+    let factor = touch_factor(fs);
+    for &at in touches {
+        let next = drums
+            .contacts()
+            .iter()
+            .filter(|c| c.drum == j && c.start_s > at)
+            .map(|c| c.start_s)
+            .fold(f64::INFINITY, f64::min);
+        let from = ((at * fs).round().max(0.0) as usize).min(mono.len());
+        let to = ((next * fs).round().min(mono.len() as f64)) as usize;
+        let rest = (TOUCH_S * fs) as usize;
+        let mut gain = 1.0;
+        for (k, s) in mono[from..to.max(from)].iter_mut().enumerate() {
+            if k < rest {
+                gain *= factor;
+            }
+            *s = (f64::from(*s) * gain) as f32;
+        }
+    }
+}
+
 /// Each drum's own sound, panned and scaled exactly as in the mix (stereo): what its
 /// head radiates. The stems sum to the mix, to the rounding. One [`Audio`] per kit drum.
 pub fn stems(
     kit: &Kit,
-    drums: &DrumSet,
+    (drums, touches): (&DrumSet, &[Touch]),
     duration_s: f64,
     model: SoundModel,
 ) -> Result<Vec<Audio>, SoundError> {
-    let (mix, state) = render_resuming(kit, drums, duration_s, model, None)?;
+    let (mix, state) = render_touched(kit, drums, touches, duration_s, model, None)?;
     Ok(state
         .drums
         .iter()
@@ -179,9 +226,21 @@ pub fn render_resuming(
     model: SoundModel,
     previous: Option<SoundState>,
 ) -> Result<(Audio, SoundState), SoundError> {
+    render_touched(kit, drums, &[], duration_s, model, previous)
+}
+
+/// [`render_resuming`] with hands damping heads at `touches`.
+pub fn render_touched(
+    kit: &Kit,
+    drums: &DrumSet,
+    touches: &[Touch],
+    duration_s: f64,
+    model: SoundModel,
+    previous: Option<SoundState>,
+) -> Result<(Audio, SoundState), SoundError> {
     render_calibrated(
         kit,
-        drums,
+        (drums, touches),
         duration_s,
         (model, calibration::Calibration::shipped()),
         previous,
@@ -191,7 +250,7 @@ pub fn render_resuming(
 /// [`render_resuming`] with the modal model under `calibration` (the fit tries its own).
 pub fn render_calibrated(
     kit: &Kit,
-    drums: &DrumSet,
+    (drums, touches): (&DrumSet, &[Touch]),
     duration_s: f64,
     (model, calibration): (SoundModel, &calibration::Calibration),
     previous: Option<SoundState>,
@@ -232,17 +291,31 @@ pub fn render_calibrated(
             .enumerate()
             .map(|(j, (drum, (mono, synth, heard)))| {
                 scope.spawn(move || {
+                    let own: Vec<f64> = touches
+                        .iter()
+                        .filter(|t| t.drum == j)
+                        .map(|t| t.at_s)
+                        .collect();
                     let (touched, from) = match model {
-                        SoundModel::Modal => {
-                            modal::resynthesise((drum, calibration), drums, j, mono, frames, synth)
-                        }
+                        SoundModel::Modal => modal::resynthesise(
+                            (drum, calibration),
+                            (drums, &own),
+                            j,
+                            mono,
+                            frames,
+                            synth,
+                        ),
                         SoundModel::Sample => {
                             *mono = vec![0.0; frames];
-                            (sample::render_drum(drum, drums, j, mono)?, 0)
+                            let touched = sample::render_drum(drum, drums, j, mono)?;
+                            damp_replayed(mono, &own, drums, j);
+                            (touched, 0)
                         }
                         SoundModel::Signal => {
                             *mono = vec![0.0; frames];
-                            (signal::render_drum(drums, j, mono), 0)
+                            let touched = signal::render_drum(drums, j, mono);
+                            damp_replayed(mono, &own, drums, j);
+                            (touched, 0)
                         }
                     };
                     *heard = touched;

@@ -120,6 +120,8 @@ pub struct DrumSynth {
     /// The drum's excitation it heard, in time order: time (s), contact point (m), force
     /// (N).
     heard: Vec<(f64, DVec2, f64)>,
+    /// The damping touches it heard, s.
+    touches: Vec<f64>,
     voices: Vec<Voice>,
 }
 
@@ -131,7 +133,7 @@ pub struct DrumSynth {
 /// whether anything touched the drum and the first frame rewritten.
 pub fn resynthesise(
     (drum, calibration): (&Drum, &Calibration),
-    drums: &DrumSet,
+    (drums, touches): (&DrumSet, &[f64]),
     j: usize,
     out: &mut Vec<f32>,
     frames: usize,
@@ -167,11 +169,26 @@ pub fn resynthesise(
                 .fold(f64::INFINITY, f64::min);
             span(t).1
         });
+    let mut touches = touches.to_vec();
+    touches.sort_by(f64::total_cmp);
+    let first_touch_difference = (0..touches.len().max(synth.touches.len()))
+        .find(|&d| touches.get(d) != synth.touches.get(d))
+        .map(|d| {
+            let t = [touches.get(d), synth.touches.get(d)]
+                .into_iter()
+                .flatten()
+                .fold(f64::INFINITY, |m, t| m.min(*t));
+            (t * fs).floor().max(0.0) as usize
+        });
     let silent_both = heard.is_empty() && synth.heard.is_empty();
     let from = if voices != synth.voices && !silent_both {
         0
     } else {
-        first_difference.unwrap_or(usize::MAX).min(out.len())
+        first_difference
+            .into_iter()
+            .chain(first_touch_difference)
+            .fold(usize::MAX, usize::min)
+            .min(out.len())
     };
     let touched = !entries.is_empty();
     // A silent drum's output is zero: only what it held since `from` is cleared.
@@ -183,6 +200,7 @@ pub fn resynthesise(
     .min(frames);
     synth.saved.retain(|s| s.frame <= start);
     synth.heard = heard;
+    synth.touches = touches;
     synth.voices = voices;
     out.resize(frames, 0.0);
     out[start..].fill(0.0);
@@ -197,6 +215,7 @@ pub fn resynthesise(
         .iter()
         .map(|m| 1.0 / m.modal_mass_kg)
         .collect();
+    let damping = super::touch_factor(fs) as f32;
     let saved = &mut synth.saved;
     let mut silent = true;
     if let Some(s) = saved.pop() {
@@ -251,6 +270,12 @@ pub fn resynthesise(
             driven = true;
         }
         if driven || !silent {
+            let t = n0 as f64 / fs;
+            let resting = synth
+                .touches
+                .iter()
+                .any(|&at| at <= t && t < at + super::TOUCH_S);
+            bank.damp(if resting { damping } else { 1.0 });
             bank.retune(bank.glide());
         }
         if driven {

@@ -65,6 +65,8 @@ pub struct VoiceBank {
     /// after a restore).
     glides: bool,
     tuned: f32,
+    /// Extra decay factor per sample (1: none).
+    damping: f32,
     /// Per chunk: whether any of its voices is ringing (all-zero chunks are skipped).
     active: Vec<bool>,
 }
@@ -90,6 +92,7 @@ impl VoiceBank {
             omega_dt: zero,
             glides: voices.iter().any(|v| v.glide > 0.0),
             tuned: 0.0,
+            damping: 1.0,
             active: vec![false; chunks],
         };
         for (k, v) in voices.iter().enumerate() {
@@ -140,14 +143,30 @@ impl VoiceBank {
         // saved state retunes exactly as the whole run did) and are rebuilt only when the
         // glide moves by a step.
         let delta = ((delta.clamp(-MAX_GLIDE, MAX_GLIDE) / GLIDE_STEP).round()) * GLIDE_STEP;
-        if delta == self.tuned {
-            return;
+        if delta != self.tuned {
+            self.tuned = delta;
+            self.rebuild();
         }
-        self.tuned = delta;
+    }
+
+    /// Damp every voice by the extra factor `per_sample` (≤ 1) each sample from now on
+    /// (a hand resting on the head); 1 lifts it.
+    pub fn damp(&mut self, per_sample: f32) {
+        if per_sample != self.damping {
+            self.damping = per_sample;
+            self.rebuild();
+        }
+    }
+
+    /// The step matrices from the plain ones, the glide and the damping.
+    fn rebuild(&mut self) {
+        let delta = if self.tuned.is_nan() { 0.0 } else { self.tuned };
+        let d = self.damping;
         let [b11, b12, b21, b22] = &self.base;
         for c in 0..self.a11.len() {
             for l in 0..LANES {
                 let (s, k) = (self.omega_dt[c][l] * delta).sin_cos();
+                let (s, k) = (s * d, k * d);
                 self.a11[c][l] = b11[c][l] * k - b12[c][l] * s;
                 self.a12[c][l] = b11[c][l] * s + b12[c][l] * k;
                 self.a21[c][l] = b21[c][l] * k - b22[c][l] * s;
