@@ -174,6 +174,20 @@ fn damp_replayed(mono: &mut [f32], touches: &[f64], drums: &DrumSet, j: usize) {
     }
 }
 
+/// A drum's radiated sound at frame `n` from what its synthesis keeps: the modal model
+/// keeps Σ (gain_k/ω_k)·q̇_k and the pressure is its time derivative (a head radiates its
+/// acceleration, so a mode's forced response below its resonance radiates less than at
+/// it: [`partials`]); the other models keep the sound itself.
+fn radiated(model: SoundModel, mono: &[f32], n: usize) -> f32 {
+    match model {
+        SoundModel::Modal => {
+            let before = if n == 0 { 0.0 } else { mono[n - 1] };
+            (mono[n] - before) * SAMPLE_RATE_HZ as f32
+        }
+        SoundModel::Sample | SoundModel::Signal => mono[n],
+    }
+}
+
 /// Each drum's own sound, panned and scaled exactly as in the mix (stereo): what its
 /// head radiates. The stems sum to the mix, to the rounding. One [`Audio`] per kit drum.
 pub fn stems(
@@ -192,10 +206,9 @@ pub fn stems(
             Audio {
                 rate_hz: SAMPLE_RATE_HZ,
                 channels: 2,
-                samples: mono
-                    .iter()
-                    .flat_map(|s| {
-                        let s = f64::from(*s) * mix.gain;
+                samples: (0..mono.len())
+                    .flat_map(|n| {
+                        let s = f64::from(radiated(model, mono, n)) * mix.gain;
                         [(s * l) as f32, (s * r) as f32]
                     })
                     .collect(),
@@ -340,7 +353,8 @@ pub fn render_calibrated(
         }
         let (l, r) = pan_gains(drum.placement.x_m);
         let (l, r) = (l as f32, r as f32);
-        for (frame, &s) in mix[2 * start..].chunks_exact_mut(2).zip(&mono[start..]) {
+        for (n, frame) in mix[2 * start..].chunks_exact_mut(2).enumerate() {
+            let s = radiated(model, mono, start + n);
             frame[0] += l * s;
             frame[1] += r * s;
         }

@@ -22,7 +22,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 /// Output per unit of Σ gain × modal velocity (gains: [`super::partials`]): an ff strike at the
 /// playing spot of the standard 26-inch drum peaks near −6 dBFS.
-pub const MODAL_CALIBRATION: f64 = 0.011;
+pub const MODAL_CALIBRATION: f64 = 0.006;
 /// Samples per processing block.
 const BLOCK: usize = 128;
 /// States below this (m/s; with gains ≤ 0.2 per m/s, under −150 dBFS) are flushed to zero,

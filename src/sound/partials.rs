@@ -28,8 +28,8 @@ pub const HEAD_POISSON: f64 = 0.38;
 /// The share of the stretch that tensions the playing area: the film is not clamped at
 /// the rim but wraps a flesh hoop over the kettle's bearing edge, and the collar and hoop
 /// take up the rest. An estimate, not a measurement: chosen so an ff stroke on the 26-inch
-/// drum in D3 starts ≈ 1.3 % sharp and a p stroke ≈ 0.15 % (`timpanist sound analyse`;
-/// a clamped film, share 1, glided 8 % at ff).
+/// drum in D3 glides ≈ 0.7 % and a p stroke ≈ 0.1 % (`timpanist sound analyse`, 10–70 ms
+/// against 0.5–0.6 s; a clamped film, share 1, glided several %).
 pub const HEAD_STRETCH_SHARE: f64 = 0.15;
 
 /// Highest mode frequency that sounds, Hz.
@@ -69,7 +69,7 @@ impl SoundHead {
             .map_or(1.0, |(_, w)| w.abs());
         for (mode, w) in modes.modes().iter().zip(weights.iter_mut()) {
             if mode.listed {
-                *w = w11 * mode.gain * radiation::directivity(&modes, mode);
+                *w = w11 * mode.gain * radiation::directivity(mode);
             }
         }
         let loudest = weights.iter().fold(0.0f64, |m, w| m.max(w.abs()));
@@ -116,11 +116,13 @@ impl SoundHead {
                     freq_hz: mode.freq_hz,
                     t60_s: calibration.t60_s(mode.m, mode.n, mode.freq_hz),
                     glide: glide_per_state * stretch(mode),
+                    // Over ω_k: the mix differentiates (the head radiates its
+                    // acceleration), giving w at the mode's own frequency.
                     gain: if mode.listed {
                         w
                     } else {
                         w * scale * calibration.radiation_gain(mode.freq_hz)
-                    },
+                    } / (std::f64::consts::TAU * mode.freq_hz),
                 }
             })
             .collect();

@@ -1,12 +1,12 @@
 //! How strongly each mode of a head is heard: the far-field pressure per unit modal
 //! velocity from the Rayleigh integral of a baffled circular membrane (the kettle closes
-//! the head's back), at a listener direction (azimuth φ in head-local coordinates, polar
-//! angle ψ from the head's normal):
+//! the head's back), toward a listener at polar angle ψ from the head's normal, averaged
+//! over azimuth (see [`directivity`]):
 //!
 //! P_k ∝ ω_k · ∫ Φ_k(r, θ) e^{i k r sin ψ cos(θ − φ)} dA
 //!     = ω_k · 2π · A_m(φ) · ∫₀^a J_m(α r) J_m(β r) r dr,  α = j_mn/a, β = k sin ψ,
 //!
-//! with A_m(φ) = cos(mφ) or sin(mφ) by orientation, and the radial integral in closed form
+//! with A_m the azimuthal factor (1 for m = 0, 1/√2 otherwise), and the radial integral in closed form
 //! (Lommel, J_m(αa) = 0): −a·α·J_{m−1}(j_mn)·J_m(βa) / (α² − β²). A timpani head is
 //! subsonic (membrane waves ≈ 90 m/s against 343 m/s in air, so β < α always): the
 //! axisymmetric modes radiate as monopoles (the low thump of the (0,1)), the others as
@@ -16,8 +16,7 @@
 
 use crate::drum::HeadModes;
 use crate::drum::bessel::{EXACT_ZERO_LIMIT, bessel_j};
-use crate::drum::modes::{HeadMode, Orientation};
-use glam::DVec2;
+use crate::drum::modes::HeadMode;
 use std::f64::consts::{PI, TAU};
 
 /// Speed of sound in air at 20 °C, m/s.
@@ -26,22 +25,15 @@ pub const SOUND_SPEED_MPS: f64 = 343.0;
 /// plane of the head, rad.
 pub const LISTENER_POLAR_RAD: f64 = PI / 4.0;
 
-/// The listener's azimuth in `head`'s local coordinates: toward the audience, world +y
-/// (in front of the player, beyond the drums), rad.
-pub fn listener_azimuth(head: &HeadModes) -> f64 {
-    let audience = head.world(DVec2::ZERO) + glam::DVec3::Y;
-    let local = head.local(audience);
-    local.y.atan2(local.x)
-}
-
-/// A mode's azimuthal factor toward the listener: cos(mφ) or sin(mφ) by orientation (1 for
-/// m = 0).
-pub fn directivity(head: &HeadModes, mode: &HeadMode) -> f64 {
-    let phi = listener_azimuth(head);
-    match (mode.m, mode.orientation) {
-        (0, _) => 1.0,
-        (m, Orientation::Cos) => (f64::from(m) * phi).cos(),
-        (m, Orientation::Sin) => (f64::from(m) * phi).sin(),
+/// A mode's azimuthal factor as heard: 1 for m = 0, else the RMS of cos(mφ) over the
+/// listener's azimuth, 1/√2 — recordings hear a head through several microphones and a
+/// room, not from one point on a nodal pattern (one point put the (2,1) and (3,1) of a
+/// playing-spot stroke 8–14 dB down by geometry alone).
+pub fn directivity(mode: &HeadMode) -> f64 {
+    if mode.m == 0 {
+        1.0
+    } else {
+        std::f64::consts::FRAC_1_SQRT_2
     }
 }
 
@@ -72,7 +64,7 @@ pub fn weights(head: &HeadModes) -> Vec<f64> {
             let omega = TAU * mode.freq_hz;
             let alpha = mode.bessel_zero() / a;
             let beta = omega / SOUND_SPEED_MPS * LISTENER_POLAR_RAD.sin();
-            let angular = directivity(head, mode);
+            let angular = directivity(mode);
             // J_m(x) for m > x + 25 is below 1e-7 of its peak: silent.
             if f64::from(m) > beta * a + 25.0 {
                 return 0.0;
