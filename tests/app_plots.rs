@@ -100,7 +100,8 @@ fn every_tab_shows_its_plots() {
 
     open_tab(&mut h, "Sound");
     h.get_by_label("waveform");
-    h.get_by_label("spectrum");
+    h.get_by_label("simulated stroke");
+    h.get_by_label_contains("recorded Timpani_");
     h.get_by_label("analysed strike");
     // The playhead is at 0: the first strike is analysed.
     let first = &rendering().events[0];

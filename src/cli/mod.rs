@@ -180,6 +180,10 @@ pub enum SoundCommand {
         /// WAV files, one note each (the first onset is measured).
         #[arg(required = true)]
         files: Vec<PathBuf>,
+        /// Measure the note starting near these times instead (s, comma-separated; e.g.
+        /// the strokes of a render: each is measured from 10 ms before the time given).
+        #[arg(long, value_delimiter = ',')]
+        at: Vec<f64>,
     },
     /// Render one scripted stroke (legato, playing spot, general mallet) on the standard
     /// drum nearest a pitch, to audition the modal sound or compare it with a recording.
@@ -445,8 +449,8 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Some(Command::Mocap(MocapCommand::Stats { dir })) => {
             mocap::stats(&dir).map(|()| ExitCode::SUCCESS)
         }
-        Some(Command::Sound(SoundCommand::Analyse { files })) => {
-            sound::analyse(&files).map(|()| ExitCode::SUCCESS)
+        Some(Command::Sound(SoundCommand::Analyse { files, at })) => {
+            sound::analyse(&files, &at).map(|()| ExitCode::SUCCESS)
         }
         Some(Command::Sound(SoundCommand::Stroke {
             pitch,

@@ -80,50 +80,74 @@ pub fn fit(files: &[PathBuf], output: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Print each file's measurements, one block per file.
-pub fn analyse(files: &[PathBuf]) -> anyhow::Result<()> {
+/// Print each file's measurements, one block per file (per note with `at`).
+pub fn analyse(files: &[PathBuf], at: &[f64]) -> anyhow::Result<()> {
     for path in files {
-        let (samples, rate) = analysis::read_mono(path)?;
-        let p = analysis::profile(&samples, rate)
-            .ok_or_else(|| anyhow::anyhow!("{}: the file is silent", path.display()))?;
-        println!("{}", path.display());
-        let peak = samples.iter().fold(0.0f32, |m, s| m.max(s.abs()));
-        println!(
-            "  onset {:.3} s, rate {rate} Hz, peak {:.1} dBFS",
-            p.onset_s,
-            20.0 * peak.max(1e-12).log10()
-        );
-        let bands: Vec<String> = OCTAVE_CENTRES_HZ
-            .iter()
-            .zip(&p.bands_db)
-            .map(|(c, b)| format!("{c:.0} Hz {b:.1}"))
-            .collect();
-        println!("  octave bands (dB of the total): {}", bands.join(", "));
-        println!("  spectral centroid {:.0} Hz", p.centroid_hz);
-        let decays: Vec<String> = OCTAVE_CENTRES_HZ
-            .iter()
-            .map(|&c| {
-                analysis::band_t60(&samples, rate, c, (0.02, 1.0), 0.08)
-                    .map_or(format!("{c:.0} Hz -"), |t| format!("{c:.0} Hz {t:.2} s"))
-            })
-            .collect();
-        println!("  octave-band T60 over 0-1 s: {}", decays.join(", "));
-        match p.principal_hz {
-            Some(f) => {
-                let t0 = p.onset_s;
-                let t60 = analysis::partial_t60(&samples, rate, f, (t0 + 0.05, t0 + 1.5), 0.1);
-                let glide = analysis::glide_percent(&samples, rate, f);
-                print!("  (1,1) {f:.2} Hz");
-                if let Some(t60) = t60 {
-                    print!(", T60 {t60:.2} s");
+        let (all, rate) = analysis::read_mono(path)?;
+        let duration = all.len() as f64 / f64::from(rate);
+        let starts: Vec<Option<f64>> = if at.is_empty() {
+            vec![None]
+        } else {
+            at.iter().map(|t| Some(*t)).collect()
+        };
+        for start in starts {
+            let from = match start {
+                Some(t) if t.is_finite() && (0.0..duration).contains(&t) => {
+                    ((t - 0.01).max(0.0) * f64::from(rate)) as usize
                 }
-                if let Some(g) = glide {
-                    print!(", glide {g:+.2} % (10-70 ms against 0.5-0.6 s)");
-                }
-                println!();
-            }
-            None => println!("  no kettledrum (1,1) found between 40 and 400 Hz"),
+                Some(t) => anyhow::bail!(
+                    "{}: --at {t} s is outside the file (0-{duration:.2} s)",
+                    path.display()
+                ),
+                None => 0,
+            };
+            let label = start.map_or(String::new(), |t| format!(" at {t} s"));
+            analyse_note(&format!("{}{label}", path.display()), &all[from..], rate)?;
         }
+    }
+    Ok(())
+}
+
+/// Print one note's measurements.
+fn analyse_note(name: &str, samples: &[f32], rate: u32) -> anyhow::Result<()> {
+    let p = analysis::profile(samples, rate).ok_or_else(|| anyhow::anyhow!("{name}: silent"))?;
+    println!("{name}");
+    let peak = samples.iter().fold(0.0f32, |m, s| m.max(s.abs()));
+    println!(
+        "  onset {:.3} s, rate {rate} Hz, peak {:.1} dBFS",
+        p.onset_s,
+        20.0 * peak.max(1e-12).log10()
+    );
+    let bands: Vec<String> = OCTAVE_CENTRES_HZ
+        .iter()
+        .zip(&p.bands_db)
+        .map(|(c, b)| format!("{c:.0} Hz {b:.1}"))
+        .collect();
+    println!("  octave bands (dB of the total): {}", bands.join(", "));
+    println!("  spectral centroid {:.0} Hz", p.centroid_hz);
+    let decays: Vec<String> = OCTAVE_CENTRES_HZ
+        .iter()
+        .map(|&c| {
+            analysis::band_t60(samples, rate, c, (0.02, 1.0), 0.08)
+                .map_or(format!("{c:.0} Hz -"), |t| format!("{c:.0} Hz {t:.2} s"))
+        })
+        .collect();
+    println!("  octave-band T60 over 0-1 s: {}", decays.join(", "));
+    match p.principal_hz {
+        Some(f) => {
+            let t0 = p.onset_s;
+            let t60 = analysis::partial_t60(samples, rate, f, (t0 + 0.05, t0 + 1.5), 0.1);
+            let glide = analysis::glide_percent(samples, rate, f);
+            print!("  (1,1) {f:.2} Hz");
+            if let Some(t60) = t60 {
+                print!(", T60 {t60:.2} s");
+            }
+            if let Some(g) = glide {
+                print!(", glide {g:+.2} % (10-70 ms against 0.5-0.6 s)");
+            }
+            println!();
+        }
+        None => println!("  no kettledrum (1,1) found between 40 and 400 Hz"),
     }
     Ok(())
 }

@@ -2,7 +2,10 @@
 //! of about a pixel, never every sample) on the linked time axis, and the magnitude
 //! spectrum (dB re full scale against frequency on a log axis, Hann window,
 //! `sound::spectrum`) of one strike: the first selected beat's, else the one nearest the
-//! playhead, over [`ANALYSIS_S`] of audio from its first touch.
+//! playhead, over [`ANALYSIS_S`] of audio from its first touch — overlaid with the
+//! spectrum of the embedded recorded timpani note nearest the drum's tuning (FluidR3,
+//! `sound::sample`), its frequencies scaled to the tuning and its strongest bin put level
+//! with the stroke's, to hear and see how far the simulation is from a real drum.
 
 use super::decimate::Envelope;
 use super::linked::{MAX_POINTS, Outcome, Series, TimeLink, legend, time_plot};
@@ -21,6 +24,7 @@ const LOWEST_HZ: f64 = 20.0;
 const RANGE_DB: f64 = 80.0;
 const WAVE_COLOUR: Color32 = Color32::from_rgb(150, 200, 120);
 const SPECTRUM_COLOUR: Color32 = Color32::from_rgb(230, 200, 120);
+const RECORDED_COLOUR: Color32 = Color32::from_rgb(120, 170, 230);
 
 /// Points and caches of one rendering.
 #[derive(Default)]
@@ -34,6 +38,9 @@ pub struct SoundPlot {
     /// The strike analysed (event index) and its spectrum (log10 Hz, dB).
     strike: Option<usize>,
     spectrum: Series,
+    /// The recorded note's spectrum for that strike, and its name.
+    recorded: Series,
+    recorded_name: String,
 }
 
 /// The strike to analyse: the first contact of the first selected beat that has one,
@@ -90,6 +97,34 @@ pub fn strike_spectrum(audio: &Audio, t0_s: f64, window_s: f64) -> Vec<[f64; 2]>
         .filter(|&(f, _)| f >= LOWEST_HZ)
         .map(|(f, m)| [f.log10(), db(m).max(top - RANGE_DB)])
         .collect()
+}
+
+/// The spectrum of the recorded note nearest `tuning_hz` over [`ANALYSIS_S`] from its
+/// onset, as [`strike_spectrum`] draws it, frequencies × tuning/(its (1,1)) and levels
+/// shifted so its strongest bin is at `top_db`; with the recording's name.
+pub fn recorded_spectrum(tuning_hz: f64, top_db: f64) -> Option<(Vec<[f64; 2]>, String)> {
+    let recordings = crate::sound::sample::recordings().ok()?;
+    let rec = crate::sound::sample::nearest(recordings, tuning_hz)?;
+    let start = crate::sound::analysis::onset(&rec.samples, rec.rate_hz)?;
+    let len = (ANALYSIS_S * f64::from(rec.rate_hz)) as usize;
+    let window = &rec.samples[start..(start + len).min(rec.samples.len())];
+    let spec = crate::sound::spectrum(window, rec.rate_hz);
+    let db = |amp: f64| 20.0 * amp.max(1e-12).log10();
+    let top = spec
+        .iter()
+        .map(|&(_, m)| db(m))
+        .fold(f64::NEG_INFINITY, f64::max);
+    let scale = tuning_hz / rec.principal_hz;
+    let points = spec
+        .into_iter()
+        .map(|(f, m)| (f * scale, db(m) - top + top_db))
+        .filter(|&(f, _)| f >= LOWEST_HZ)
+        .map(|(f, d)| [f.log10(), d.max(top_db - RANGE_DB)])
+        .collect();
+    Some((
+        points,
+        format!("recorded {} at {:.0} Hz", rec.name, tuning_hz),
+    ))
 }
 
 /// A frequency for an axis: "50 Hz", "1 kHz", "2.5 kHz".
@@ -163,9 +198,21 @@ impl SoundPlot {
         let strike = selected_strike(&r.events, selected_beats, link.playhead_s);
         if strike != self.strike {
             self.strike = strike;
-            self.spectrum = Series::new(strike.map_or_else(Vec::new, |i| {
+            let points = strike.map_or_else(Vec::new, |i| {
                 strike_spectrum(audio, r.events[i].contact_s, ANALYSIS_S)
-            }));
+            });
+            let top = points
+                .iter()
+                .map(|p| p[1])
+                .fold(f64::NEG_INFINITY, f64::max);
+            let tuning = strike.and_then(|i| r.kit.drums.get(r.events[i].drum));
+            let (recorded, name) = tuning
+                .filter(|_| top.is_finite())
+                .and_then(|d| recorded_spectrum(d.tuning.hz(), top))
+                .unwrap_or_default();
+            self.spectrum = Series::new(points);
+            self.recorded = Series::new(recorded);
+            self.recorded_name = name;
         }
         ui.label(
             strike.map_or("No strikes in this rendering.".to_string(), |i| {
@@ -178,6 +225,8 @@ impl SoundPlot {
         let mut outcome = Outcome::default();
         let span = strike.map(|i| r.events[i].contact_s);
         let spectrum = self.spectrum.view(None);
+        let recorded = self.recorded.view(None);
+        let recorded_name = self.recorded_name.clone();
         ui.columns(2, |cols| {
             let buckets = (cols[0].available_width() as usize).clamp(16, MAX_POINTS / 2);
             let key = (
@@ -230,7 +279,11 @@ impl SoundPlot {
                 .include_x(LOWEST_HZ.log10())
                 .include_x(f64::from(audio.rate_hz / 2).log10())
                 .show(&mut cols[1], |plot| {
-                    plot.line(Line::new("spectrum", spectrum).color(SPECTRUM_COLOUR));
+                    plot.line(
+                        Line::new(recorded_name, recorded)
+                            .color(RECORDED_COLOUR.gamma_multiply(0.7)),
+                    );
+                    plot.line(Line::new("simulated stroke", spectrum).color(SPECTRUM_COLOUR));
                 });
         });
         outcome
@@ -319,6 +372,34 @@ mod tests {
         assert_eq!(hz_label(1000.0), "1 kHz");
         assert_eq!(hz_label(2500.0), "2.5 kHz");
         assert_eq!(hz_label(50.0), "50 Hz");
+    }
+
+    /// The overlay is the G2 recording pitched to D3: its strongest bin is where it was
+    /// put, and its (1,1) is a peak at the tuning.
+    #[test]
+    fn recorded_note_overlay() {
+        let (points, name) = recorded_spectrum(146.83, -10.0).unwrap();
+        assert!(name.contains("Timpani_3L"), "{name}");
+        let top = points
+            .iter()
+            .map(|p| p[1])
+            .fold(f64::NEG_INFINITY, f64::max);
+        assert!((top + 10.0).abs() < 1e-9, "{top}");
+        // The recording's (1,1), pitched to the tuning, is a peak within 1 % of it.
+        let near: Vec<&[f64; 2]> = points
+            .iter()
+            .filter(|p| (10f64.powf(p[0]) / 146.83 - 1.0).abs() < 0.01)
+            .collect();
+        let around: Vec<&[f64; 2]> = points
+            .iter()
+            .filter(|p| (10f64.powf(p[0]) / 146.83 - 1.0).abs() < 0.1)
+            .collect();
+        let peak_near = near.iter().map(|p| p[1]).fold(f64::NEG_INFINITY, f64::max);
+        let peak_around = around
+            .iter()
+            .map(|p| p[1])
+            .fold(f64::NEG_INFINITY, f64::max);
+        assert_eq!(peak_near, peak_around);
     }
 
     /// Decades and their 2 and 5 are the stronger grid lines; marks stay in bounds.
