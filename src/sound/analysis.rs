@@ -152,24 +152,13 @@ pub fn partial_t60(
     samples: &[f32],
     rate_hz: u32,
     near_hz: f64,
-    (from_s, to_s): (f64, f64),
+    span_s: (f64, f64),
     window_s: f64,
 ) -> Option<f64> {
-    let fs = f64::from(rate_hz);
-    let len = (window_s * fs).round() as usize;
-    let mut points = Vec::new();
-    let mut t = from_s;
-    while t + window_s <= to_s {
-        let a = (t * fs).round() as usize;
-        if a + len > samples.len() {
-            break;
-        }
-        let spec = spectrum(&samples[a..a + len], rate_hz);
-        if let Some((_, amp)) = peak_in(&spec, near_hz * 0.97, near_hz * 1.03) {
-            points.push((t, 20.0 * amp.max(1e-12).log10()));
-        }
-        t += 0.5 * window_s;
-    }
+    let points = levels(samples, rate_hz, (0, span_s), window_s, |w| {
+        let (_, amp) = peak_in(&spectrum(w, rate_hz), near_hz * 0.97, near_hz * 1.03)?;
+        Some(20.0 * amp.max(1e-12).log10())
+    });
     t60_of(&points)
 }
 
@@ -180,24 +169,16 @@ pub fn band_t60(
     samples: &[f32],
     rate_hz: u32,
     centre_hz: f64,
-    (from_s, to_s): (f64, f64),
+    span_s: (f64, f64),
     window_s: f64,
 ) -> Option<f64> {
-    let fs = f64::from(rate_hz);
     let start = onset(samples, rate_hz)?;
-    let len = (window_s * fs).round() as usize;
     let (lo, hi) = (centre_hz / 2f64.sqrt(), centre_hz * 2f64.sqrt());
-    let mut points = Vec::new();
-    let mut t = from_s;
-    while t + window_s <= to_s {
-        let a = start + (t * fs).round() as usize;
-        if a + len > samples.len() {
-            break;
-        }
-        let windowed: Vec<f32> = samples[a..a + len]
+    let points = levels(samples, rate_hz, (start, span_s), window_s, |w| {
+        let windowed: Vec<f32> = w
             .iter()
             .enumerate()
-            .map(|(i, &s)| s * hann(i, len) as f32)
+            .map(|(i, &s)| s * hann(i, w.len()) as f32)
             .collect();
         let (bin, power) = power_spectrum(&windowed, rate_hz);
         let energy: f64 = power
@@ -206,12 +187,35 @@ pub fn band_t60(
             .filter(|(k, _)| (lo..hi).contains(&(*k as f64 * bin)))
             .map(|(_, p)| p)
             .sum();
-        if energy > 0.0 {
-            points.push((t, 10.0 * energy.log10()));
+        (energy > 0.0).then(|| 10.0 * energy.log10())
+    });
+    t60_of(&points)
+}
+
+/// A level (dB, by `level`) of successive windows of `window_s` seconds, half overlapping,
+/// from `from_s` to `to_s` after frame `start`: (window start s, dB) where it has one.
+fn levels(
+    samples: &[f32],
+    rate_hz: u32,
+    (start, (from_s, to_s)): (usize, (f64, f64)),
+    window_s: f64,
+    level: impl Fn(&[f32]) -> Option<f64>,
+) -> Vec<(f64, f64)> {
+    let fs = f64::from(rate_hz);
+    let len = (window_s * fs).round() as usize;
+    let mut points = Vec::new();
+    let mut t = from_s;
+    while t + window_s <= to_s {
+        let a = start + (t * fs).round() as usize;
+        if a + len > samples.len() {
+            break;
+        }
+        if let Some(db) = level(&samples[a..a + len]) {
+            points.push((t, db));
         }
         t += 0.5 * window_s;
     }
-    t60_of(&points)
+    points
 }
 
 /// T60 (s) of levels (time s, dB) from their least-squares slope; None for fewer than three

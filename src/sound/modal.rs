@@ -125,6 +125,20 @@ pub struct DrumSynth {
     voices: Vec<Voice>,
 }
 
+/// The time (s, by `time`) of the first entry where two time-ordered records differ: the
+/// earlier of the two entries there (one may be missing). None when they are equal.
+fn first_change<T: PartialEq>(now: &[T], before: &[T], time: impl Fn(&T) -> f64) -> Option<f64> {
+    (0..now.len().max(before.len()))
+        .find(|&d| now.get(d) != before.get(d))
+        .map(|d| {
+            [now.get(d), before.get(d)]
+                .into_iter()
+                .flatten()
+                .map(&time)
+                .fold(f64::INFINITY, f64::min)
+        })
+}
+
 /// Render drum `j`'s sound (mono, 48 kHz, from t = 0), `frames` long, into `out` that
 /// holds the output `synth` was rendered with (empty, with a default `synth`, the first
 /// time): the record is compared with the one heard then, and synthesis resumes from the
@@ -159,27 +173,11 @@ pub fn resynthesise(
     // The first frame a difference reaches: none before the end of the previous output
     // when the drum is silent now and was then, or heard the same entries with the same
     // voices.
-    let first_difference = (0..heard.len().max(synth.heard.len()))
-        .find(|&d| heard.get(d) != synth.heard.get(d))
-        .map(|d| {
-            let t = [heard.get(d), synth.heard.get(d)]
-                .into_iter()
-                .flatten()
-                .map(|e| e.0)
-                .fold(f64::INFINITY, f64::min);
-            span(t).1
-        });
+    let first_difference = first_change(&heard, &synth.heard, |e| e.0).map(|t| span(t).1);
     let mut touches = touches.to_vec();
     touches.sort_by(f64::total_cmp);
-    let first_touch_difference = (0..touches.len().max(synth.touches.len()))
-        .find(|&d| touches.get(d) != synth.touches.get(d))
-        .map(|d| {
-            let t = [touches.get(d), synth.touches.get(d)]
-                .into_iter()
-                .flatten()
-                .fold(f64::INFINITY, |m, t| m.min(*t));
-            (t * fs).floor().max(0.0) as usize
-        });
+    let first_touch_difference =
+        first_change(&touches, &synth.touches, |t| *t).map(|t| (t * fs).floor().max(0.0) as usize);
     let silent_both = heard.is_empty() && synth.heard.is_empty();
     let from = if voices != synth.voices && !silent_both {
         0

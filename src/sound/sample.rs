@@ -297,14 +297,7 @@ mod tests {
     /// recording itself) from ff up.
     #[test]
     fn cutoff_law() {
-        for d in [
-            Dynamic::Pp,
-            Dynamic::P,
-            Dynamic::Mp,
-            Dynamic::Mf,
-            Dynamic::F,
-            Dynamic::Ff,
-        ] {
+        for (d, _, _) in Dynamic::MARKS {
             let v = impact_speed_mps(d);
             eprintln!("{d:?}: {v:.3} m/s, cutoff {:.0} Hz", cutoff_hz(v));
         }
