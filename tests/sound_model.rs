@@ -138,3 +138,31 @@ fn a_hand_on_the_head_stops_it() {
         }
     }
 }
+
+/// Striking the 26-inch drum makes its neighbours ring through the air: the 29-inch
+/// drum's stem is audible (above −100 dBFS) but at least 30 dB below the struck drum's.
+#[test]
+fn neighbours_ring_faintly() {
+    use timpanist::drum::strike::{PLAYING_SPOT_FRACTION, SIM_RATE_HZ, impact_speed_mps};
+    use timpanist::drum::{DrumSet, ModeConfig};
+    use timpanist::kit::{Kit, Side};
+    use timpanist::sound::{SoundModel, stems};
+    let kit = Kit::standard();
+    let mallet = &kit.mallets[0];
+    let drum = &kit.drums[2];
+    let mut drums = DrumSet::new(&kit, mallet, &ModeConfig::default(), 1.0 / SIM_RATE_HZ).unwrap();
+    let point = drum.point_on_head(PLAYING_SPOT_FRACTION, 0.0);
+    let speed = impact_speed_mps(Dynamic::Ff);
+    timpanist::drum::strike::scripted(&mut drums, drum, mallet, Side::Right, point, speed, 0.3);
+    let stems = stems(&kit, (&drums, &[]), 2.0, SoundModel::Modal).unwrap();
+    let rms_db = |a: &timpanist::sound::Audio| {
+        let e = a.samples.iter().map(|s| f64::from(*s).powi(2)).sum::<f64>();
+        10.0 * (e / a.samples.len() as f64).max(1e-30).log10()
+    };
+    let (struck, neighbour) = (rms_db(&stems[2]), rms_db(&stems[1]));
+    assert!(neighbour > -100.0, "29-inch {neighbour:.1} dBFS");
+    assert!(
+        neighbour < struck - 30.0,
+        "26-inch {struck:.1}, 29-inch {neighbour:.1} dBFS"
+    );
+}

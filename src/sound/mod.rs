@@ -13,6 +13,7 @@ pub mod radiation;
 pub mod sample;
 pub mod signal;
 pub mod spectrum;
+pub mod sympathy;
 pub mod voices;
 pub mod wav;
 
@@ -142,6 +143,8 @@ pub struct SoundState {
     model: SoundModel,
     /// Per drum: mono output, synthesis state, whether anything touched it.
     drums: Vec<(Vec<f32>, modal::DrumSynth, bool)>,
+    /// Per drum: what the others' sound makes it ring (modal model).
+    sympathy: Vec<sympathy::SympathyState>,
     /// Interleaved stereo mix before the normalisation gain.
     mix: Vec<f32>,
     peaks: Vec<f32>,
@@ -178,13 +181,14 @@ fn damp_replayed(mono: &mut [f32], touches: &[f64], drums: &DrumSet, j: usize) {
 /// keeps Σ (gain_k/ω_k)·q̇_k and the pressure is its time derivative (a head radiates its
 /// acceleration, so a mode's forced response below its resonance radiates less than at
 /// it: [`partials`]); the other models keep the sound itself.
-fn radiated(model: SoundModel, mono: &[f32], n: usize) -> f32 {
+fn radiated(model: SoundModel, mono: &[f32], sympathy: Option<&[f32]>, n: usize) -> f32 {
+    let at = |k: usize| mono[k] + sympathy.and_then(|s| s.get(k)).copied().unwrap_or(0.0);
     match model {
         SoundModel::Modal => {
-            let before = if n == 0 { 0.0 } else { mono[n - 1] };
-            (mono[n] - before) * SAMPLE_RATE_HZ as f32
+            let before = if n == 0 { 0.0 } else { at(n - 1) };
+            (at(n) - before) * SAMPLE_RATE_HZ as f32
         }
-        SoundModel::Sample | SoundModel::Signal => mono[n],
+        SoundModel::Sample | SoundModel::Signal => at(n),
     }
 }
 
@@ -201,14 +205,16 @@ pub fn stems(
         .drums
         .iter()
         .zip(&kit.drums)
-        .map(|((mono, _, _), drum)| {
+        .enumerate()
+        .map(|(j, ((mono, _, _), drum))| {
+            let sympathy = state.sympathy.get(j).map(|s| s.out.as_slice());
             let (l, r) = pan_gains(drum.placement.x_m);
             Audio {
                 rate_hz: SAMPLE_RATE_HZ,
                 channels: 2,
                 samples: (0..mono.len())
                     .flat_map(|n| {
-                        let s = f64::from(radiated(model, mono, n)) * mix.gain;
+                        let s = f64::from(radiated(model, mono, sympathy, n)) * mix.gain;
                         [(s * l) as f32, (s * r) as f32]
                     })
                     .collect(),
@@ -340,21 +346,57 @@ pub fn render_calibrated(
             .map(|job| job.join().expect("a drum's synthesis panicked"))
             .collect()
     });
-    for from in results {
-        start = start.min(from?);
+    let froms = results.into_iter().collect::<Result<Vec<usize>, _>>()?;
+    start = froms.iter().fold(start, |s, f| s.min(*f));
+    if model == SoundModel::Modal {
+        let heads: modal::SoundHeads = kit
+            .drums
+            .iter()
+            .map(|d| modal::sound_head(d, drums, calibration))
+            .collect();
+        let radiated: Vec<Vec<f32>> = state
+            .drums
+            .iter()
+            .map(|(mono, _, _)| {
+                (0..frames)
+                    .map(|n| radiated(model, mono, None, n))
+                    .collect()
+            })
+            .collect();
+        state.sympathy.resize(kit.drums.len(), Default::default());
+        let sympathy_froms: Vec<usize> = std::thread::scope(|scope| {
+            let jobs: Vec<_> = state
+                .sympathy
+                .iter_mut()
+                .enumerate()
+                .map(|(j, sym)| {
+                    let (heads, radiated, froms) = (&heads, &radiated, &froms);
+                    scope.spawn(move || {
+                        sympathy::resynthesise(kit, heads, j, (radiated, froms), frames, sym)
+                    })
+                })
+                .collect();
+            jobs.into_iter()
+                .map(|job| job.join().expect("a drum's sympathy panicked"))
+                .collect()
+        });
+        start = sympathy_froms.iter().fold(start, |s, f| s.min(*f));
+    } else {
+        state.sympathy.clear();
     }
     let start = start.min(frames);
     let mix = &mut state.mix;
     mix.resize(2 * frames, 0.0);
     mix[2 * start..].fill(0.0);
-    for (drum, (mono, _, heard)) in kit.drums.iter().zip(&state.drums) {
-        if !heard {
+    for (j, (drum, (mono, _, heard))) in kit.drums.iter().zip(&state.drums).enumerate() {
+        let sympathy = state.sympathy.get(j).map(|s| s.out.as_slice());
+        if !heard && sympathy.is_none_or(|s| s.iter().all(|v| *v == 0.0)) {
             continue;
         }
         let (l, r) = pan_gains(drum.placement.x_m);
         let (l, r) = (l as f32, r as f32);
         for (n, frame) in mix[2 * start..].chunks_exact_mut(2).enumerate() {
-            let s = radiated(model, mono, start + n);
+            let s = radiated(model, mono, sympathy, start + n);
             frame[0] += l * s;
             frame[1] += r * s;
         }

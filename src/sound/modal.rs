@@ -76,15 +76,20 @@ pub fn sound_head(
     Some(head)
 }
 
+/// Each kit drum's sounding head (None where it could not be built).
+pub type SoundHeads = Vec<Option<Arc<SoundHead>>>;
+
+/// A sounding head's voice with the model's calibration applied.
+pub fn calibrated_voice(v: &Voice) -> Voice {
+    Voice {
+        gain: v.gain * MODAL_CALIBRATION,
+        ..*v
+    }
+}
+
 /// The voices of a sounding head with the model's calibration applied.
 fn calibrated(head: &SoundHead) -> Vec<Voice> {
-    head.voices
-        .iter()
-        .map(|v| Voice {
-            gain: v.gain * MODAL_CALIBRATION,
-            ..*v
-        })
-        .collect()
+    head.voices.iter().map(calibrated_voice).collect()
 }
 
 /// Contact points are taken to the centre of a square cell this wide for their mode

@@ -1,0 +1,200 @@
+//! Sympathetic resonance (modal model): a struck head's sound reaches the other heads of
+//! the kit through the air and drives their modes, so partials they share ring faintly.
+//!
+//! The sound a drum radiates, as the mix has it, is taken as the pressure it makes
+//! [`REFERENCE_DISTANCE_M`] away, full scale being [`FULL_SCALE_PA`] (an ff stroke, −6
+//! dBFS, then peaks near 6.3 Pa ≈ 110 dB SPL at 1 m, the low end of what orchestral
+//! timpani reach up close: an assumption, not a measurement of ours). At
+//! another head, a distance d between centres, it arrives d/c later and (1 m)/d weaker;
+//! across that head the wave is taken as plane, p(x) ≈ p − (x·ŝ)/c·ṗ (ŝ the direction it
+//! travels). Its generalised force on the head's mode k is ∫ p Φ_k dA:
+//!
+//! * m = 0: p·A_k, A_k = ∫Φ_k dA = 2π a² J₁(j)/j (the uniform pressure);
+//! * m = 1: −(ṗ/c)·B_k·(cos θ_s or sin θ_s), B_k = π a³ J₂(j)/j (the pressure gradient);
+//!
+//! and modes with m ≥ 2 see no net force from a plane wave at this order. Each receiving
+//! head runs those modes (its m ≤ 1 voices, gains as in its own sound) driven by F/M_k,
+//! and what they radiate is added to its own sound. One way only: the ringing of a
+//! receiving head does not drive the source back (it is 30 dB and more below it).
+
+use super::SAMPLE_RATE_HZ;
+use super::modal::{FLUSH_FLOOR, SoundHeads};
+use super::radiation::SOUND_SPEED_MPS;
+use super::voices::{BankState, VoiceBank};
+use crate::drum::bessel::bessel_j;
+use crate::drum::modes::Orientation;
+use crate::kit::Kit;
+use std::f64::consts::PI;
+
+/// Pressure of a full-scale output at the reference distance, Pa.
+pub const FULL_SCALE_PA: f64 = 12.6;
+/// Distance at which the output is taken as the radiated pressure, m.
+pub const REFERENCE_DISTANCE_M: f64 = 1.0;
+/// Frames per processing block.
+const BLOCK: usize = 128;
+/// Blocks between saved states.
+const SAVE_EVERY_BLOCKS: usize = 64;
+
+/// One receiving head's coupling: its m ≤ 1 voices, and per voice the force per unit
+/// pressure (m = 0, m²) and per unit pressure rate over c (m = 1, m³ per source).
+#[derive(Clone, Debug)]
+struct Receiver {
+    bank: VoiceBank,
+    inv_mass: Vec<f64>,
+    /// Per voice: the force per unit pressure (m = 0: ∫Φ dA, m²) and per unit pressure
+    /// gradient along local x and y (m = 1: −B_k cos/sin, m³).
+    weights: Vec<[f64; 3]>,
+    /// Per source drum i ≠ j: (i, delay in frames, pressure per output unit, the direction
+    /// the wave travels in the head's local frame (cos θ_s, sin θ_s)).
+    sources: Vec<(usize, usize, f64, [f64; 2])>,
+}
+
+/// A receiving drum's sympathetic output (the same units as its own synthesis: summed
+/// gain/ω × modal velocity) and the states to resume it.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SympathyState {
+    pub out: Vec<f32>,
+    saved: Vec<(usize, BankState)>,
+}
+
+impl Receiver {
+    fn new(kit: &Kit, heads: &SoundHeads, j: usize) -> Option<Receiver> {
+        let head = heads.get(j)?.as_deref()?;
+        let a = head.modes.radius_m();
+        let picked: Vec<usize> = (0..head.voices.len())
+            .filter(|&k| head.modes.modes()[k].m <= 1 && head.voices[k].freq_hz <= MAX_HZ)
+            .collect();
+        if picked.is_empty() {
+            return None;
+        }
+        let voices: Vec<_> = picked
+            .iter()
+            .map(|&k| super::modal::calibrated_voice(&head.voices[k]))
+            .collect();
+        let inv_mass = picked
+            .iter()
+            .map(|&k| 1.0 / head.modes.modes()[k].modal_mass_kg)
+            .collect();
+        let centre = kit.drums[j].centre();
+        let weights = picked
+            .iter()
+            .map(|&k| {
+                let mode = &head.modes.modes()[k];
+                let j_mn = mode.bessel_zero();
+                if mode.m == 0 {
+                    [2.0 * PI * a * a * bessel_j(1, j_mn) / j_mn, 0.0, 0.0]
+                } else {
+                    let b = PI * a.powi(3) * bessel_j(2, j_mn) / j_mn;
+                    match mode.orientation {
+                        Orientation::Cos => [0.0, -b, 0.0],
+                        Orientation::Sin => [0.0, 0.0, -b],
+                    }
+                }
+            })
+            .collect();
+        let sources = (0..kit.drums.len())
+            .filter(|&i| i != j && heads.get(i).is_some_and(Option::is_some))
+            .map(|i| {
+                let from = kit.drums[i].centre();
+                let d = (centre - from).length().max(0.05);
+                let delay = (d / SOUND_SPEED_MPS * f64::from(SAMPLE_RATE_HZ)).round() as usize;
+                let scale = FULL_SCALE_PA * REFERENCE_DISTANCE_M / d;
+                let dir = head.modes.local(centre + (centre - from));
+                let theta = dir.y.atan2(dir.x);
+                (i, delay, scale, [theta.cos(), theta.sin()])
+            })
+            .collect();
+        Some(Receiver {
+            bank: VoiceBank::new(&voices, f64::from(SAMPLE_RATE_HZ)),
+            inv_mass,
+            weights,
+            sources,
+        })
+    }
+}
+
+/// Highest mode frequency that rings sympathetically, Hz (the shared low partials; the
+/// coupling of higher modes is far below audibility and not worth the time).
+pub const MAX_HZ: f64 = 1000.0;
+
+/// Drum `j`'s sympathetic output, `frames` long, from the other drums' radiated sound
+/// (`radiated[i]`, output units per frame), resuming `state` from the first frame a
+/// source's sound changed (`changed[i]`, per drum). Returns the first frame rewritten.
+/// Bit for bit a whole render.
+pub fn resynthesise(
+    kit: &Kit,
+    heads: &SoundHeads,
+    j: usize,
+    (radiated, changed): (&[Vec<f32>], &[usize]),
+    frames: usize,
+    state: &mut SympathyState,
+) -> usize {
+    let Some(mut rx) = Receiver::new(kit, heads, j) else {
+        state.out = vec![0.0; frames];
+        state.saved.clear();
+        return 0;
+    };
+    let from = rx
+        .sources
+        .iter()
+        .map(|(i, delay, ..)| changed[*i].saturating_add(*delay))
+        .min()
+        .unwrap_or(usize::MAX)
+        .min(state.out.len());
+    let resume = state.saved.iter().rposition(|(f, _)| *f <= from);
+    let start = resume.map_or(0, |k| state.saved[k].0).min(frames);
+    if let Some(k) = resume.filter(|_| start > 0) {
+        rx.bank.restore(&state.saved[k].1);
+    }
+    state.saved.retain(|(f, _)| *f < start);
+    state.out.resize(frames, 0.0);
+    state.out[start..].fill(0.0);
+    let stride = rx.bank.stride();
+    let mut input = vec![0.0f32; BLOCK * stride];
+    let fs = f64::from(SAMPLE_RATE_HZ);
+    let mut ringing = start > 0;
+    for n0 in (start..frames).step_by(BLOCK) {
+        if n0.is_multiple_of(SAVE_EVERY_BLOCKS * BLOCK) {
+            state.saved.push((n0, rx.bank.state()));
+        }
+        let n1 = (n0 + BLOCK).min(frames);
+        input.fill(0.0);
+        let mut driven = false;
+        for (row, n) in input.chunks_exact_mut(stride).zip(n0..n1) {
+            // The pressure at the head's centre and its gradient (Pa, Pa/m).
+            let mut field = [0.0f64; 3];
+            for (i, delay, scale, [cos, sin]) in &rx.sources {
+                let signal = &radiated[*i];
+                let Some(m) = n.checked_sub(*delay).filter(|&m| m < signal.len()) else {
+                    continue;
+                };
+                let now = f64::from(signal[m]);
+                let before = if m == 0 {
+                    0.0
+                } else {
+                    f64::from(signal[m - 1])
+                };
+                let gradient = scale * (now - before) * fs / SOUND_SPEED_MPS;
+                field[0] += scale * now;
+                field[1] += gradient * cos;
+                field[2] += gradient * sin;
+            }
+            if field == [0.0; 3] {
+                continue;
+            }
+            for ((r, w), im) in row.iter_mut().zip(&rx.weights).zip(&rx.inv_mass) {
+                *r = ((w[0] * field[0] + w[1] * field[1] + w[2] * field[2]) * im) as f32;
+            }
+            driven = true;
+        }
+        let out = &mut state.out[n0..n1];
+        if driven {
+            rx.bank.render_driven(&input[..(n1 - n0) * stride], out);
+            ringing = true;
+        } else if ringing {
+            rx.bank.render_free(out);
+            ringing = !rx.bank.flush(FLUSH_FLOOR);
+        }
+    }
+    start
+}
