@@ -166,3 +166,36 @@ fn neighbours_ring_faintly() {
         "26-inch {struck:.1}, 29-inch {neighbour:.1} dBFS"
     );
 }
+
+/// Retuning a drum nobody strikes changes what it rings in sympathy: re-rendering from
+/// the previous state equals a fresh render of the retuned kit.
+#[test]
+fn retuned_neighbour_resumes_exactly() {
+    use timpanist::drum::strike::{PLAYING_SPOT_FRACTION, SIM_RATE_HZ, impact_speed_mps};
+    use timpanist::drum::{DrumSet, ModeConfig};
+    use timpanist::kit::{Kit, Side};
+    use timpanist::sound::{SoundModel, render_resuming};
+    let strike = |kit: &Kit| {
+        let mallet = &kit.mallets[0];
+        let drum = &kit.drums[2];
+        let mut drums =
+            DrumSet::new(kit, mallet, &ModeConfig::default(), 1.0 / SIM_RATE_HZ).unwrap();
+        let point = drum.point_on_head(PLAYING_SPOT_FRACTION, 0.0);
+        let speed = impact_speed_mps(Dynamic::F);
+        timpanist::drum::strike::scripted(&mut drums, drum, mallet, Side::Right, point, speed, 0.3);
+        drums
+    };
+    let kit = Kit::standard();
+    let (before, state) =
+        render_resuming(&kit, &strike(&kit), 1.0, SoundModel::Modal, None).unwrap();
+    let mut retuned = kit.clone();
+    let pitch = retuned.drums[1].tuning.transposed(2).unwrap();
+    retuned.drums[1].membrane.tension_n_per_m = retuned.drums[1].tension_for(pitch);
+    retuned.drums[1].tuning = pitch;
+    let drums = strike(&retuned);
+    let (resumed, _) =
+        render_resuming(&retuned, &drums, 1.0, SoundModel::Modal, Some(state)).unwrap();
+    let (fresh, _) = render_resuming(&retuned, &drums, 1.0, SoundModel::Modal, None).unwrap();
+    assert_eq!(resumed.samples, fresh.samples);
+    assert_ne!(resumed.samples, before.samples);
+}

@@ -20,7 +20,7 @@
 use super::SAMPLE_RATE_HZ;
 use super::modal::{FLUSH_FLOOR, SoundHeads};
 use super::radiation::SOUND_SPEED_MPS;
-use super::voices::{BankState, VoiceBank};
+use super::voices::{BankState, Voice, VoiceBank};
 use crate::drum::bessel::bessel_j;
 use crate::drum::modes::Orientation;
 use crate::kit::Kit;
@@ -40,6 +40,7 @@ const SAVE_EVERY_BLOCKS: usize = 64;
 #[derive(Clone, Debug)]
 struct Receiver {
     bank: VoiceBank,
+    voices: Vec<Voice>,
     inv_mass: Vec<f64>,
     /// Per voice: the force per unit pressure (m = 0: ∫Φ dA, m²) and per unit pressure
     /// gradient along local x and y (m = 1: −B_k cos/sin, m³).
@@ -55,6 +56,8 @@ struct Receiver {
 pub struct SympathyState {
     pub out: Vec<f32>,
     saved: Vec<(usize, BankState)>,
+    /// The voices it rang with (a change restarts it).
+    voices: Vec<Voice>,
 }
 
 impl Receiver {
@@ -106,6 +109,7 @@ impl Receiver {
             .collect();
         Some(Receiver {
             bank: VoiceBank::new(&voices, f64::from(SAMPLE_RATE_HZ)),
+            voices,
             inv_mass,
             weights,
             sources,
@@ -130,17 +134,27 @@ pub fn resynthesise(
     state: &mut SympathyState,
 ) -> usize {
     let Some(mut rx) = Receiver::new(kit, heads, j) else {
-        state.out = vec![0.0; frames];
-        state.saved.clear();
-        return 0;
+        // Nothing rings here: silent, and unchanged if it was silent already.
+        let unchanged = state.voices.is_empty() && state.out.iter().all(|v| *v == 0.0);
+        let from = if unchanged { state.out.len() } else { 0 };
+        *state = SympathyState {
+            out: vec![0.0; frames],
+            ..SympathyState::default()
+        };
+        return from;
     };
+    // From the first frame a source's sound changes here, or the head's own synthesis
+    // changed (its voices may have: a new tuning or size).
     let from = rx
         .sources
         .iter()
         .map(|(i, delay, ..)| changed[*i].saturating_add(*delay))
+        .chain([changed[j]])
         .min()
         .unwrap_or(usize::MAX)
         .min(state.out.len());
+    let from = if rx.voices == state.voices { from } else { 0 };
+    state.voices.clone_from(&rx.voices);
     let resume = state.saved.iter().rposition(|(f, _)| *f <= from);
     let start = resume.map_or(0, |k| state.saved[k].0).min(frames);
     if let Some(k) = resume.filter(|_| start > 0) {
