@@ -90,7 +90,7 @@ pub fn analyse(files: &[PathBuf], at: &[f64]) -> anyhow::Result<()> {
         } else {
             at.iter().map(|t| Some(*t)).collect()
         };
-        for start in starts {
+        for (k, start) in starts.iter().copied().enumerate() {
             let from = match start {
                 Some(t) if t.is_finite() && (0.0..duration).contains(&t) => {
                     ((t - 0.01).max(0.0) * f64::from(rate)) as usize
@@ -101,8 +101,16 @@ pub fn analyse(files: &[PathBuf], at: &[f64]) -> anyhow::Result<()> {
                 ),
                 None => 0,
             };
+            // A note ends where the next one asked for starts.
+            let to = starts
+                .get(k + 1)
+                .copied()
+                .flatten()
+                .filter(|t| t.is_finite() && *t * f64::from(rate) > from as f64)
+                .map_or(all.len(), |t| ((t - 0.01) * f64::from(rate)) as usize)
+                .min(all.len());
             let label = start.map_or(String::new(), |t| format!(" at {t} s"));
-            analyse_note(&format!("{}{label}", path.display()), &all[from..], rate)?;
+            analyse_note(&format!("{}{label}", path.display()), &all[from..to], rate)?;
         }
     }
     Ok(())
@@ -112,7 +120,10 @@ pub fn analyse(files: &[PathBuf], at: &[f64]) -> anyhow::Result<()> {
 fn analyse_note(name: &str, samples: &[f32], rate: u32) -> anyhow::Result<()> {
     let p = analysis::profile(samples, rate).ok_or_else(|| anyhow::anyhow!("{name}: silent"))?;
     println!("{name}");
-    let peak = samples.iter().fold(0.0f32, |m, s| m.max(s.abs()));
+    // The peak of the analysed span (the onset's first second).
+    let from = (p.onset_s * f64::from(rate)) as usize;
+    let span = &samples[from..(from + rate as usize).min(samples.len())];
+    let peak = span.iter().fold(0.0f32, |m, s| m.max(s.abs()));
     println!(
         "  onset {:.3} s, rate {rate} Hz, peak {:.1} dBFS",
         p.onset_s,
