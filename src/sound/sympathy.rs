@@ -32,6 +32,9 @@ pub const FULL_SCALE_PA: f64 = 12.6;
 pub const REFERENCE_DISTANCE_M: f64 = 1.0;
 /// Frames per processing block.
 const BLOCK: usize = 128;
+/// The receiving heads run at the audio rate over this (6 kHz: their modes are below
+/// [`MAX_HZ`]); their output is brought back by linear interpolation.
+const DECIMATION: usize = 8;
 /// Blocks between saved states.
 const SAVE_EVERY_BLOCKS: usize = 64;
 
@@ -55,7 +58,8 @@ struct Receiver {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SympathyState {
     pub out: Vec<f32>,
-    saved: Vec<(usize, BankState)>,
+    /// Saved: (frame, bank state, the last sub-step's output).
+    saved: Vec<(usize, BankState, f32)>,
     /// The voices it rang with (a change restarts it).
     voices: Vec<Voice>,
 }
@@ -108,7 +112,7 @@ impl Receiver {
             })
             .collect();
         Some(Receiver {
-            bank: VoiceBank::new(&voices, f64::from(SAMPLE_RATE_HZ)),
+            bank: VoiceBank::new(&voices, f64::from(SAMPLE_RATE_HZ) / DECIMATION as f64),
             voices,
             inv_mass,
             weights,
@@ -155,41 +159,50 @@ pub fn resynthesise(
         .min(state.out.len());
     let from = if rx.voices == state.voices { from } else { 0 };
     state.voices.clone_from(&rx.voices);
-    let resume = state.saved.iter().rposition(|(f, _)| *f <= from);
+    let resume = state.saved.iter().rposition(|(f, ..)| *f <= from);
     let start = resume.map_or(0, |k| state.saved[k].0).min(frames);
+    let mut last = 0.0f32;
     if let Some(k) = resume.filter(|_| start > 0) {
         rx.bank.restore(&state.saved[k].1);
+        last = state.saved[k].2;
     }
-    state.saved.retain(|(f, _)| *f < start);
+    state.saved.retain(|(f, ..)| *f < start);
     state.out.resize(frames, 0.0);
     state.out[start..].fill(0.0);
     let stride = rx.bank.stride();
-    let mut input = vec![0.0f32; BLOCK * stride];
+    let steps = BLOCK / DECIMATION;
+    let mut input = vec![0.0f32; steps * stride];
+    let mut sub = [0.0f32; BLOCK / DECIMATION];
     let fs = f64::from(SAMPLE_RATE_HZ);
     let mut ringing = start > 0;
     for n0 in (start..frames).step_by(BLOCK) {
         if n0.is_multiple_of(SAVE_EVERY_BLOCKS * BLOCK) {
-            state.saved.push((n0, rx.bank.state()));
+            state.saved.push((n0, rx.bank.state(), last));
         }
         let n1 = (n0 + BLOCK).min(frames);
+        let used = (n1 - n0).div_ceil(DECIMATION);
         input.fill(0.0);
         let mut driven = false;
-        for (row, n) in input.chunks_exact_mut(stride).zip(n0..n1) {
-            // The pressure at the head's centre and its gradient (Pa, Pa/m).
+        for (row, a) in input
+            .chunks_exact_mut(stride)
+            .zip((n0..n1).step_by(DECIMATION))
+        {
+            let z = (a + DECIMATION).min(n1);
+            // The mean pressure at the head's centre and its gradient over the sub-step
+            // (Pa, Pa/m; the gradient's mean telescopes to its ends).
             let mut field = [0.0f64; 3];
             for (i, delay, scale, [cos, sin]) in &rx.sources {
                 let signal = &radiated[*i];
-                let Some(m) = n.checked_sub(*delay).filter(|&m| m < signal.len()) else {
-                    continue;
+                let at = |n: usize| {
+                    n.checked_sub(*delay)
+                        .and_then(|m| signal.get(m))
+                        .map_or(0.0, |v| f64::from(*v))
                 };
-                let now = f64::from(signal[m]);
-                let before = if m == 0 {
-                    0.0
-                } else {
-                    f64::from(signal[m - 1])
-                };
-                let gradient = scale * (now - before) * fs / SOUND_SPEED_MPS;
-                field[0] += scale * now;
+                let mean: f64 = (a..z).map(at).sum::<f64>() / (z - a) as f64;
+                let before = if a == 0 { 0.0 } else { at(a - 1) };
+                let gradient =
+                    scale * (at(z - 1) - before) * fs / ((z - a) as f64 * SOUND_SPEED_MPS);
+                field[0] += scale * mean;
                 field[1] += gradient * cos;
                 field[2] += gradient * sin;
             }
@@ -201,14 +214,24 @@ pub fn resynthesise(
             }
             driven = true;
         }
-        let out = &mut state.out[n0..n1];
+        sub.fill(0.0);
         if driven {
-            rx.bank.render_driven(&input[..(n1 - n0) * stride], out);
+            rx.bank
+                .render_driven(&input[..used * stride], &mut sub[..used]);
             ringing = true;
         } else if ringing {
-            rx.bank.render_free(out);
+            rx.bank.render_free(&mut sub[..used]);
             ringing = !rx.bank.flush(FLUSH_FLOOR);
+        } else if last == 0.0 {
+            continue;
         }
+        // Back to the audio rate: linear between the sub-steps' outputs.
+        for (k, o) in state.out[n0..n1].iter_mut().enumerate() {
+            let (step, phase) = (k / DECIMATION, (k % DECIMATION + 1) as f32);
+            let from = if step == 0 { last } else { sub[step - 1] };
+            *o = from + (sub[step] - from) * phase / DECIMATION as f32;
+        }
+        last = sub[used - 1];
     }
     start
 }
