@@ -354,15 +354,7 @@ pub fn render_calibrated(
             .iter()
             .map(|d| modal::sound_head(d, drums, calibration))
             .collect();
-        let radiated: Vec<Vec<f32>> = state
-            .drums
-            .iter()
-            .map(|(mono, _, _)| {
-                (0..frames)
-                    .map(|n| radiated(model, mono, None, n))
-                    .collect()
-            })
-            .collect();
+        let monos: Vec<&[f32]> = state.drums.iter().map(|(m, _, _)| m.as_slice()).collect();
         state.sympathy.resize(kit.drums.len(), Default::default());
         let sympathy_froms: Vec<usize> = std::thread::scope(|scope| {
             let jobs: Vec<_> = state
@@ -370,9 +362,9 @@ pub fn render_calibrated(
                 .iter_mut()
                 .enumerate()
                 .map(|(j, sym)| {
-                    let (heads, radiated, froms) = (&heads, &radiated, &froms);
+                    let (heads, monos, froms) = (&heads, &monos, &froms);
                     scope.spawn(move || {
-                        sympathy::resynthesise(kit, heads, j, (radiated, froms), frames, sym)
+                        sympathy::resynthesise(kit, heads, j, (monos, froms), frames, sym)
                     })
                 })
                 .collect();

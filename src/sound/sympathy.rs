@@ -126,14 +126,14 @@ impl Receiver {
 pub const MAX_HZ: f64 = 1000.0;
 
 /// Drum `j`'s sympathetic output, `frames` long, from the other drums' radiated sound
-/// (`radiated[i]`, output units per frame), resuming `state` from the first frame a
+/// (the time derivative of their synthesis `monos[i]`, as the mix radiates it), resuming `state` from the first frame a
 /// source's sound changed (`changed[i]`, per drum). Returns the first frame rewritten.
 /// Bit for bit a whole render.
 pub fn resynthesise(
     kit: &Kit,
     heads: &SoundHeads,
     j: usize,
-    (radiated, changed): (&[Vec<f32>], &[usize]),
+    (monos, changed): (&[&[f32]], &[usize]),
     frames: usize,
     state: &mut SympathyState,
 ) -> usize {
@@ -192,11 +192,14 @@ pub fn resynthesise(
             // (Pa, Pa/m; the gradient's mean telescopes to its ends).
             let mut field = [0.0f64; 3];
             for (i, delay, scale, [cos, sin]) in &rx.sources {
-                let signal = &radiated[*i];
+                let mono = monos[*i];
+                let sample = |m: usize| mono.get(m).map_or(0.0, |v| f64::from(*v));
+                // The radiated sound at frame n here: the source's derivative, delayed.
                 let at = |n: usize| {
-                    n.checked_sub(*delay)
-                        .and_then(|m| signal.get(m))
-                        .map_or(0.0, |v| f64::from(*v))
+                    n.checked_sub(*delay).map_or(0.0, |m| {
+                        let before = if m == 0 { 0.0 } else { sample(m - 1) };
+                        (sample(m) - before) * fs
+                    })
                 };
                 let mean: f64 = (a..z).map(at).sum::<f64>() / (z - a) as f64;
                 let before = if a == 0 { 0.0 } else { at(a - 1) };
