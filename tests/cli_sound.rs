@@ -1,0 +1,77 @@
+//! `timpanist sound …` from the command line: a scripted stroke written and measured, and
+//! a bad recording refused by the fit with its name and nothing written.
+
+use std::process::Command;
+
+fn timpanist(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_timpanist"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// A D3 stroke is written as a 48 kHz mono WAV and `sound analyse` finds its (1,1) at the
+/// tuning, its octave bands and its glide.
+#[test]
+fn stroke_then_analyse() {
+    let dir = tempfile::tempdir().unwrap();
+    let wav = dir.path().join("d3.wav");
+    let wav_s = wav.to_str().unwrap();
+    let out = timpanist(&[
+        "sound",
+        "stroke",
+        "--pitch",
+        "D3",
+        "--dynamic",
+        "ff",
+        "--wav",
+        wav_s,
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let spec = hound::WavReader::open(&wav).unwrap().spec();
+    assert_eq!((spec.sample_rate, spec.channels), (48_000, 1));
+    let out = timpanist(&["sound", "analyse", wav_s, "--at", "0"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("octave bands") && text.contains("glide +"),
+        "{text}"
+    );
+    let f11: f64 = text
+        .split("(1,1) ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((f11 / 146.83 - 1.0).abs() < 0.01, "{f11}");
+}
+
+/// A file that is not a WAV is named in the fit's error; no calibration is written.
+#[test]
+fn fit_refuses_a_bad_recording() {
+    let dir = tempfile::tempdir().unwrap();
+    let junk = dir.path().join("junk.wav");
+    std::fs::write(&junk, "not a wav").unwrap();
+    let cal = dir.path().join("cal.ron");
+    let out = timpanist(&[
+        "sound",
+        "fit",
+        junk.to_str().unwrap(),
+        "-o",
+        cal.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("junk.wav"));
+    assert!(!cal.exists());
+}
