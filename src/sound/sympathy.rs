@@ -38,8 +38,8 @@ const DECIMATION: usize = 8;
 /// Blocks between saved states.
 const SAVE_EVERY_BLOCKS: usize = 64;
 
-/// One receiving head's coupling: its m ≤ 1 voices, and per voice the force per unit
-/// pressure (m = 0, m²) and per unit pressure rate over c (m = 1, m³ per source).
+/// One receiving head's coupling: its m ≤ 1 voices below [`MAX_HZ`], their forces per
+/// unit pressure and pressure gradient, and the drums it hears.
 #[derive(Clone, Debug)]
 struct Receiver {
     bank: VoiceBank,
