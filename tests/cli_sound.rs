@@ -11,7 +11,7 @@ fn timpanist(args: &[&str]) -> std::process::Output {
 }
 
 /// A D3 stroke is written as a 48 kHz mono WAV and `sound analyse` finds its (1,1) at the
-/// tuning, its octave bands and its glide.
+/// tuning, its octave bands and its glide, and draws its spectrum as a PNG.
 #[test]
 fn stroke_then_analyse() {
     let dir = tempfile::tempdir().unwrap();
@@ -34,7 +34,16 @@ fn stroke_then_analyse() {
     );
     let spec = hound::WavReader::open(&wav).unwrap().spec();
     assert_eq!((spec.sample_rate, spec.channels), (48_000, 1));
-    let out = timpanist(&["sound", "analyse", wav_s, "--at", "0"]);
+    let png = dir.path().join("spectra.png");
+    let out = timpanist(&[
+        "sound",
+        "analyse",
+        wav_s,
+        "--at",
+        "0",
+        "--plot",
+        png.to_str().unwrap(),
+    ]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success(),
@@ -55,6 +64,7 @@ fn stroke_then_analyse() {
         .parse()
         .unwrap();
     assert!((f11 / 146.83 - 1.0).abs() < 0.01, "{f11}");
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
 }
 
 /// A file that is not a WAV is named in the fit's error; no calibration is written.

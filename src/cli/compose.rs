@@ -90,6 +90,7 @@ pub fn figure(comp: &Composition, title: &str) -> Figure {
     };
     Figure {
         title: format!("{title}: composed stick tips"),
+        x_label: "time (s)".into(),
         panels: vec![panel("height z (m)", 2), panel("depth y (m)", 1)],
         guides: comp.strokes.iter().map(|s| s.time_s).collect(),
         size: (1400, 800),

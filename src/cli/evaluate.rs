@@ -143,6 +143,7 @@ fn fig5(model: &BodyModel, mode: PlayingMode, captured: &Motion, motions: &[Moti
             "{}: captured vs IK / ID / HIMC (seed 000 Fig. 5)",
             mode.name()
         ),
+        x_label: "time (s)".into(),
         panels: vec![
             panel("wrist flexion (deg)", &flexion(Joint::WristR)),
             panel("elbow flexion (deg)", &flexion(Joint::ElbowR)),

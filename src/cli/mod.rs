@@ -184,6 +184,10 @@ pub enum SoundCommand {
         /// the strokes of a render: each is measured from 10 ms before the time given).
         #[arg(long, value_delimiter = ',')]
         at: Vec<f64>,
+        /// Also draw each note's spectrum (first 0.5 s) over the embedded recorded note
+        /// nearest its (1,1), pitched to it, as a PNG.
+        #[arg(long)]
+        plot: Option<PathBuf>,
     },
     /// Render one scripted stroke (legato, playing spot, general mallet) on the standard
     /// drum nearest a pitch, to audition the modal sound or compare it with a recording.
@@ -449,8 +453,8 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Some(Command::Mocap(MocapCommand::Stats { dir })) => {
             mocap::stats(&dir).map(|()| ExitCode::SUCCESS)
         }
-        Some(Command::Sound(SoundCommand::Analyse { files, at })) => {
-            sound::analyse(&files, &at).map(|()| ExitCode::SUCCESS)
+        Some(Command::Sound(SoundCommand::Analyse { files, at, plot })) => {
+            sound::analyse(&files, &at, plot.as_deref()).map(|()| ExitCode::SUCCESS)
         }
         Some(Command::Sound(SoundCommand::Stroke {
             pitch,

@@ -188,6 +188,7 @@ fn figure(r: &Rendering, title: &str) -> Figure {
     let colour_of = |hand: &str| HAND_COLOURS[usize::from(hand == "right")];
     Figure {
         title: format!("{title}: rendered performance"),
+        x_label: "time (s)".into(),
         panels: vec![
             Panel {
                 y_label: "stick tip height z (m)".into(),

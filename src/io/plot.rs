@@ -1,5 +1,5 @@
 //! PNG figures of time series (for `compose --plot` and other reports): stacked panels
-//! sharing a time axis, lines per series, point markers and vertical guide lines, drawn
+//! sharing an x axis (time, or frequency for spectra), lines per series, point markers and vertical guide lines, drawn
 //! with plotters and the font egui ships (no system fonts needed); written atomically.
 
 use plotters::prelude::*;
@@ -25,6 +25,8 @@ pub struct Panel {
 /// A figure of stacked panels over a common time axis.
 pub struct Figure {
     pub title: String,
+    /// The shared x axis's label, e.g. "time (s)".
+    pub x_label: String,
     pub panels: Vec<Panel>,
     /// Times of vertical guide lines (e.g. beats), s.
     pub guides: Vec<f64>,
@@ -126,7 +128,7 @@ impl Figure {
                 .build_cartesian_2d(t0..t1, y0..y1)?;
             chart
                 .configure_mesh()
-                .x_desc("time (s)")
+                .x_desc(self.x_label.as_str())
                 .y_desc(panel.y_label.as_str())
                 .light_line_style(WHITE.mix(0.0))
                 .draw()?;

@@ -235,6 +235,39 @@ fn t60_of(points: &[(f64, f64)]) -> Option<f64> {
     (slope < 0.0).then(|| -60.0 / slope)
 }
 
+/// The magnitude spectrum of a note over `window_s` from its onset (Hann, zero-padded),
+/// as (frequency Hz, level dB re the strongest bin). Empty for a silent signal.
+pub fn note_spectrum_db(samples: &[f32], rate_hz: u32, window_s: f64) -> Vec<(f64, f64)> {
+    let Some(start) = onset(samples, rate_hz) else {
+        return Vec::new();
+    };
+    let len = (window_s * f64::from(rate_hz)) as usize;
+    let spec = spectrum(&samples[start..(start + len).min(samples.len())], rate_hz);
+    let db = |amp: f64| 20.0 * amp.max(1e-12).log10();
+    let top = spec
+        .iter()
+        .map(|&(_, m)| db(m))
+        .fold(f64::NEG_INFINITY, f64::max);
+    spec.into_iter().map(|(f, m)| (f, db(m) - top)).collect()
+}
+
+/// The embedded recorded timpani note nearest `tuning_hz` (FluidR3, the sample model's),
+/// its spectrum over `window_s` from the onset with frequencies × tuning/(its (1,1)): how
+/// that note would look pitched to the tuning. With a name for a legend.
+pub fn recorded_reference(tuning_hz: f64, window_s: f64) -> Option<(String, Vec<(f64, f64)>)> {
+    let recordings = super::sample::recordings().ok()?;
+    let rec = super::sample::nearest(recordings, tuning_hz)?;
+    let scale = tuning_hz / rec.principal_hz;
+    let points = note_spectrum_db(&rec.samples, rec.rate_hz, window_s)
+        .into_iter()
+        .map(|(f, d)| (f * scale, d))
+        .collect();
+    Some((
+        format!("recorded {} at {:.0} Hz", rec.name, tuning_hz),
+        points,
+    ))
+}
+
 /// Why a WAV could not be read for analysis.
 #[derive(Debug, thiserror::Error)]
 #[error("{}: {message}", path.display())]

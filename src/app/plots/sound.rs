@@ -100,31 +100,16 @@ pub fn strike_spectrum(audio: &Audio, t0_s: f64, window_s: f64) -> Vec<[f64; 2]>
 }
 
 /// The spectrum of the recorded note nearest `tuning_hz` over [`ANALYSIS_S`] from its
-/// onset, as [`strike_spectrum`] draws it, frequencies × tuning/(its (1,1)) and levels
-/// shifted so its strongest bin is at `top_db`; with the recording's name.
+/// onset ([`crate::sound::analysis::recorded_reference`]), as [`strike_spectrum`] draws
+/// it, levels shifted so its strongest bin is at `top_db`; with the recording's name.
 pub fn recorded_spectrum(tuning_hz: f64, top_db: f64) -> Option<(Vec<[f64; 2]>, String)> {
-    let recordings = crate::sound::sample::recordings().ok()?;
-    let rec = crate::sound::sample::nearest(recordings, tuning_hz)?;
-    let start = crate::sound::analysis::onset(&rec.samples, rec.rate_hz)?;
-    let len = (ANALYSIS_S * f64::from(rec.rate_hz)) as usize;
-    let window = &rec.samples[start..(start + len).min(rec.samples.len())];
-    let spec = crate::sound::spectrum(window, rec.rate_hz);
-    let db = |amp: f64| 20.0 * amp.max(1e-12).log10();
-    let top = spec
-        .iter()
-        .map(|&(_, m)| db(m))
-        .fold(f64::NEG_INFINITY, f64::max);
-    let scale = tuning_hz / rec.principal_hz;
+    let (name, spec) = crate::sound::analysis::recorded_reference(tuning_hz, ANALYSIS_S)?;
     let points = spec
         .into_iter()
-        .map(|(f, m)| (f * scale, db(m) - top + top_db))
         .filter(|&(f, _)| f >= LOWEST_HZ)
-        .map(|(f, d)| [f.log10(), d.max(top_db - RANGE_DB)])
+        .map(|(f, d)| [f.log10(), (d + top_db).max(top_db - RANGE_DB)])
         .collect();
-    Some((
-        points,
-        format!("recorded {} at {:.0} Hz", rec.name, tuning_hz),
-    ))
+    Some((points, name))
 }
 
 /// A frequency for an axis: "50 Hz", "1 kHz", "2.5 kHz".
