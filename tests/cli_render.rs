@@ -96,6 +96,9 @@ fn cli_render_writes_wav_motion_and_events() {
     );
     assert!(take.track("LTIP_TARGET").is_some() && take.track("ELBOW_R").is_some());
     assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+    // --plot's second figure: the first stroke's spectrum against a recorded note.
+    let spectra = dir.path().join("plot-spectra.png");
+    assert!(std::fs::read(&spectra).unwrap().starts_with(b"\x89PNG"));
 }
 
 /// A malformed score, or one with a stroke out of reach, fails with its name and the

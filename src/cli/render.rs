@@ -125,6 +125,12 @@ pub fn run(
     }
     if let (Some(path), Some(figure)) = (outputs.plot, figure) {
         figure.save_png(path)?;
+        let spectra = path.with_file_name(format!(
+            "{}-spectra.png",
+            path.file_stem()
+                .map_or("plot".into(), |s| s.to_string_lossy())
+        ));
+        super::sound::spectra_figure(first_strokes(&rendering)).save_png(&spectra)?;
     }
     if let (Some(path), Some(text)) = (outputs.motion, motion) {
         ron_file::write_atomic(path, text.as_bytes())?;
@@ -208,6 +214,35 @@ fn figure(r: &Rendering, title: &str) -> Figure {
         guides: r.composition.strokes.iter().map(|s| s.time_s).collect(),
         size: (1400, 800),
     }
+}
+
+/// Per drum struck, its first scored stroke's spectrum (one second of the mix from 10 ms
+/// before the contact: later strokes within it are heard too) over the recorded note
+/// nearest its (1,1): `--plot`'s second figure.
+fn first_strokes(r: &Rendering) -> Vec<crate::io::plot::Panel> {
+    let mono = r.audio.mono();
+    let rate = r.audio.rate_hz;
+    let mut seen = Vec::new();
+    r.events
+        .iter()
+        .filter(|e| e.beat.is_some())
+        .filter(|e| {
+            let new = !seen.contains(&e.drum);
+            seen.push(e.drum);
+            new
+        })
+        .filter_map(|e| {
+            let from = ((e.contact_s - 0.01).max(0.0) * f64::from(rate)) as usize;
+            let name = r.kit.drums.get(e.drum).map_or("drum", |d| d.name.as_str());
+            (from < mono.len()).then(|| {
+                super::sound::spectrum_panel(
+                    &format!("{name} at {:.2} s", e.contact_s),
+                    &mono[from..(from + rate as usize).min(mono.len())],
+                    rate,
+                )
+            })
+        })
+        .collect()
 }
 
 /// `--stats` lists the strokes whose peak force is off its aim by more than this fraction.

@@ -122,18 +122,22 @@ pub fn analyse(files: &[PathBuf], at: &[f64], plot: Option<&Path>) -> anyhow::Re
         }
     }
     if let Some(path) = plot {
-        let count = panels.len() as u32;
-        let figure = Figure {
-            title: "Spectra (first 0.5 s) against recorded timpani".into(),
-            x_label: "frequency: log10 Hz (2 = 100 Hz, 3 = 1 kHz)".into(),
-            panels,
-            guides: Vec::new(),
-            size: (1200, 120 + 300 * count.max(1)),
-        };
-        figure.save_png(path)?;
+        spectra_figure(panels).save_png(path)?;
         println!("spectra -> {}", path.display());
     }
     Ok(())
+}
+
+/// A figure of spectrum panels ([`spectrum_panel`]), one above the other.
+pub fn spectra_figure(panels: Vec<Panel>) -> Figure {
+    let count = panels.len() as u32;
+    Figure {
+        title: "Spectra (first 0.5 s) against recorded timpani".into(),
+        x_label: "frequency: log10 Hz (2 = 100 Hz, 3 = 1 kHz)".into(),
+        panels,
+        guides: Vec::new(),
+        size: (1200, 120 + 300 * count.max(1)),
+    }
 }
 
 /// Span of a plotted spectrum, s, and its frequency range, Hz.
@@ -144,7 +148,7 @@ const PLOT_POINTS: usize = 1200;
 
 /// A note's spectrum (dB re its peak, floored at −90) on a log10 frequency axis, with the
 /// recorded note nearest its (1,1) pitched to it.
-fn spectrum_panel(name: &str, samples: &[f32], rate: u32) -> Panel {
+pub fn spectrum_panel(name: &str, samples: &[f32], rate: u32) -> Panel {
     let bucketed = |points: Vec<(f64, f64)>| -> Vec<(f64, f64)> {
         let (lo, hi) = (PLOT_HZ.0.log10(), PLOT_HZ.1.log10());
         let mut buckets = vec![f64::NEG_INFINITY; PLOT_POINTS];
