@@ -56,19 +56,24 @@ fn power_spectrum(samples: &[f32], rate_hz: u32) -> (f64, Vec<f64>) {
     (f64::from(rate_hz) / n as f64, power)
 }
 
+/// The energy of a power spectrum (bin width `bin_hz`) in the octave band centred on
+/// `centre_hz`, from centre/√2 (included) to centre·√2. DC never falls in a band.
+fn octave_energy(bin_hz: f64, power: &[f64], centre_hz: f64) -> f64 {
+    let (lo, hi) = (centre_hz / 2f64.sqrt(), centre_hz * 2f64.sqrt());
+    power
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| (lo..hi).contains(&(*k as f64 * bin_hz)))
+        .map(|(_, p)| p)
+        .sum()
+}
+
 /// Octave-band shares (dB) and power-weighted centroid (Hz) of a power spectrum; DC left out.
 fn bands_and_centroid(bin_hz: f64, power: &[f64]) -> ([f64; 7], f64) {
     let total: f64 = power.iter().skip(1).sum::<f64>().max(1e-300);
     let mut bands = [0.0; 7];
     for (band, &centre) in bands.iter_mut().zip(&OCTAVE_CENTRES_HZ) {
-        let (lo, hi) = (centre / 2f64.sqrt(), centre * 2f64.sqrt());
-        let energy: f64 = power
-            .iter()
-            .enumerate()
-            .skip(1)
-            .filter(|(k, _)| (lo..hi).contains(&(*k as f64 * bin_hz)))
-            .map(|(_, p)| p)
-            .sum();
+        let energy = octave_energy(bin_hz, power, centre);
         *band = 10.0 * (energy / total).max(1e-30).log10();
     }
     let moment: f64 = power
@@ -173,7 +178,6 @@ pub fn band_t60(
     window_s: f64,
 ) -> Option<f64> {
     let start = onset(samples, rate_hz)?;
-    let (lo, hi) = (centre_hz / 2f64.sqrt(), centre_hz * 2f64.sqrt());
     let points = levels(samples, rate_hz, (start, span_s), window_s, |w| {
         let windowed: Vec<f32> = w
             .iter()
@@ -181,12 +185,7 @@ pub fn band_t60(
             .map(|(i, &s)| s * hann(i, w.len()) as f32)
             .collect();
         let (bin, power) = power_spectrum(&windowed, rate_hz);
-        let energy: f64 = power
-            .iter()
-            .enumerate()
-            .filter(|(k, _)| (lo..hi).contains(&(*k as f64 * bin)))
-            .map(|(_, p)| p)
-            .sum();
+        let energy = octave_energy(bin, &power, centre_hz);
         (energy > 0.0).then(|| 10.0 * energy.log10())
     });
     t60_of(&points)

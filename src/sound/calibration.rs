@@ -55,11 +55,6 @@ impl Calibration {
         CAL.get_or_init(|| ron::from_str(SHIPPED).expect("kits/sound/modal.ron is valid"))
     }
 
-    /// Read a calibration file.
-    pub fn load(path: &Path) -> Result<Calibration, FileError> {
-        ron_file::parse(path, &ron_file::read_text(path)?)
-    }
-
     /// Write it atomically.
     pub fn save(&self, path: &Path) -> Result<(), FileError> {
         let text = format!(

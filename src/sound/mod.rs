@@ -23,8 +23,10 @@ pub use wav::write_wav;
 pub use crate::base::choices::SoundModel;
 use crate::drum::DrumSet;
 use crate::kit::Kit;
+use partials::SoundHead;
 use std::f64::consts::FRAC_PI_4;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// Audio sample rate, Hz.
 pub const SAMPLE_RATE_HZ: u32 = 48_000;
@@ -301,44 +303,55 @@ pub fn render_calibrated(
     };
     // The first frame any drum re-synthesises from.
     let mut start = state.mix.len() / 2;
-    // Each drum on its own thread: they share nothing but what they read.
-    let results: Vec<Result<usize, SoundError>> = std::thread::scope(|scope| {
+    // Each drum on its own thread: they share nothing but what they read. The modal
+    // model's threads also build (or find) their drum's sounding head, which the
+    // sympathetic pass then reuses.
+    type Synthesised = (Result<usize, SoundError>, Option<Arc<SoundHead>>);
+    let results: Vec<Synthesised> = std::thread::scope(|scope| {
         let jobs: Vec<_> = kit
             .drums
             .iter()
             .zip(state.drums.iter_mut())
             .enumerate()
             .map(|(j, (drum, (mono, synth, heard)))| {
-                scope.spawn(move || {
+                scope.spawn(move || -> Synthesised {
                     let own: Vec<f64> = touches
                         .iter()
                         .filter(|t| t.drum == j)
                         .map(|t| t.at_s)
                         .collect();
-                    let (touched, from) = match model {
-                        SoundModel::Modal => modal::resynthesise(
-                            (drum, calibration),
-                            (drums, &own),
-                            j,
-                            mono,
-                            frames,
-                            synth,
-                        ),
+                    let mut head = None;
+                    let outcome = match model {
+                        SoundModel::Modal => {
+                            head = modal::sound_head(drum, drums, calibration);
+                            Ok(modal::resynthesise(
+                                head.as_deref(),
+                                (drums, &own),
+                                j,
+                                mono,
+                                frames,
+                                synth,
+                            ))
+                        }
                         SoundModel::Sample => {
                             *mono = vec![0.0; frames];
-                            let touched = sample::render_drum(drum, drums, j, mono)?;
-                            damp_replayed(mono, &own, drums, j);
-                            (touched, 0)
+                            sample::render_drum(drum, drums, j, mono).map(|touched| {
+                                damp_replayed(mono, &own, drums, j);
+                                (touched, 0)
+                            })
                         }
                         SoundModel::Signal => {
                             *mono = vec![0.0; frames];
                             let touched = signal::render_drum(drums, j, mono);
                             damp_replayed(mono, &own, drums, j);
-                            (touched, 0)
+                            Ok((touched, 0))
                         }
                     };
-                    *heard = touched;
-                    Ok(from)
+                    let from = outcome.map(|(touched, from)| {
+                        *heard = touched;
+                        from
+                    });
+                    (from, head)
                 })
             })
             .collect();
@@ -346,14 +359,10 @@ pub fn render_calibrated(
             .map(|job| job.join().expect("a drum's synthesis panicked"))
             .collect()
     });
-    let froms = results.into_iter().collect::<Result<Vec<usize>, _>>()?;
+    let (froms, heads): (Vec<_>, modal::SoundHeads) = results.into_iter().unzip();
+    let froms = froms.into_iter().collect::<Result<Vec<usize>, _>>()?;
     start = froms.iter().fold(start, |s, f| s.min(*f));
     if model == SoundModel::Modal {
-        let heads: modal::SoundHeads = kit
-            .drums
-            .iter()
-            .map(|d| modal::sound_head(d, drums, calibration))
-            .collect();
         let monos: Vec<&[f32]> = state.drums.iter().map(|(m, _, _)| m.as_slice()).collect();
         state.sympathy.resize(kit.drums.len(), Default::default());
         let sympathy_froms: Vec<usize> = std::thread::scope(|scope| {

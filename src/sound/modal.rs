@@ -1,20 +1,17 @@
-//! The modal sound model (seed 000 §4): per head, a [`VoiceBank`] of every
-//! audible mode driven by the contact force the simulation recorded. The force, held over
-//! each simulation step, is resampled to 48 kHz by a triangle kernel one step wide each
-//! side (linear interpolation, impulse preserved); mode k receives F·Φ_k(x)/M_k (its shape
-//! at the contact point over its modal mass, m/s²) and the output is
-//! `MODAL_CALIBRATION` × Σ gain_k × q̇_k.
-//!
-//! Audible modes: below 0.45 × 48 kHz, with the listener on the head's axis through the
-//! player (θ = 0): the cos orientations radiate there with the kit's gain; the sin
-//! orientations have a nodal line on that axis and are silent (they still move the head
-//! in the simulation).
+//! The modal sound model (seed 000 §4): per head, a [`VoiceBank`] of its sounding modes
+//! ([`SoundHead`]: full band, radiation-weighted, calibrated) driven by the contact force
+//! the simulation recorded. The force, held over each simulation step, is resampled to
+//! 48 kHz by a triangle kernel one step wide each side (linear interpolation, impulse
+//! preserved); mode k receives F·Φ_k(x)/M_k (its shape at the contact point over its
+//! modal mass, m/s²) and the drum's synthesis is `MODAL_CALIBRATION` × Σ (gain_k/ω_k) ×
+//! q̇_k, which the mix differentiates. Hands resting on the head (touches) damp it, and
+//! the glide retunes the bank, block by block.
 
 use super::SAMPLE_RATE_HZ;
 use super::calibration::Calibration;
 use super::partials::SoundHead;
 use super::voices::{BankState, Voice, VoiceBank};
-use crate::drum::{DrumSet, HeadModes, Orientation};
+use crate::drum::DrumSet;
 use crate::kit::Drum;
 use glam::DVec2;
 use std::collections::HashMap;
@@ -28,30 +25,6 @@ const BLOCK: usize = 128;
 /// States below this (m/s; with gains ≤ 0.2 per m/s, under −150 dBFS) are flushed to zero,
 /// and a chunk of voices that is all zero is skipped.
 pub const FLUSH_FLOOR: f32 = 1e-7;
-
-/// The audible modes of a head: their indices in `head.modes()` and their voices (gains
-/// include `MODAL_CALIBRATION`).
-pub fn voices_for(head: &HeadModes, calibration: f64) -> (Vec<usize>, Vec<Voice>) {
-    let nyquist_margin = 0.45 * f64::from(SAMPLE_RATE_HZ);
-    head.modes()
-        .iter()
-        .enumerate()
-        .filter(|(_, m)| {
-            m.orientation == Orientation::Cos && m.freq_hz < nyquist_margin && m.gain > 0.0
-        })
-        .map(|(k, m)| {
-            (
-                k,
-                Voice {
-                    freq_hz: m.freq_hz,
-                    t60_s: m.t60_s,
-                    gain: m.gain * calibration,
-                    glide: 0.0,
-                },
-            )
-        })
-        .unzip()
-}
 
 /// The sounding modes of `drum` under `calibration`, built once per process per drum
 /// definition, frequency source and calibration (a full-band head takes a while to build).
@@ -151,7 +124,7 @@ fn first_change<T: PartialEq>(now: &[T], before: &[T], time: impl Fn(&T) -> f64)
 /// output) reaches; the output before it is kept. Bit for bit a whole render. Returns
 /// whether anything touched the drum and the first frame rewritten.
 pub fn resynthesise(
-    (drum, calibration): (&Drum, &Calibration),
+    head: Option<&SoundHead>,
     (drums, touches): (&DrumSet, &[f64]),
     j: usize,
     out: &mut Vec<f32>,
@@ -167,14 +140,13 @@ pub fn resynthesise(
         let hi = (c + dt * fs).ceil().max(0.0) as usize; // exclusive
         (c, lo, hi)
     };
-    let head = sound_head(drum, drums, calibration);
     let mut entries: Vec<_> = drums.excitation().iter().filter(|e| e.drum == j).collect();
     entries.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
     let heard: Vec<(f64, DVec2, f64)> = entries
         .iter()
         .map(|e| (e.time_s, e.point, e.force_n))
         .collect();
-    let voices = head.as_deref().map_or(Vec::new(), calibrated);
+    let voices = head.map_or(Vec::new(), calibrated);
     // The first frame a difference reaches: none before the end of the previous output
     // when the drum is silent now and was then, or heard the same entries with the same
     // voices.

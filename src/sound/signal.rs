@@ -1,15 +1,41 @@
 //! The signal-based sound model (seed 002): each contact starts decaying sinusoidal
 //! partials at the head's mode frequencies, decays and gains (the voices of
-//! [`modal::voices_for`]), each weighted by its mode shape at the impact point, plus a
+//! [`voices_for`]), each weighted by its mode shape at the impact point, plus a
 //! short noise burst (deterministic, seeded by drum and contact), all in proportion to
 //! the impact speed: a strike at `REFERENCE_SPEED_MPS` gives partials of total amplitude
 //! ≈ `REFERENCE_LEVEL` at the playing spot.
 
-use super::modal::{FLUSH_FLOOR, voices_for};
-use super::voices::VoiceBank;
+use super::modal::FLUSH_FLOOR;
+use super::voices::{Voice, VoiceBank};
 use super::{REFERENCE_LEVEL, REFERENCE_SPEED_MPS, SAMPLE_RATE_HZ};
 use crate::base::rng::Rng;
-use crate::drum::DrumSet;
+use crate::drum::{DrumSet, HeadModes, Orientation};
+
+/// The partials of a head: the indices in `head.modes()` and the voices (gains × `scale`)
+/// of the simulated head's modes below 0.45 × 48 kHz heard on its axis through the
+/// player (θ = 0), where the cos orientations radiate with the kit's gain and the sin
+/// orientations, with a nodal line there, are silent.
+fn voices_for(head: &HeadModes, scale: f64) -> (Vec<usize>, Vec<Voice>) {
+    let nyquist_margin = 0.45 * f64::from(SAMPLE_RATE_HZ);
+    head.modes()
+        .iter()
+        .enumerate()
+        .filter(|(_, m)| {
+            m.orientation == Orientation::Cos && m.freq_hz < nyquist_margin && m.gain > 0.0
+        })
+        .map(|(k, m)| {
+            (
+                k,
+                Voice {
+                    freq_hz: m.freq_hz,
+                    t60_s: m.t60_s,
+                    gain: m.gain * scale,
+                    glide: 0.0,
+                },
+            )
+        })
+        .unzip()
+}
 
 /// Scale of the partials: with the kit's gains and the shapes at the playing spot, a
 /// reference strike peaks near `REFERENCE_LEVEL` (measured: 0.22 at scale 2 → 4.4).
