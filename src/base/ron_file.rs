@@ -114,9 +114,16 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".timpanist-")
-        .suffix(".tmp")
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".timpanist-").suffix(".tmp");
+    // A replaced file keeps its permissions; a new one gets the usual rw-r--r-- (a bare
+    // temporary file would be private to its owner).
+    #[cfg(unix)]
+    builder.permissions(std::fs::metadata(path).map_or_else(
+        |_| std::os::unix::fs::PermissionsExt::from_mode(0o644),
+        |m| m.permissions(),
+    ));
+    let mut tmp = builder
         .tempfile_in(dir)
         .map_err(|e| FileError::io(path, e))?;
     tmp.write_all(bytes).map_err(|e| FileError::io(path, e))?;
@@ -158,6 +165,25 @@ pub fn top_level_name(text: &str) -> Option<&str> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A new file is created rw-r--r-- (less the umask), not private like a bare temporary
+    /// file; a replaced one keeps its mode.
+    #[cfg(unix)]
+    #[test]
+    fn written_files_have_ordinary_permissions() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.txt");
+        write_atomic(&path, b"one").unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        // rw-r--r-- less whatever the umask removes (never more, never less for the owner).
+        assert_eq!(mode(&path) & 0o600, 0o600);
+        assert_eq!(mode(&path) & !0o644, 0);
+        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o600)).unwrap();
+        write_atomic(&path, b"two").unwrap();
+        assert_eq!(mode(&path), 0o600);
+        assert_eq!(std::fs::read(&path).unwrap(), b"two");
+    }
     use serde::Deserialize;
 
     #[derive(Debug, Deserialize, Serialize, PartialEq)]

@@ -91,6 +91,23 @@ pub fn solve(
     }
 }
 
+/// A posture with both stick tips on `tips` ([left, right], m, performer frame): each arm
+/// solved in turn from the rest pose (trunk upright, 500 iterations of the default
+/// solver), so a simulation started in it has its tips on their first targets instead of
+/// hanging at rest ~0.8 m away. A tip out of reach leaves that arm stretched toward it.
+pub fn posture_reaching(skeleton: &Skeleton, tips: [DVec3; 2]) -> Pose {
+    let params = IkParams {
+        max_iterations: 500,
+        use_trunk: false,
+        ..IkParams::default()
+    };
+    let mut pose = super::skeleton::REST;
+    for (side, tip) in [Side::Left, Side::Right].into_iter().zip(tips) {
+        pose = solve(skeleton, &pose, side, tip, None, &params).pose;
+    }
+    pose
+}
+
 /// One iteration of the solver: the joint steps that move the `side` tip toward `target`,
 /// computed from `frames` (the forward kinematics of the pose the steps are applied to) and
 /// applied to `pose`. HIMC runs exactly this once per arm every simulation step, both arms
@@ -263,6 +280,18 @@ mod tests {
             "arm not stretched"
         );
         assert!((target - tip).length() - r.error_m < 1e-9);
+    }
+
+    /// Both tips of the reaching posture are on their targets (to the solver's
+    /// tolerance), whichever hand's target is nearer the rest pose.
+    #[test]
+    fn posture_reaching_puts_both_tips_on_target() {
+        let s = Skeleton::default();
+        let tips = [DVec3::new(-0.3, 0.5, 0.85), DVec3::new(0.35, 0.55, 0.8)];
+        let pose = posture_reaching(&s, tips);
+        for (side, tip) in [Side::Left, Side::Right].into_iter().zip(tips) {
+            assert!(s.tip(&pose, side).distance(tip) < 1e-4, "{side:?}");
+        }
     }
 
     /// The null-space pull keeps the tip on target while moving toward the reference.

@@ -43,19 +43,24 @@ arg_enum!(DynamicArg => Dynamic {
 arg_enum!(GripArg => Grip { French => Grip::French, German => Grip::German });
 arg_enum!(UpArg => UpAxis { Y => UpAxis::Y, Z => UpAxis::Z });
 
-/// A capture format by name (c3d, motive, vicon, csv).
+/// A capture format by name (c3d, motive, vicon, trc, csv).
 pub fn parse_format(s: &str) -> Result<Format, String> {
     Format::from_name(s)
-        .ok_or_else(|| format!("unknown format \"{s}\": expected c3d, motive, vicon or csv"))
+        .ok_or_else(|| format!("unknown format \"{s}\": expected c3d, motive, vicon, trc or csv"))
 }
 
-/// Two comma-separated labels, left then right.
-pub fn parse_pair(s: &str) -> Result<(String, String), String> {
+/// `--tips`: "LEFT,RIGHT", "LEFT," or ",RIGHT", or one label.
+pub fn parse_tips(s: &str) -> Result<crate::cli::mocap::TipsArg, String> {
+    use crate::cli::mocap::TipsArg;
+    let label = |x: &str| Some(x.trim().to_string()).filter(|x| !x.is_empty());
     match s.split_once(',') {
-        Some((a, b)) if !a.trim().is_empty() && !b.trim().is_empty() => {
-            Ok((a.trim().into(), b.trim().into()))
-        }
-        _ => Err(format!("expected LEFT,RIGHT labels, found \"{s}\"")),
+        None => label(s)
+            .map(TipsArg::One)
+            .ok_or_else(|| "--tips: expected a label".to_string()),
+        Some((a, b)) => match (label(a), label(b)) {
+            (None, None) => Err(format!("expected LEFT,RIGHT labels, found \"{s}\"")),
+            (l, r) => Ok(TipsArg::Both(l, r)),
+        },
     }
 }
 

@@ -1,5 +1,9 @@
 //! `timpanist compose`: write the two composed stick-tip trajectories of a score as CSV
 //! and, with `--plot`, a PNG of tip height and depth against time with the beats marked.
+//!
+//! Also what `compose` and `render` share about the motion database: a database lacking
+//! a playing mode is completed from the shipped synthetic one ([`load_db`]), and the
+//! beats played with a unit of other labels than asked are told ([`print_substitutions`]).
 
 use crate::base::ron_file;
 use crate::io::plot::{Figure, Panel, Series};
@@ -8,8 +12,9 @@ use crate::kit::Side;
 use crate::mocap::db::MotionDb;
 use crate::motion::compose::{ComposeParams, Composition};
 use crate::motion::perform;
-use crate::motion::plan::PlanParams;
+use crate::motion::plan::{self, PlanParams, Substitution};
 use crate::score::LoadedScore;
+use crate::score::{Grip, PlayingMode};
 use plotters::style::RGBColor;
 use std::path::Path;
 
@@ -25,7 +30,7 @@ pub fn run(
     seed: u64,
 ) -> anyhow::Result<()> {
     let loaded = LoadedScore::load(score)?;
-    let db = MotionDb::load(db_dir)?;
+    let db = load_db(db_dir)?;
     let started = std::time::Instant::now();
     let comp = perform::trajectories(
         &loaded.score,
@@ -39,6 +44,7 @@ pub fn run(
     )
     .map_err(|e| anyhow::anyhow!("{}: {e}", db_dir.display()))?;
     let took = started.elapsed();
+    print_substitutions(&plan::substitutions(&comp.strokes, &loaded.score, &db));
     let csv = tips_csv::to_csv(&comp);
     if let Some(plot) = plot {
         figure(&comp, &loaded.score.title).save_png(plot)?;
@@ -55,6 +61,94 @@ pub fn run(
         took.as_secs_f64() * 1e3
     );
     Ok(())
+}
+
+/// The motion database in `db_dir`, completed for the playing modes (per grip) it has no
+/// unit of by the shipped synthetic database ([`MotionDb::with_fallback`]), saying on
+/// stderr which modes came from it. The shipped database itself (or one holding every
+/// mode of both grips) is used as it is; when the shipped one cannot be read, the
+/// database is used as it is with a note.
+pub fn load_db(db_dir: &Path) -> anyhow::Result<MotionDb> {
+    let db = MotionDb::load(db_dir)?;
+    let shipped_dir = crate::mocap::db::default_dir();
+    let has = |key: (Grip, PlayingMode)| db.index.units.iter().any(|u| (u.grip, u.mode) == key);
+    let complete = [Grip::French, Grip::German]
+        .into_iter()
+        .all(|grip| PlayingMode::ALL.into_iter().all(|mode| has((grip, mode))));
+    if complete || same_dir(db_dir, &shipped_dir) {
+        return Ok(db);
+    }
+    let shipped = match MotionDb::load(&shipped_dir) {
+        Ok(shipped) => shipped,
+        Err(e) => {
+            eprintln!(
+                "note: the modes {} lacks are not completed: {e}",
+                db_dir.display()
+            );
+            return Ok(db);
+        }
+    };
+    let lacking = db.modes_lacking(&shipped);
+    if !lacking.is_empty() {
+        let modes: Vec<String> = (lacking.iter())
+            .map(|(grip, mode)| format!("{} ({grip:?})", mode.name()))
+            .collect();
+        eprintln!(
+            "note: {} has no unit of {}: those come from the synthetic database {}",
+            db_dir.display(),
+            modes.join(", "),
+            shipped_dir.display()
+        );
+    }
+    Ok(db.with_fallback(&shipped))
+}
+
+/// Whether two paths name the same folder.
+fn same_dir(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => a == b,
+    }
+}
+
+/// Substitutions told one by one; beyond these, a summary line.
+const LISTED_SUBSTITUTIONS: usize = 8;
+
+/// Tell on stderr which beats were played with a unit of other labels than asked
+/// ("note: beat 12 (staccato, right, mf): no such unit; used accent, right, mf"), the
+/// first few one by one and then how many more and of what.
+pub fn print_substitutions(substitutions: &[Substitution]) {
+    for s in substitutions.iter().take(LISTED_SUBSTITUTIONS) {
+        eprintln!("note: {s}");
+    }
+    if substitutions.len() > LISTED_SUBSTITUTIONS {
+        eprintln!(
+            "note: {} more beats played with units of other labels ({} in all: {})",
+            substitutions.len() - LISTED_SUBSTITUTIONS,
+            substitutions.len(),
+            kinds(substitutions)
+        );
+    }
+}
+
+/// How many substitutions change each label, e.g. "3 of mode, 12 of dynamic".
+fn kinds(substitutions: &[Substitution]) -> String {
+    let differences: Vec<_> = (substitutions.iter())
+        .map(|s| s.wanted.differences(&s.used))
+        .collect();
+    let count = |f: fn(&plan::Differences) -> bool| differences.iter().filter(|d| f(d)).count();
+    [
+        ("mode", count(|d| d.mode)),
+        ("hand", count(|d| d.hand)),
+        ("location", count(|d| d.location)),
+        ("dynamic", count(|d| d.dynamic)),
+        ("grip", count(|d| d.grip)),
+    ]
+    .into_iter()
+    .filter(|(_, n)| *n > 0)
+    .map(|(what, n)| format!("{n} of {what}"))
+    .collect::<Vec<_>>()
+    .join(", ")
 }
 
 /// Height and depth of both tips against time, impacts dotted, beats as guides.

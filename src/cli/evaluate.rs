@@ -8,6 +8,7 @@ use crate::body::model::BodyModel;
 use crate::body::sim::Motion;
 use crate::body::skeleton::{Joint, REST};
 use crate::io::plot::{Figure, Panel, Series};
+use crate::kit::Side;
 use crate::mocap::db::MotionDb;
 use crate::render::evaluate::{self, EvalParams, Report};
 use crate::score::PlayingMode;
@@ -15,7 +16,11 @@ use plotters::style::RGBColor;
 use std::path::Path;
 
 /// Run the evaluation with `trials` per mode (joints held within the database's limits if
-/// `joint_limits`) and report it, also as JSON and PNG figures when asked.
+/// `joint_limits`) and report it, also as JSON and PNG figures when asked. Any database
+/// will do: per mode the best-labelled units are evaluated (the table is followed by
+/// which labels were used when not right hand, playing spot, mf, French), modes it lacks
+/// are listed as skipped, and for tip-only captures ID replays the joint angles IK solves
+/// from the tips on the capture skeleton (`render::evaluate`'s doc).
 pub fn run(
     db_dir: &Path,
     trials: usize,
@@ -29,20 +34,19 @@ pub fn run(
         ..EvalParams::default()
     };
     if joint_limits {
-        // The evaluated strokes are French-grip units (`evaluate::units_for`).
+        // The evaluation prefers French-grip units (`evaluate::preferred`).
         params.sim.limits = db.joint_limits(crate::score::Grip::French);
+        if params.sim.limits.iter().all(Option::is_none) {
+            println!("note: no French-grip unit has captured joints: no joint limits to hold");
+        }
     }
     let started = std::time::Instant::now();
     let report = evaluate::evaluate(&db, &model, &params)?;
     let took = started.elapsed().as_secs_f64();
     print_table(&report);
-    let simulated: f64 = PlayingMode::ALL
-        .iter()
-        .flat_map(|&m| evaluate::units_for(&db, m, params.strokes_per_mode))
-        .map(|u| (u.end - u.start) as f64 / db.takes[u.take].rate_hz)
-        .sum::<f64>()
-        * 2.0
-        * params.trials as f64;
+    print_notes(&report);
+    let simulated: f64 =
+        report.modes.iter().map(|m| m.duration_s).sum::<f64>() * 2.0 * params.trials as f64;
     println!(
         "simulated {simulated:.1} s of ID and HIMC at {} Hz in {took:.1} s wall ({:.0}× real time, IK included)",
         params.sim.sim_hz,
@@ -55,18 +59,18 @@ pub fn run(
     if let Some(dir) = plot {
         std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
         for mode in PlayingMode::ALL {
-            let Some(unit) = evaluate::units_for(&db, mode, 1).into_iter().next() else {
+            let selection = evaluate::select(&db, mode, 1, params.max_gap_s);
+            let Some((_, unit, reference)) = selection.units.first() else {
                 continue;
             };
-            let reference = evaluate::reference_of(&db, unit);
-            let motions = evaluate::trial(&model, &reference, &params, &mut Rng::new(params.seed))?;
+            let motions = evaluate::trial(&model, reference, &params, &mut Rng::new(params.seed))?;
             let captured = Motion {
                 rate_hz: reference.rate_hz,
                 tips: reference.tips.clone(),
                 poses: reference.poses.clone().unwrap_or_default(),
             };
             let path = dir.join(format!("fig5-{}.png", mode.name().replace(' ', "-")));
-            fig5(&model, mode, &captured, &motions).save_png(&path)?;
+            fig5(&model, (mode, unit.hand), &captured, &motions).save_png(&path)?;
             println!("wrote {}", path.display());
         }
     }
@@ -93,6 +97,57 @@ fn print_table(report: &Report) {
     }
 }
 
+/// Units passed over listed per mode; the rest are counted.
+const LISTED_SKIPS: usize = 3;
+
+/// Under the table, what differs from the seed's evaluation: the labels of the units
+/// evaluated when not the preferred ones, units passed over, modes skipped, and what ID
+/// replayed without captured joints. Nothing for the shipped database.
+fn print_notes(report: &Report) {
+    let preferred = evaluate::UsedLabels::of(&evaluate::preferred(PlayingMode::Legato));
+    for m in &report.modes {
+        if m.substituted() {
+            let used: Vec<String> = (m.labels.iter())
+                .map(|l| format!("{} × {}", l.units, l.describe()))
+                .collect();
+            println!(
+                "{}: evaluated {} (no unit of {})",
+                m.mode,
+                used.join("; "),
+                preferred.describe()
+            );
+        }
+        for skip in m.skipped_units.iter().take(LISTED_SKIPS) {
+            println!(
+                "{}: passed over unit {}: {}",
+                m.mode, skip.unit, skip.reason
+            );
+        }
+        if m.skipped_units.len() > LISTED_SKIPS {
+            println!(
+                "{}: passed over {} more units",
+                m.mode,
+                m.skipped_units.len() - LISTED_SKIPS
+            );
+        }
+    }
+    for skipped in &report.skipped {
+        println!("{}: skipped ({})", skipped.mode, skipped.reason);
+    }
+    let solved: Vec<&str> = (report.modes.iter())
+        .filter(|m| m.joints_from_ik)
+        .map(|m| m.mode.as_str())
+        .collect();
+    if !solved.is_empty() {
+        println!(
+            "{}: no captured joint angles; ID replays the joint angles inverse kinematics \
+             solves from the captured tips on the {:.2} m capture skeleton",
+            solved.join(", "),
+            evaluate::CAPTURE_HEIGHT_M
+        );
+    }
+}
+
 const CAPTURED: RGBColor = RGBColor(0, 0, 0);
 const COLOURS: [RGBColor; 3] = [
     RGBColor(40, 160, 60),
@@ -100,8 +155,16 @@ const COLOURS: [RGBColor; 3] = [
     RGBColor(220, 40, 40),
 ];
 
-/// Seed 000 Fig. 5 for one mode: right-arm flexion angles and heights, captured vs each pipeline.
-fn fig5(model: &BodyModel, mode: PlayingMode, captured: &Motion, motions: &[Motion; 3]) -> Figure {
+/// Seed 000 Fig. 5 for one mode played by `hand`: that arm's flexion angles and heights,
+/// captured vs each pipeline.
+fn fig5(
+    model: &BodyModel,
+    (mode, hand): (PlayingMode, Side),
+    captured: &Motion,
+    motions: &[Motion; 3],
+) -> Figure {
+    let [shoulder, elbow, wrist, _] = Joint::arm(hand);
+    let h = crate::mocap::db::side_index(hand);
     let all: Vec<(&str, RGBColor, &Motion)> = std::iter::once(("captured", CAPTURED, captured))
         .chain(
             ["IK", "ID", "HIMC"]
@@ -121,7 +184,7 @@ fn fig5(model: &BodyModel, mode: PlayingMode, captured: &Motion, motions: &[Moti
     let height = |joint: Option<Joint>| {
         move |m: &Motion, k: usize| match joint {
             Some(j) => model.skeleton.forward(&m.poses[k]).position[j.index()].z,
-            None => m.tips[1][k].z,
+            None => m.tips[h][k].z,
         }
     };
     let panel = |label: &str, f: &dyn Fn(&Motion, usize) -> f64| Panel {
@@ -131,7 +194,7 @@ fn fig5(model: &BodyModel, mode: PlayingMode, captured: &Motion, motions: &[Moti
             .map(|(name, colour, m)| Series {
                 label: (*name).into(),
                 colour: *colour,
-                points: (0..m.poses.len().min(m.tips[1].len()))
+                points: (0..m.poses.len().min(m.tips[h].len()))
                     .map(|k| (k as f64 / m.rate_hz, f(m, k)))
                     .collect(),
             })
@@ -145,12 +208,12 @@ fn fig5(model: &BodyModel, mode: PlayingMode, captured: &Motion, motions: &[Moti
         ),
         x_label: "time (s)".into(),
         panels: vec![
-            panel("wrist flexion (deg)", &flexion(Joint::WristR)),
-            panel("elbow flexion (deg)", &flexion(Joint::ElbowR)),
-            panel("shoulder flexion (deg)", &flexion(Joint::ShoulderR)),
+            panel("wrist flexion (deg)", &flexion(wrist)),
+            panel("elbow flexion (deg)", &flexion(elbow)),
+            panel("shoulder flexion (deg)", &flexion(shoulder)),
             panel("tip height (m)", &height(None)),
-            panel("wrist height (m)", &height(Some(Joint::WristR))),
-            panel("elbow height (m)", &height(Some(Joint::ElbowR))),
+            panel("wrist height (m)", &height(Some(wrist))),
+            panel("elbow height (m)", &height(Some(elbow))),
         ],
         guides: Vec::new(),
         size: (1200, 1600),

@@ -2,12 +2,19 @@
 //! database (per playing mode and grip, per dynamic, and joint limits).
 
 use crate::body::skeleton::Joint;
+use crate::kit::{Kit, Side};
+use crate::mocap::align::{self, Transform};
 use crate::mocap::db::MotionDb;
+use crate::mocap::db::side_index;
 use crate::mocap::import::Format;
-use crate::mocap::ingest::{IngestOptions, UpAxis, ingest};
+use crate::mocap::import::profile::CaptureProfile;
+use crate::mocap::ingest::{
+    Alignment, IngestOptions, IngestReport, UpAxis, hand_from_label, ingest,
+};
+use crate::mocap::take::Take;
 use crate::mocap::{stats, synth};
 use crate::score::{Dynamic, Grip};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Build the synthetic database into `dir`.
 pub fn synth(dir: &Path, seed: u64) -> anyhow::Result<()> {
@@ -138,14 +145,36 @@ fn print_limits(db: &MotionDb, grip: Grip) {
     }
 }
 
+/// Which sticks `--tips` names.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum TipsArg {
+    /// Not given: taken from the capture profile or the track labels.
+    Unnamed,
+    /// One label; its hand from `--hand`, the profile or the label itself.
+    One(String),
+    /// Left and right labels (either may be absent: "StickL," or ",StickR").
+    Both(Option<String>, Option<String>),
+}
+
 /// What `mocap import` was asked to do.
 pub struct ImportArgs {
     pub files: Vec<std::path::PathBuf>,
     pub format: Option<Format>,
-    pub tips: [String; 2],
+    /// A capture profile (shipped name or RON file) for delimited text captures.
+    pub profile: Option<String>,
+    pub tips: TipsArg,
     pub up: Option<UpAxis>,
     pub unit: Option<String>,
     pub tip_offset_m: Option<glam::DVec3>,
+    /// "none", "auto" or "x,y,z,yaw".
+    pub align: String,
+    /// The kit to align to (default: the standard set).
+    pub kit: Option<std::path::PathBuf>,
+    /// The drum the takes were played on (name or number; default: from the file name,
+    /// else the drum in front of each hand).
+    pub drum: Option<String>,
+    /// Files come in pairs (left stick's file, right stick's file) of one take each.
+    pub pair: bool,
     pub mode: Option<crate::score::PlayingMode>,
     pub location: Option<crate::score::ImpactLocation>,
     pub hand: Option<crate::kit::Side>,
@@ -155,27 +184,53 @@ pub struct ImportArgs {
     pub output: std::path::PathBuf,
 }
 
+/// One take to ingest: read from one file, or two paired ones.
+struct Source {
+    path: PathBuf,
+    take: Take,
+    tips: [Option<String>; 2],
+    up: UpAxis,
+    tip_offset_m: Option<glam::DVec3>,
+}
+
 /// Import captures into the database at `args.output` (created if absent). Every file
-/// is read and cut before anything is written, so a bad file leaves the database as it was.
+/// is read, cut and aligned before anything is written, so a bad file leaves the database
+/// as it was.
 pub fn import(args: ImportArgs) -> anyhow::Result<()> {
     let mut db = if args.output.join("index.ron").exists() {
         MotionDb::load(&args.output)?
     } else {
         MotionDb::empty("Imported motion captures")
     };
-    for path in &args.files {
-        let bytes = std::fs::read(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-        let format = args.format.or_else(|| Format::guess(path, &bytes));
-        let take = crate::mocap::import::read_with_unit(path, format, args.unit.as_deref())?;
-        let up = args.up.unwrap_or(if format == Some(Format::Motive) {
-            UpAxis::Y
-        } else {
-            UpAxis::Z
-        });
+    let profile = args
+        .profile
+        .as_deref()
+        .map(CaptureProfile::resolve)
+        .transpose()?;
+    let align = alignment(&args)?;
+    let sources = if args.pair {
+        if !args.files.len().is_multiple_of(2) {
+            anyhow::bail!(
+                "--pair takes the files two by two (left stick's file, right stick's file); {} files given",
+                args.files.len()
+            );
+        }
+        args.files
+            .chunks(2)
+            .map(|pair| paired_source(&pair[0], &pair[1], &args, profile.as_ref()))
+            .collect::<anyhow::Result<Vec<_>>>()?
+    } else {
+        args.files
+            .iter()
+            .map(|path| single_source(path, &args, profile.as_ref(), None))
+            .collect::<anyhow::Result<Vec<_>>>()?
+    };
+    for source in &sources {
         let options = IngestOptions {
-            tips: args.tips.clone(),
-            up,
-            tip_offset_m: args.tip_offset_m,
+            tips: source.tips.clone(),
+            up: source.up,
+            tip_offset_m: source.tip_offset_m,
+            align: align.clone(),
             mode: args.mode,
             location: args.location,
             dynamic: args.dynamic,
@@ -184,24 +239,8 @@ pub fn import(args: ImportArgs) -> anyhow::Result<()> {
             performer: args.performer.clone(),
             segment: Default::default(),
         };
-        let report = ingest(&mut db, path, &take, &options)?;
-        let plane = |p: Option<f64>| p.map_or("-".into(), |z| format!("{z:.3} m"));
-        println!(
-            "{}: {} frames at {} Hz ({}); left {} impacts -> {} units (membrane {}), right {} impacts -> {} units (membrane {})",
-            path.display(),
-            take.frames,
-            take.rate_hz,
-            take.file_unit,
-            report.impacts[0],
-            report.units[0],
-            plane(report.plane_height_m[0]),
-            report.impacts[1],
-            report.units[1],
-            plane(report.plane_height_m[1]),
-        );
-        for note in take.notes.iter().chain(&report.notices) {
-            eprintln!("note: {}: {note}", path.display());
-        }
+        let report = ingest(&mut db, &source.path, &source.take, &options)?;
+        print_report(source, &report, &align);
     }
     std::fs::create_dir_all(&args.output)
         .map_err(|e| anyhow::anyhow!("{}: {e}", args.output.display()))?;
@@ -214,3 +253,367 @@ pub fn import(args: ImportArgs) -> anyhow::Result<()> {
     );
     Ok(())
 }
+
+/// The alignment `--align` asks for, with the kit and drum it needs.
+fn alignment(args: &ImportArgs) -> anyhow::Result<Alignment> {
+    match args.align.trim().to_ascii_lowercase().as_str() {
+        "none" | "" => Ok(Alignment::None),
+        "auto" => {
+            let kit = match &args.kit {
+                Some(path) => Kit::load(path)?,
+                None => Kit::standard(),
+            };
+            let drum = args
+                .drum
+                .as_deref()
+                .map(|name| find_drum(&kit, name))
+                .transpose()?;
+            let shipped = crate::mocap::db::default_dir();
+            let habits = match MotionDb::load(&shipped) {
+                Ok(db) => align::habits_of(&db, &kit),
+                Err(e) => {
+                    eprintln!(
+                        "note: {e}; the player is assumed to lift straight back toward themselves"
+                    );
+                    align::HabitBook::default()
+                }
+            };
+            Ok(Alignment::Auto { kit, drum, habits })
+        }
+        text => Transform::parse(text)
+            .map(Alignment::Manual)
+            .map_err(|e| anyhow::anyhow!("--align: {e}; or \"auto\", or \"none\"")),
+    }
+}
+
+/// A kit drum by name, by the number its name starts with, or by 1-based index.
+fn find_drum(kit: &Kit, name: &str) -> anyhow::Result<usize> {
+    let wanted = name.trim().to_lowercase();
+    kit.drums
+        .iter()
+        .position(|d| {
+            let lower = d.name.to_lowercase();
+            lower == wanted || lower.split(|c: char| !c.is_ascii_digit()).next() == Some(&wanted)
+        })
+        .or_else(|| {
+            wanted
+                .parse::<usize>()
+                .ok()
+                .filter(|&i| (1..=kit.drums.len()).contains(&i))
+                .map(|i| i - 1)
+        })
+        .ok_or_else(|| {
+            let names: Vec<&str> = kit.drums.iter().map(|d| d.name.as_str()).collect();
+            anyhow::anyhow!(
+                "--drum: no drum \"{name}\" in the kit ({})",
+                names.join(", ")
+            )
+        })
+}
+
+/// Read one capture with the profile or format given.
+fn read_take(
+    path: &Path,
+    args: &ImportArgs,
+    profile: Option<&CaptureProfile>,
+) -> anyhow::Result<Take> {
+    Ok(match profile {
+        Some(p) => crate::mocap::import::read_with_profile(path, p, args.unit.as_deref())?,
+        None => crate::mocap::import::read_with_unit(path, args.format, args.unit.as_deref())?,
+    })
+}
+
+/// The up axis: `--up`, else the profile's, else Y for Motive files and Z otherwise.
+fn up_axis(path: &Path, args: &ImportArgs, profile: Option<&CaptureProfile>) -> UpAxis {
+    args.up
+        .or_else(|| profile.and_then(|p| p.up.map(Into::into)))
+        .unwrap_or_else(|| {
+            let bytes = std::fs::read(path).unwrap_or_default();
+            let format = args.format.or_else(|| Format::guess(path, &bytes));
+            // Motive and OpenSim (TRC) are Y up by convention; Vicon, Qualisys, C3D Z up.
+            match format {
+                Some(Format::Motive | Format::Trc) => UpAxis::Y,
+                _ => UpAxis::Z,
+            }
+        })
+}
+
+/// One file as one take; `only` restricts it to one hand (a file of a pair).
+fn single_source(
+    path: &Path,
+    args: &ImportArgs,
+    profile: Option<&CaptureProfile>,
+    only: Option<Side>,
+) -> anyhow::Result<Source> {
+    let take = read_take(path, args, profile)?;
+    let tips = resolve_tips(path, &take, args, profile, only)?;
+    Ok(Source {
+        path: path.to_path_buf(),
+        up: up_axis(path, args, profile),
+        tip_offset_m: args
+            .tip_offset_m
+            .or_else(|| profile.and_then(CaptureProfile::tip_offset)),
+        take,
+        tips,
+    })
+}
+
+/// Two files, the left stick's and the right stick's, as one take: same rate, aligned at
+/// their first frames.
+fn paired_source(
+    left: &Path,
+    right: &Path,
+    args: &ImportArgs,
+    profile: Option<&CaptureProfile>,
+) -> anyhow::Result<Source> {
+    let mut l = single_source(left, args, profile, Some(Side::Left))?;
+    let r = single_source(right, args, profile, Some(Side::Right))?;
+    if (l.take.rate_hz - r.take.rate_hz).abs() > 1e-6 * l.take.rate_hz {
+        anyhow::bail!(
+            "{} ({} Hz) and {} ({} Hz) cannot be paired: their rates differ",
+            left.display(),
+            l.take.rate_hz,
+            right.display(),
+            r.take.rate_hz
+        );
+    }
+    let frames = l.take.frames.max(r.take.frames);
+    let mut tracks = Vec::new();
+    for (prefix, source) in [("left", &l), ("right", &r)] {
+        for t in &source.take.tracks {
+            let mut t = t.clone();
+            t.label = format!("{prefix}:{}", t.label);
+            t.positions.resize(frames, None);
+            if !t.rotations.is_empty() {
+                t.rotations.resize(frames, None);
+            }
+            tracks.push(t);
+        }
+    }
+    l.tips = [
+        l.tips[0].take().map(|t| format!("left:{t}")),
+        r.tips[1].clone().map(|t| format!("right:{t}")),
+    ];
+    l.take = Take {
+        source: left.to_path_buf(),
+        rate_hz: l.take.rate_hz,
+        frames,
+        file_unit: l.take.file_unit.clone(),
+        tracks,
+        notes: l.take.notes.iter().chain(&r.take.notes).cloned().collect(),
+    };
+    Ok(l)
+}
+
+/// Each hand's track label for one take.
+fn resolve_tips(
+    path: &Path,
+    take: &Take,
+    args: &ImportArgs,
+    profile: Option<&CaptureProfile>,
+    only: Option<Side>,
+) -> anyhow::Result<[Option<String>; 2]> {
+    let hand_of = |label: &str| {
+        profile
+            .and_then(|p| p.hand_of(label))
+            .or_else(|| hand_from_label(label))
+    };
+    let mut tips: [Option<String>; 2] = [None, None];
+    let mut place = |side: Side, label: String| tips[side_index(side)] = Some(label);
+    let fixed = only.or(args.hand);
+    match &args.tips {
+        TipsArg::Both(l, r) if only.is_none() => {
+            tips = [l.clone(), r.clone()];
+        }
+        TipsArg::Both(l, r) => {
+            let side = only.unwrap_or(Side::Left);
+            let label = [l, r][side_index(side)]
+                .clone()
+                .ok_or_else(|| anyhow::anyhow!("--tips names no {side:?} stick"))?;
+            place(side, label);
+        }
+        TipsArg::One(label) => {
+            let side = fixed.or_else(|| hand_of(label)).ok_or_else(|| {
+                anyhow::anyhow!(
+                    "{}: which hand plays \"{label}\"? add --hand left or --hand right",
+                    path.display()
+                )
+            })?;
+            place(side, label.clone());
+        }
+        TipsArg::Unnamed => {
+            let labels = take.labels();
+            let sides: Vec<(Side, &str)> = labels
+                .iter()
+                .filter_map(|l| Some((hand_of(l)?, *l)))
+                .collect();
+            for side in [Side::Left, Side::Right] {
+                let mine: Vec<&str> = sides.iter().filter(|s| s.0 == side).map(|s| s.1).collect();
+                let sticks: Vec<&str> = mine.iter().copied().filter(|l| names_a_stick(l)).collect();
+                if let [one] = mine[..] {
+                    place(side, one.to_string());
+                } else if let [one] = sticks[..] {
+                    place(side, one.to_string());
+                }
+            }
+            if let (Some(side), [one]) = (fixed, &labels[..]) {
+                tips = [None, None];
+                tips[side_index(side)] = Some(one.to_string());
+            }
+        }
+    }
+    if let Some(side) = fixed {
+        tips[side_index(side.other())] = None;
+    }
+    if tips.iter().all(Option::is_none) {
+        anyhow::bail!(
+            "{}: cannot tell which track is which stick; name them with --tips LEFT,RIGHT (or one label with --hand); the file has: {}",
+            path.display(),
+            take.labels().join(", ")
+        );
+    }
+    Ok(tips)
+}
+
+/// Whether a track label names a stick or its tip (not an arm marker).
+fn names_a_stick(label: &str) -> bool {
+    let lower = label.to_ascii_lowercase();
+    ["tip", "stick", "stk", "mallet", "bead"]
+        .iter()
+        .any(|w| lower.contains(w))
+}
+
+/// Print what one take gave.
+fn print_report(source: &Source, report: &IngestReport, align: &Alignment) {
+    let path = source.path.display();
+    let drum_name = |d: usize| match align {
+        Alignment::Auto { kit, .. } => kit.drums.get(d).map_or("?", |d| d.name.as_str()),
+        _ => "?",
+    };
+    println!(
+        "{path}: {} frames at {} Hz ({})",
+        source.take.frames, source.take.rate_hz, source.take.file_unit
+    );
+    let t = report.transform;
+    if t != Transform::IDENTITY {
+        println!(
+            "  aligned: turned {:.1}° about the vertical, moved ({:.3}, {:.3}, {:.3}) m",
+            t.yaw_rad.to_degrees(),
+            t.translation_m.x,
+            t.translation_m.y,
+            t.translation_m.z
+        );
+    }
+    for h in &report.hands {
+        let median = |x: Option<f64>, unit: &str, scale: f64| {
+            x.map_or("-".into(), |x| format!("{:.2} {unit}", x * scale))
+        };
+        println!(
+            "  {:?} stick \"{}\": {} impacts -> {} units; rejected: {}; {} missing frames ({} filled)",
+            h.hand,
+            h.label,
+            h.impacts.len(),
+            h.units,
+            h.rejected.summary(),
+            h.missing_frames,
+            h.filled_frames
+        );
+        println!(
+            "    strokes: every {}, lift {}, impact speed {}",
+            median(h.interval_s, "s", 1.0),
+            median(h.lift_m, "cm", 100.0),
+            median(h.impact_speed_mps, "m/s", 1.0)
+        );
+        if h.tip_estimate.is_some_and(|e| e.rests_on_priors()) {
+            println!(
+                "    the capture hardly tells where the tip is (the stick meets the head at nearly one angle): the estimate below leans on the priors (head 0.76 m above the floor, tip 0.30 m from the body origin); give --tip-offset if you know it"
+            );
+        }
+        if let Some(e) = &h.tip_estimate {
+            println!(
+                "    tip estimated at ({:.3}, {:.3}, {:.3}) m in the body frame (± {:.3}, {:.3}, {:.3}), height scatter {:.1} mm over {} impacts",
+                e.offset_m.x,
+                e.offset_m.y,
+                e.offset_m.z,
+                e.standard_error_m.x,
+                e.standard_error_m.y,
+                e.standard_error_m.z,
+                e.residual_m * 1e3,
+                e.impacts
+            );
+        }
+        if let Some(f) = &h.fit {
+            println!(
+                "    on drum {} ({}): impacts {:.1} mm from the head plane (mean; max {:.1} mm), centre {:.1} cm from the target{}",
+                f.drum + 1,
+                drum_name(f.drum),
+                f.plane_mean_m * 1e3,
+                f.plane_max_m * 1e3,
+                f.target_distance_m * 1e2,
+                if f.off_head > 0 {
+                    format!(", {} impacts off the head", f.off_head)
+                } else {
+                    String::new()
+                }
+            );
+        }
+    }
+    for note in source.take.notes.iter().chain(&report.notices) {
+        eprintln!("note: {path}: {note}");
+    }
+}
+
+/// Print how a delimited text capture is laid out, read with `profile` (default: a
+/// profile that detects everything and finds "<name> X/Y/Z" tracks).
+pub fn columns(file: &Path, profile: Option<&str>) -> anyhow::Result<()> {
+    let profile = match profile {
+        Some(p) => CaptureProfile::resolve(p)?,
+        None => CaptureProfile::named("auto-detected"),
+    };
+    let bytes = std::fs::read(file).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+    let layout = crate::mocap::import::table::inspect(file, &bytes, &profile)?;
+    println!(
+        "{}: read with the profile \"{}\"",
+        file.display(),
+        profile.name
+    );
+    print!("{layout}");
+    Ok(())
+}
+
+/// Write the lab-style test corpus into `dir`: one capture per layout from takes of the
+/// shipped database (several modes and both hands), and one from the real TrajOptDrums
+/// stroke, with `truth.ron`.
+pub fn corpus(dir: &Path, seed: u64) -> anyhow::Result<()> {
+    use crate::mocap::labcorpus::{self, LabStyle, Layout};
+    let db = MotionDb::load(&crate::mocap::db::default_dir())?;
+    let takes = db.index.takes.len().max(1);
+    let mut captures = Vec::new();
+    for (k, layout) in Layout::ALL.into_iter().enumerate() {
+        let style = LabStyle {
+            seed: seed + k as u64,
+            ..LabStyle::typical(layout)
+        };
+        captures.push(labcorpus::generate(&db, (k * 7 + 3) % takes, &style)?);
+    }
+    let style = LabStyle {
+        seed,
+        ..LabStyle::typical(Layout::Trc)
+    };
+    captures.push(
+        labcorpus::from_trajoptdrums(TRAJOPT_X, TRAJOPT_Y, &style, 12)
+            .map_err(|e| anyhow::anyhow!("the TrajOptDrums stroke: {e}"))?,
+    );
+    labcorpus::write_all(dir, &captures)?;
+    for c in &captures {
+        for (name, _) in &c.files {
+            println!("{}", dir.join(name).display());
+        }
+    }
+    println!("{}", dir.join("truth.ron").display());
+    Ok(())
+}
+
+/// The real drum stroke of Pearl's TrajOptDrums (MIT; `tests/fixtures/trajoptdrums/`).
+const TRAJOPT_X: &str = include_str!("../../tests/fixtures/trajoptdrums/JointCenters_XPose_cm.csv");
+const TRAJOPT_Y: &str = include_str!("../../tests/fixtures/trajoptdrums/JointCenters_YPose_cm.csv");

@@ -14,7 +14,7 @@ mod sticking;
 
 use args::{
     ControlArg, DynamicArg, GripArg, LocationArg, ModeArg, SideArg, SoundArg, UpArg, parse_format,
-    parse_pair, parse_vec3,
+    parse_tips, parse_vec3,
 };
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -235,6 +235,9 @@ impl From<StickingMethod> for crate::motion::sticking::Method {
     }
 }
 
+// The import variant carries many options; the enum is parsed once per run, so its size
+// does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Subcommand)]
 pub enum MocapCommand {
     /// Build the synthetic motion database (bit-for-bit reproducible from the seed).
@@ -246,34 +249,59 @@ pub enum MocapCommand {
         #[arg(long, default_value_t = 2008)]
         seed: u64,
     },
-    /// Read captures (C3D, OptiTrack Motive CSV, Vicon CSV, plain CSV), cut them into
-    /// strokes and add them to a database.
+    /// Read captures (C3D, Motive CSV, Vicon CSV, TRC, plain CSV, or any delimited text
+    /// capture through a capture profile), cut them into strokes, align them to the
+    /// performer and add them to a database.
     Import {
         /// Capture files.
         #[arg(required = true)]
         files: Vec<PathBuf>,
         /// File format (default: recognised from the content).
-        #[arg(long, value_parser = parse_format)]
+        #[arg(long, value_parser = parse_format, conflicts_with = "profile")]
         format: Option<crate::mocap::import::Format>,
-        /// Labels of the left and right stick-tip markers or rigid bodies, e.g. "StickL,StickR".
-        #[arg(long, value_parser = parse_pair)]
-        tips: (String, String),
-        /// Which axis of the capture points up (default: y for Motive, z otherwise).
+        /// Capture profile for a delimited text capture: a shipped name (motive, vicon,
+        /// qualisys-3d, qualisys-6d, trc, plain) or a RON file (see `mocap columns`).
+        #[arg(long)]
+        profile: Option<String>,
+        /// The sticks' tracks: "LEFT,RIGHT", "LEFT," / ",RIGHT", or one label (its hand
+        /// from --hand, the profile, or the label: StickL, RSTK, …) [default: from the
+        /// profile or the labels].
+        #[arg(long, value_parser = parse_tips)]
+        tips: Option<mocap::TipsArg>,
+        /// Which axis of the capture points up (default: the profile's, y for Motive, z
+        /// otherwise).
         #[arg(long, value_enum)]
         up: Option<UpArg>,
         /// Length unit of the file, overriding what it says: mm, cm or m.
         #[arg(long)]
         unit: Option<String>,
-        /// For rigid bodies: the tip in the body's frame, metres, "x,y,z".
+        /// For rigid bodies: the tip in the body's frame, metres, "x,y,z" (default: the
+        /// profile's, else estimated from the impacts and reported).
         #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
         tip_offset: Option<glam::DVec3>,
+        /// Place the takes in the performer frame: "auto" fits each take's impacts to
+        /// its drum's head, "x,y,z,yaw" (metres, degrees) turns about the vertical then
+        /// moves, "none" keeps the capture's coordinates.
+        #[arg(long, default_value = "none", allow_hyphen_values = true)]
+        align: String,
+        /// The kit for --align auto [default: the standard set].
+        #[arg(long)]
+        kit: Option<PathBuf>,
+        /// The drum the takes were played on, by name ("26-inch", "26") or number
+        /// [default: a drum named in the file name, else the drum in front of each hand].
+        #[arg(long)]
+        drum: Option<String>,
+        /// Take the files two by two: the left stick's file, then the right stick's file
+        /// of the same take (same rate, first frames together).
+        #[arg(long)]
+        pair: bool,
         /// Playing mode of every stroke (default: from the file name).
         #[arg(long, value_enum)]
         mode: Option<ModeArg>,
         /// Impact location (default: from the file name, else the playing spot).
         #[arg(long, value_enum)]
         location: Option<LocationArg>,
-        /// Keep only this hand's strokes.
+        /// The hand of a one-stick file, or keep only this hand's strokes.
         #[arg(long, value_enum)]
         hand: Option<SideArg>,
         /// Dynamic (default: from the file name, else mf).
@@ -288,6 +316,27 @@ pub enum MocapCommand {
         /// The database folder (created, or added to).
         #[arg(short, long)]
         output: PathBuf,
+    },
+    /// Show how a delimited text capture is laid out: delimiter, header, metadata,
+    /// columns with their first values, and the tracks a profile finds; for writing a
+    /// capture profile.
+    Columns {
+        /// The capture file.
+        file: PathBuf,
+        /// Read it with this profile (shipped name or RON file) [default: plain
+        /// auto-detection].
+        #[arg(long)]
+        profile: Option<String>,
+    },
+    /// Write a test corpus of captures the way real labs write them (lab offset and
+    /// turn, millimetres, rigid bodies off the tip, one stick per file, gaps, noise,
+    /// several layouts) from the shipped database, with the ground truth in truth.ron.
+    Corpus {
+        /// The folder to write.
+        output: PathBuf,
+        /// Seed of the noise and gaps.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
     },
     /// Per playing mode: tip height and depth range, impact speed, stroke duration; per
     /// joint: the limit ellipsoid.
@@ -423,10 +472,15 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Some(Command::Mocap(MocapCommand::Import {
             files,
             format,
+            profile,
             tips,
             up,
             unit,
             tip_offset,
+            align,
+            kit,
+            drum,
+            pair,
             mode,
             location,
             hand,
@@ -437,10 +491,15 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         })) => mocap::import(mocap::ImportArgs {
             files,
             format,
-            tips: [tips.0, tips.1],
+            profile,
+            tips: tips.unwrap_or(mocap::TipsArg::Unnamed),
             up: up.map(Into::into),
             unit,
             tip_offset_m: tip_offset,
+            align,
+            kit,
+            drum,
+            pair,
             mode: mode.map(Into::into),
             location: location.map(Into::into),
             hand: hand.map(Into::into),
@@ -450,6 +509,12 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             output,
         })
         .map(|()| ExitCode::SUCCESS),
+        Some(Command::Mocap(MocapCommand::Columns { file, profile })) => {
+            mocap::columns(&file, profile.as_deref()).map(|()| ExitCode::SUCCESS)
+        }
+        Some(Command::Mocap(MocapCommand::Corpus { output, seed })) => {
+            mocap::corpus(&output, seed).map(|()| ExitCode::SUCCESS)
+        }
         Some(Command::Mocap(MocapCommand::Stats { dir })) => {
             mocap::stats(&dir).map(|()| ExitCode::SUCCESS)
         }

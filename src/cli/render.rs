@@ -1,15 +1,16 @@
 //! `timpanist render`: a whole score to a WAV (and optionally the simulated motion as CSV
 //! and one JSON object per contact, and a PNG of tip heights and contact forces), through the same pipeline as the editor, with a
 //! progress bar on stderr and, with `--stats`, where the time went. Everything is computed
-//! before anything is written; each file is written atomically.
+//! before anything is written; each file is written atomically. A database lacking a
+//! playing mode is completed from the shipped synthetic one, and the beats played with a
+//! unit of other labels than asked are told as notes (`super::compose`).
 
 use super::compose::HAND_COLOURS;
 use crate::base::ron_file;
 use crate::body::sim::Pipeline;
 use crate::io::plot::{Figure, Panel, Series};
 use crate::io::{motion_c3d, motion_csv};
-use crate::mocap::db::MotionDb;
-use crate::motion::plan::PlanParams;
+use crate::motion::plan::{self, PlanParams};
 use crate::render::{Progress, RenderParams, Rendering, render, strikes};
 use crate::score::LoadedScore;
 use crate::sound::SoundModel;
@@ -57,7 +58,7 @@ pub fn run(
     for notice in &loaded.notices {
         eprintln!("note: {notice}");
     }
-    let db = MotionDb::load(db_dir)?;
+    let db = super::compose::load_db(db_dir)?;
     let settings = RenderParams::for_score(&loaded.score.settings);
     let params = RenderParams {
         control: control.unwrap_or(settings.control),
@@ -77,6 +78,11 @@ pub fn run(
     bar.finish();
     let rendering = rendering.map_err(|e| anyhow::anyhow!("{}: {e}", score.display()))?;
     let wall = started.elapsed();
+    super::compose::print_substitutions(&plan::substitutions(
+        &rendering.composition.strokes,
+        &loaded.score,
+        &db,
+    ));
     let events = outputs
         .events
         .map(|_| serde_json::to_string_pretty(&rendering.events))

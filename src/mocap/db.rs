@@ -234,6 +234,62 @@ impl MotionDb {
         ron_file::save(&dir.join("index.ron"), &self.index)
     }
 
+    /// The (grip, playing mode) pairs `other` has units of and this database has none of,
+    /// in `other`'s order of first appearance.
+    pub fn modes_lacking(&self, other: &MotionDb) -> Vec<(Grip, PlayingMode)> {
+        let has = |db: &MotionDb, key: (Grip, PlayingMode)| {
+            db.index.units.iter().any(|u| (u.grip, u.mode) == key)
+        };
+        let mut lacking: Vec<(Grip, PlayingMode)> = Vec::new();
+        for key in other.index.units.iter().map(|u| (u.grip, u.mode)) {
+            if !lacking.contains(&key) && !has(self, key) {
+                lacking.push(key);
+            }
+        }
+        lacking
+    }
+
+    /// This database completed by `shipped` (the synthetic one): for every playing mode of
+    /// a grip this database has no unit of ([`MotionDb::modes_lacking`]), `shipped`'s
+    /// units of it and the takes they are cut from are added (after this database's own,
+    /// their files under `fallback/`), so a score asking for that mode gets a stroke of
+    /// its own mode rather than the nearest of another. Labels this database has are left
+    /// alone, even where `shipped` has more of them (hands, locations, dynamics).
+    pub fn with_fallback(&self, shipped: &MotionDb) -> MotionDb {
+        let lacking = self.modes_lacking(shipped);
+        let mut db = self.clone();
+        if lacking.is_empty() {
+            return db;
+        }
+        let mut taken: Vec<Option<usize>> = vec![None; shipped.takes.len()];
+        for unit in &shipped.index.units {
+            if !lacking.contains(&(unit.grip, unit.mode)) {
+                continue;
+            }
+            let take = *taken[unit.take].get_or_insert_with(|| {
+                let entry = &shipped.index.takes[unit.take];
+                db.index.takes.push(TakeEntry {
+                    file: format!("fallback/{}", entry.file),
+                    ..entry.clone()
+                });
+                db.takes.push(shipped.takes[unit.take].clone());
+                db.takes.len() - 1
+            });
+            db.index.units.push(UnitEntry {
+                take,
+                ..unit.clone()
+            });
+        }
+        if db.takes.iter().any(|t| t.joints.is_some()) {
+            db.index.joints = joint_names();
+        }
+        db.index.description = format!(
+            "{} Completed with the modes it lacks from: {}",
+            self.index.description, shipped.index.description
+        );
+        db
+    }
+
     /// The tip samples of unit `u` for its own hand, from start to end.
     pub fn unit_tip(&self, u: &UnitEntry) -> &[Option<DVec3>] {
         &self.takes[u.take].tip(u.hand)[u.start..=u.end]

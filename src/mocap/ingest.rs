@@ -1,15 +1,21 @@
-//! Turning a raw capture into database units: pick the two stick-tip tracks by label (a
-//! marker, or a rigid body plus a tip offset in its own frame), bring them into the
-//! performer frame (Z up; a Y-up capture is turned so that its −Z axis points forward),
-//! segment each tip into strokes, and label every unit from options or from words in the
-//! file path.
+//! Turning a raw capture into database units: pick each stick's track by label (a marker
+//! on the tip, or a rigid body plus a tip offset in its own frame, estimated from the
+//! capture when not given), turn it Z up (a Y-up capture is turned so that its −Z axis
+//! points forward), segment each tip into strokes, align the take to the performer frame
+//! (by hand, or fitted to the head of the drum it was played on: `mocap::align`), and
+//! label every unit from options or from words in the file path.
+//!
+//! A take may hold one stick or both; a hand without a track gets no units and an unseen
+//! tip in the database.
 
+use super::align::{self, HabitBook, HandFit, HandStrokes, Target, Transform};
 use super::db::{MotionDb, TakeData, TakeEntry, UnitEntry};
-use super::segment::{SegmentParams, segment};
+use super::segment::{RejectionCounts, SegmentParams, find_impacts, segment};
 use super::take::{ImportError, Take, Track};
-use crate::kit::Side;
+use super::tip_estimate::{self, TipEstimate, TipEstimateError};
+use crate::kit::{Kit, Side};
 use crate::score::{Dynamic, Grip, ImpactLocation, PlayingMode};
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 use std::path::Path;
 
 /// Which axis of the capture points up.
@@ -24,11 +30,14 @@ pub enum UpAxis {
 /// How to read one capture into the database.
 #[derive(Clone, Debug)]
 pub struct IngestOptions {
-    /// Labels of the left and right stick-tip tracks.
-    pub tips: [String; 2],
+    /// Labels of the left and right sticks' tracks; `None`: that stick is not in the take.
+    pub tips: [Option<String>; 2],
     pub up: UpAxis,
-    /// For rigid-body tracks: the tip in the body's own frame, m.
+    /// For rigid-body tracks: the tip in the body's own frame, m; `None` estimates it
+    /// (`mocap::tip_estimate`).
     pub tip_offset_m: Option<DVec3>,
+    /// How the take is placed in the performer frame.
+    pub align: Alignment,
     /// Labels; `None` reads them from the file path (see [`labels_from_path`]).
     pub mode: Option<PlayingMode>,
     pub location: Option<ImpactLocation>,
@@ -38,6 +47,22 @@ pub struct IngestOptions {
     pub hand: Option<Side>,
     pub performer: String,
     pub segment: SegmentParams,
+}
+
+/// How a take is placed in the performer frame.
+#[derive(Clone, Debug)]
+pub enum Alignment {
+    /// Kept as captured (the capture is already in the performer frame).
+    None,
+    /// A given lab → performer transform.
+    Manual(Transform),
+    /// Fitted to the head of the drum each stick played: `drum` names it (else the drum in
+    /// front of that hand), the impact location label names the point.
+    Auto {
+        kit: Kit,
+        drum: Option<usize>,
+        habits: HabitBook,
+    },
 }
 
 /// Labels found in words of a path.
@@ -85,17 +110,62 @@ pub fn labels_from_path(path: &Path) -> PathLabels {
     l
 }
 
+/// What one stick of a capture gave.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HandReport {
+    pub hand: Side,
+    /// The track it came from.
+    pub label: String,
+    /// Frames of the impacts found (including the first and last, which give no unit).
+    pub impacts: Vec<usize>,
+    /// Units added.
+    pub units: usize,
+    /// Candidates turned down, by reason.
+    pub rejected: RejectionCounts,
+    /// Samples missing in the capture, and of those filled by interpolation.
+    pub missing_frames: usize,
+    pub filled_frames: usize,
+    /// The tip offset estimated for a rigid body given none.
+    pub tip_estimate: Option<TipEstimate>,
+    /// Where the impacts landed after alignment.
+    pub fit: Option<HandFit>,
+    /// Medians over the strokes: time between impacts, s; lift (top of the stroke above
+    /// its impact), m; approach speed into the head, m/s.
+    pub interval_s: Option<f64>,
+    pub lift_m: Option<f64>,
+    pub impact_speed_mps: Option<f64>,
+}
+
 /// What one capture added.
 #[derive(Clone, Debug, PartialEq)]
 pub struct IngestReport {
-    /// Units added per hand [left, right].
-    pub units: [usize; 2],
-    /// Impacts found per hand (including the dropped first and last).
-    pub impacts: [usize; 2],
-    /// Estimated membrane height per hand, m.
-    pub plane_height_m: [Option<f64>; 2],
+    /// One entry per stick found in the take.
+    pub hands: Vec<HandReport>,
+    /// The lab → performer transform applied.
+    pub transform: Transform,
     /// Labels that were guessed, for the user to check.
     pub notices: Vec<String>,
+}
+
+impl IngestReport {
+    /// Units added per hand [left, right].
+    pub fn units(&self) -> [usize; 2] {
+        let mut n = [0, 0];
+        for h in &self.hands {
+            n[crate::mocap::db::side_index(h.hand)] += h.units;
+        }
+        n
+    }
+}
+
+/// One stick's track, Z up, before alignment.
+struct Stick {
+    hand: Side,
+    label: String,
+    tip: Vec<Option<DVec3>>,
+    /// A rigid body's origin (somewhere on the stick behind the tip); empty for a marker.
+    origin: Vec<Option<DVec3>>,
+    estimate: Option<TipEstimate>,
 }
 
 /// Add `take` (read from `path`) to `db` as a new take file `takes/NAME.tmot`.
@@ -131,27 +201,99 @@ pub fn ingest(
         "grip",
         &mut notices,
     );
-    let tips: [Vec<Option<DVec3>>; 2] = [0, 1]
-        .map(|k| tip_track(path, take, &options.tips[k], options))
+    let wanted: Vec<(Side, &String)> = [Side::Left, Side::Right]
         .into_iter()
-        .collect::<Result<Vec<_>, _>>()?
-        .try_into()
-        .expect("two tips");
-    let take_index = db.index.takes.len();
-    let mut report = IngestReport {
-        units: [0, 0],
-        impacts: [0, 0],
-        plane_height_m: [None, None],
-        notices,
-    };
-    for (k, side) in [Side::Left, Side::Right].into_iter().enumerate() {
-        if options.hand.is_some_and(|h| h != side) {
-            continue;
+        .filter(|&side| options.hand.is_none_or(|h| h == side))
+        .filter_map(|side| {
+            Some((
+                side,
+                options.tips[crate::mocap::db::side_index(side)].as_ref()?,
+            ))
+        })
+        .collect();
+    // Every label is checked before any work, so a misspelt one is what the user hears of.
+    for (_, label) in &wanted {
+        find_track(path, take, label)?;
+    }
+    let mut sticks = Vec::new();
+    for (side, label) in wanted {
+        let target_height = target_for(options, path, side, location).map(|(_, p)| p.z);
+        sticks.push(stick(
+            path,
+            take,
+            side,
+            label,
+            options,
+            target_height,
+            &mut notices,
+        )?);
+    }
+    if sticks.is_empty() {
+        return Err(ImportError::format(
+            path,
+            "labels",
+            "no stick to import: name a track with --tips (for the hand --hand gives)",
+        ));
+    }
+    let rate = take.rate_hz;
+    let segmentations: Vec<_> = sticks
+        .iter()
+        .map(|s| segment(&s.tip, rate, &options.segment))
+        .collect();
+    let transform = match &options.align {
+        Alignment::None => Transform::IDENTITY,
+        Alignment::Manual(t) => *t,
+        Alignment::Auto { kit, habits, .. } => {
+            let strokes: Vec<HandStrokes> = sticks
+                .iter()
+                .zip(&segmentations)
+                .map(|(s, seg)| s.strokes(rate, &seg.impacts))
+                .collect();
+            let targets = target_list(options, path, &sticks, location)?;
+            align::fit(
+                &strokes,
+                &targets,
+                kit,
+                &habits.for_stroke(grip, mode, location),
+            )
+            .map_err(|e| ImportError::format(path, "alignment", e.to_string()))?
         }
-        let seg = segment(&tips[k], take.rate_hz, &options.segment);
-        report.impacts[k] = seg.impacts.len();
-        report.plane_height_m[k] = seg.plane_height_m;
-        report.units[k] = seg.units.len();
+    };
+    let fits = match &options.align {
+        Alignment::Auto { kit, .. } => {
+            let strokes: Vec<HandStrokes> = sticks
+                .iter()
+                .zip(&segmentations)
+                .map(|(s, seg)| s.strokes(rate, &seg.impacts))
+                .collect();
+            align::report(
+                &strokes,
+                &target_list(options, path, &sticks, location)?,
+                kit,
+                &transform,
+            )
+        }
+        _ => Vec::new(),
+    };
+    let take_index = db.index.takes.len();
+    let mut tips: [Vec<Option<DVec3>>; 2] = [vec![None; take.frames], vec![None; take.frames]];
+    let mut hands = Vec::new();
+    for (s, seg) in sticks.into_iter().zip(segmentations) {
+        let stats = stroke_stats(&s.tip, rate, &options.segment);
+        hands.push(HandReport {
+            hand: s.hand,
+            label: s.label.clone(),
+            impacts: seg.impacts.clone(),
+            units: seg.units.len(),
+            rejected: seg.rejected,
+            missing_frames: seg.missing_frames,
+            filled_frames: seg.filled_frames,
+            tip_estimate: s.estimate,
+            fit: fits.iter().find(|f| f.hand == s.hand).copied(),
+            interval_s: stats.0,
+            lift_m: stats.1,
+            impact_speed_mps: stats.2,
+        });
         db.index
             .units
             .extend(seg.units.iter().map(|span| UnitEntry {
@@ -159,12 +301,17 @@ pub fn ingest(
                 start: span.start,
                 impact: span.impact,
                 end: span.end,
-                hand: side,
+                hand: s.hand,
                 mode,
                 location,
                 dynamic,
                 grip,
             }));
+        tips[crate::mocap::db::side_index(s.hand)] = s
+            .tip
+            .iter()
+            .map(|p| p.map(|p| transform.point(p)))
+            .collect();
     }
     let stem = path
         .file_stem()
@@ -187,7 +334,214 @@ pub fn ingest(
         tips,
         joints: None,
     });
-    Ok(report)
+    Ok(IngestReport {
+        hands,
+        transform,
+        notices,
+    })
+}
+
+impl Stick {
+    /// The strokes at `impacts` as alignment sees them, with the stick's direction from
+    /// the origin to the tip for a rigid body.
+    fn strokes(&self, rate_hz: f64, impacts: &[usize]) -> HandStrokes {
+        let mut strokes = align::strokes_of(&self.tip, rate_hz, impacts, self.hand);
+        if !self.origin.is_empty() {
+            strokes.sticks = impacts
+                .iter()
+                .skip(1)
+                .filter_map(|&i| {
+                    Some((self.tip.get(i).copied()?? - self.origin.get(i).copied()??).truncate())
+                })
+                .collect();
+        }
+        strokes
+    }
+}
+
+/// The drum and point a hand's strokes belong to, when aligning automatically.
+fn target_for(
+    options: &IngestOptions,
+    path: &Path,
+    hand: Side,
+    location: ImpactLocation,
+) -> Option<(usize, DVec3)> {
+    let Alignment::Auto { kit, drum, .. } = &options.align else {
+        return None;
+    };
+    let drum = drum
+        .or_else(|| drum_from_path(kit, path))
+        .unwrap_or_else(|| front_drum(kit, hand));
+    let (radius, angle) = location.polar();
+    Some((drum, kit.drums[drum].point_on_head(radius, angle)))
+}
+
+/// The alignment targets of the sticks, in order.
+fn target_list(
+    options: &IngestOptions,
+    path: &Path,
+    sticks: &[Stick],
+    location: ImpactLocation,
+) -> Result<Vec<Target>, ImportError> {
+    sticks
+        .iter()
+        .map(|s| {
+            target_for(options, path, s.hand, location)
+                .map(|(drum, point)| Target { drum, point })
+                .ok_or_else(|| ImportError::format(path, "alignment", "no kit to align to"))
+        })
+        .collect()
+}
+
+/// The drum named by a word of the path: its whole name without punctuation ("26inch")
+/// or the number it starts with ("26" for the drum "26-inch").
+pub fn drum_from_path(kit: &Kit, path: &Path) -> Option<usize> {
+    let text = path.to_string_lossy().to_lowercase();
+    let words: Vec<&str> = text
+        .split(|c: char| !c.is_ascii_alphanumeric())
+        .filter(|w| !w.is_empty())
+        .collect();
+    kit.drums.iter().position(|d| {
+        let lower = d.name.to_lowercase();
+        let name: String = lower.chars().filter(char::is_ascii_alphanumeric).collect();
+        let number: String = lower.chars().take_while(char::is_ascii_digit).collect();
+        [name, number]
+            .iter()
+            .any(|n| !n.is_empty() && words.contains(&n.as_str()))
+    })
+}
+
+/// The drum in front of a hand: of the drums that hand prefers, the one farthest forward.
+pub fn front_drum(kit: &Kit, hand: Side) -> usize {
+    (0..kit.drums.len())
+        .filter(|&d| kit.drums[d].preferred_hand == hand)
+        .max_by(|&a, &b| {
+            kit.drums[a]
+                .placement
+                .y_m
+                .total_cmp(&kit.drums[b].placement.y_m)
+        })
+        .unwrap_or(0)
+}
+
+/// One stick's tip, Z up, in the capture's place: the marker itself, or the rigid body's
+/// origin carried to its tip (given or estimated).
+fn stick(
+    path: &Path,
+    take: &Take,
+    hand: Side,
+    label: &str,
+    options: &IngestOptions,
+    head_height_m: Option<f64>,
+    notices: &mut Vec<String>,
+) -> Result<Stick, ImportError> {
+    let track = find_track(path, take, label)?;
+    let positions: Vec<Option<DVec3>> = track
+        .positions
+        .iter()
+        .map(|p| p.map(|p| to_performer(p, options.up)))
+        .collect();
+    let rotations: Vec<Option<DQuat>> = track
+        .rotations
+        .iter()
+        .map(|q| q.map(|q| rotation_to_performer(q, options.up)))
+        .collect();
+    let has_rotations = rotations.iter().any(Option::is_some);
+    let (offset, estimate) = match (options.tip_offset_m, has_rotations) {
+        (Some(d), true) => (Some(d), None),
+        (None, true) => match tip_estimate::estimate(
+            &positions,
+            &rotations,
+            take.rate_hz,
+            head_height_m.unwrap_or(0.76),
+        ) {
+            Ok(e) => (Some(e.offset_m), Some(e)),
+            // A stick that hardly plays (the idle hand of a take) has no tip to find:
+            // its origin stands in.
+            Err(TipEstimateError::TooFewImpacts(n)) => {
+                notices.push(format!(
+                    "track \"{label}\": {n} impacts are too few to estimate where its tip is; its origin is used (give --tip-offset)"
+                ));
+                (None, None)
+            }
+            Err(e) => {
+                return Err(ImportError::format(
+                    path,
+                    format!("track \"{label}\""),
+                    e.to_string(),
+                ));
+            }
+        },
+        (_, false) => (None, None),
+    };
+    let tip = positions
+        .iter()
+        .enumerate()
+        .map(|(f, p)| match offset {
+            Some(d) => Some(*p.as_ref()? + rotations.get(f).copied().flatten()? * d),
+            None => *p,
+        })
+        .collect();
+    Ok(Stick {
+        hand,
+        label: track.label.clone(),
+        tip,
+        origin: if offset.is_some() {
+            positions
+        } else {
+            Vec::new()
+        },
+        estimate,
+    })
+}
+
+/// The track labelled `label`, or an error listing the labels the file has.
+fn find_track<'a>(path: &Path, take: &'a Take, label: &str) -> Result<&'a Track, ImportError> {
+    take.track(label).ok_or_else(|| {
+        ImportError::format(
+            path,
+            "labels",
+            format!(
+                "no track labelled \"{label}\"; the file has: {}",
+                take.labels().join(", ")
+            ),
+        )
+    })
+}
+
+/// Medians of the interval between impacts, the lift and the approach speed of a tip.
+fn stroke_stats(
+    tip: &[Option<DVec3>],
+    rate_hz: f64,
+    params: &SegmentParams,
+) -> (Option<f64>, Option<f64>, Option<f64>) {
+    let height: Vec<f64> = super::segment::fill_gaps(tip, (params.max_gap_s * rate_hz) as usize)
+        .iter()
+        .map(|p| p.map_or(f64::NAN, |p| p.z))
+        .collect();
+    let (impacts, _, _) = find_impacts(&height, rate_hz, params);
+    let median = |mut xs: Vec<f64>| {
+        xs.retain(|x| x.is_finite());
+        xs.sort_by(f64::total_cmp);
+        (!xs.is_empty()).then(|| xs[xs.len() / 2])
+    };
+    let intervals = impacts
+        .windows(2)
+        .map(|w| (w[1].frame - w[0].frame) as f64 / rate_hz)
+        .collect();
+    let lifts = impacts
+        .windows(2)
+        .map(|w| {
+            height[w[0].frame..w[1].frame]
+                .iter()
+                .copied()
+                .filter(|h| h.is_finite())
+                .fold(f64::NEG_INFINITY, f64::max)
+                - w[1].height_m
+        })
+        .collect();
+    let speeds = impacts.iter().map(|i| i.approach_mps).collect();
+    (median(intervals), median(lifts), median(speeds))
 }
 
 /// The given label, else the one from the path, else `default` with a notice.
@@ -206,37 +560,29 @@ fn pick<T: std::fmt::Debug + Copy>(
     })
 }
 
-/// The tip positions of the track labelled `label`, in the performer frame.
-fn tip_track(
-    path: &Path,
-    take: &Take,
-    label: &str,
-    options: &IngestOptions,
-) -> Result<Vec<Option<DVec3>>, ImportError> {
-    let track: &Track = take.track(label).ok_or_else(|| {
-        ImportError::format(
-            path,
-            "labels",
-            format!(
-                "no track labelled \"{label}\"; the file has: {}",
-                take.labels().join(", ")
-            ),
-        )
-    })?;
-    let offset = options.tip_offset_m.unwrap_or(DVec3::ZERO);
-    Ok(track
-        .positions
-        .iter()
-        .enumerate()
-        .map(|(f, p)| {
-            let rotation = track.rotations.get(f).copied().flatten();
-            let p = match rotation {
-                Some(q) if options.tip_offset_m.is_some() => *p.as_ref()? + q * offset,
-                _ => (*p)?,
-            };
-            Some(to_performer(p, options.up))
-        })
-        .collect())
+/// Which hand a track label names, when it says: "left"/"right" in it, or an L/R at
+/// either end of a letter run ("StickL", "LSTK", "Stick_R").
+pub fn hand_from_label(label: &str) -> Option<Side> {
+    let lower = label.to_ascii_lowercase();
+    if lower.contains("left") {
+        return Some(Side::Left);
+    }
+    if lower.contains("right") {
+        return Some(Side::Right);
+    }
+    let name = label.rsplit(':').next().unwrap_or(label);
+    let letters: String = name.chars().filter(char::is_ascii_alphabetic).collect();
+    let (first, last) = (letters.chars().next()?, letters.chars().last()?);
+    let side = |c: char| match c {
+        'L' => Some(Side::Left),
+        'R' => Some(Side::Right),
+        _ => None,
+    };
+    match (side(last), side(first)) {
+        (Some(s), _) => Some(s),
+        (None, Some(s)) if letters.len() <= 5 => Some(s),
+        _ => None,
+    }
 }
 
 /// A capture position in the performer frame.
@@ -244,6 +590,15 @@ pub fn to_performer(p: DVec3, up: UpAxis) -> DVec3 {
     match up {
         UpAxis::Z => p,
         UpAxis::Y => DVec3::new(p.x, -p.z, p.y),
+    }
+}
+
+/// A capture orientation (world from body) with the world turned like [`to_performer`]:
+/// for Y up, a quarter turn about X.
+pub fn rotation_to_performer(q: DQuat, up: UpAxis) -> DQuat {
+    match up {
+        UpAxis::Z => q,
+        UpAxis::Y => (DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2) * q).normalize(),
     }
 }
 
@@ -317,9 +672,10 @@ mod tests {
             takes: Vec::new(),
         };
         let options = IngestOptions {
-            tips: ["TipL".into(), "TipR".into()],
+            tips: [Some("TipL".into()), Some("TipR".into())],
             up: UpAxis::Y,
             tip_offset_m: None,
+            align: Alignment::None,
             mode: None,
             location: None,
             dynamic: None,
@@ -329,7 +685,7 @@ mod tests {
             segment: SegmentParams::default(),
         };
         let report = ingest(&mut db, Path::new("legato_rim_f.csv"), &take, &options).unwrap();
-        assert_eq!(report.units, [0, 6], "{report:?}");
+        assert_eq!(report.units(), [0, 6], "{report:?}");
         assert!(report.notices.is_empty());
         let spans: Vec<(usize, usize)> = source
             .index
@@ -349,7 +705,7 @@ mod tests {
             &take,
             &IngestOptions {
                 mode: Some(PlayingMode::Legato),
-                tips: ["Nope".into(), "TipR".into()],
+                tips: [Some("Nope".into()), Some("TipR".into())],
                 ..options
             },
         )

@@ -2,12 +2,15 @@
 //! units, the on-disk motion database, the synthetic performer that builds the shipped
 //! database (joint-limit estimation from its captures lives in `body::limits`).
 
+pub mod align;
 pub mod db;
 pub mod import;
 pub mod ingest;
+pub mod labcorpus;
 pub mod segment;
 pub mod stats;
 pub mod synth;
 pub mod take;
+pub mod tip_estimate;
 
 pub use take::{ImportError, Take, Track};

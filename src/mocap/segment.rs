@@ -1,8 +1,20 @@
 //! Stroke segmentation: find the impacts of a stick-tip trajectory and cut it into motion
-//! units. An impact is a height minimum where a fast descent turns into a rebound, close
-//! to the membrane plane, whose height is estimated from the data (the median of the
-//! candidate minima). A unit runs from the end of the previous stroke's rebound to the end
-//! of its own rebound; the first and last strokes of a take are dropped as broken.
+//! units.
+//!
+//! An impact is a prominent height minimum where a fast descent turns abruptly into a
+//! rebound: the tip must approach at [`SegmentParams::min_approach_speed`] or faster, the
+//! vertical velocity must jump upward by at least [`SegmentParams::min_reversal_accel`]
+//! across the minimum (the acceleration spike of a contact, measured over
+//! [`SegmentParams::reversal_velocity_s`] on each side so 1 mm of marker noise does not
+//! fake or hide it), the tip must rise again, and the minimum must lie near the membrane
+//! plane, whose height is estimated from the data (the median of the candidate minima).
+//! Minima shallower than [`SegmentParams::min_prominence_m`] are jitter, not candidates.
+//! Every candidate turned down is counted by its [`Rejection`] reason.
+//!
+//! Short gaps are filled linearly first; a candidate next to a gap that stayed open cannot
+//! be judged and is rejected as [`Rejection::NearGap`]. A unit runs from the end of the
+//! previous stroke's rebound to the end of its own rebound; the first and last strokes of a
+//! take are dropped as broken.
 
 use glam::DVec3;
 
@@ -11,14 +23,28 @@ use glam::DVec3;
 pub struct SegmentParams {
     /// A stroke must descend at least this fast somewhere in the window before impact, m/s.
     pub min_approach_speed: f64,
-    /// Window before and after the minimum checked for the reversal, s.
+    /// Window before and after the minimum checked for the descent and the rebound, s.
     pub reversal_window_s: f64,
-    /// Impacts lie within this distance of the estimated membrane plane, m.
-    pub plane_tolerance_m: f64,
+    /// Span of the one-sided velocities compared across a minimum, s.
+    pub reversal_velocity_s: f64,
+    /// The upward velocity change across an impact, divided by that span, must reach this,
+    /// m/s² (a turn at the bottom of a smooth motion stays far below; a felt mallet on a
+    /// head gives hundreds).
+    pub min_reversal_accel: f64,
+    /// The tip must rise at least this fast somewhere in the window after impact, m/s.
+    pub min_rebound_speed: f64,
+    /// A minimum is a candidate only if the height rises this much on both sides within
+    /// the window, m.
+    pub min_prominence_m: f64,
+    /// Impacts lie within this distance of the estimated membrane plane, m; `None` skips
+    /// the test (a rigid body's origin, whose height at impact varies with the stick angle).
+    pub plane_tolerance_m: Option<f64>,
     /// Two impacts of one stick are at least this far apart, s.
     pub min_interval_s: f64,
     /// The rebound ends when the upward speed has fallen to this fraction of its peak.
     pub rebound_end_fraction: f64,
+    /// Span of the central-difference velocity that finds the end of a rebound, s.
+    pub rebound_velocity_s: f64,
     /// Gaps (missing samples) up to this long are filled linearly, s.
     pub max_gap_s: f64,
 }
@@ -28,10 +54,104 @@ impl Default for SegmentParams {
         SegmentParams {
             min_approach_speed: 0.3,
             reversal_window_s: 0.04,
-            plane_tolerance_m: 0.05,
+            reversal_velocity_s: 0.012,
+            min_reversal_accel: 40.0,
+            min_rebound_speed: 0.05,
+            min_prominence_m: 0.005,
+            plane_tolerance_m: Some(0.05),
             min_interval_s: 0.08,
             rebound_end_fraction: 0.25,
+            rebound_velocity_s: 0.004,
             max_gap_s: 0.05,
+        }
+    }
+}
+
+/// Why a candidate minimum was not taken as an impact.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Rejection {
+    /// Next to a gap that was too long to fill.
+    NearGap,
+    /// The descent before it was slower than [`SegmentParams::min_approach_speed`].
+    SlowApproach,
+    /// The turn was smooth: no acceleration spike.
+    SoftTurn,
+    /// The tip did not rise again within the window.
+    NoRebound,
+    /// Too far from the membrane plane.
+    OffPlane,
+    /// Too soon after (or before) a deeper impact of the same stick.
+    TooClose,
+}
+
+impl Rejection {
+    /// Every reason, in report order.
+    pub const ALL: [Rejection; 6] = [
+        Rejection::NearGap,
+        Rejection::SlowApproach,
+        Rejection::SoftTurn,
+        Rejection::NoRebound,
+        Rejection::OffPlane,
+        Rejection::TooClose,
+    ];
+
+    /// The reason in words, for reports.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Rejection::NearGap => "next to an unfilled gap",
+            Rejection::SlowApproach => "slow approach",
+            Rejection::SoftTurn => "smooth turn (no impact spike)",
+            Rejection::NoRebound => "no rebound",
+            Rejection::OffPlane => "off the membrane plane",
+            Rejection::TooClose => "too close to a deeper impact",
+        }
+    }
+}
+
+/// How many candidates were rejected, per reason (indexed like [`Rejection::ALL`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RejectionCounts(pub [usize; 6]);
+
+impl RejectionCounts {
+    fn add(&mut self, reason: Rejection) {
+        self.0[Rejection::ALL
+            .iter()
+            .position(|&r| r == reason)
+            .unwrap_or(0)] += 1;
+    }
+
+    /// The count for `reason`.
+    pub fn get(&self, reason: Rejection) -> usize {
+        Rejection::ALL
+            .iter()
+            .position(|&r| r == reason)
+            .map_or(0, |i| self.0[i])
+    }
+
+    /// All rejected candidates.
+    pub fn total(&self) -> usize {
+        self.0.iter().sum()
+    }
+
+    /// "3 slow approach, 1 off the membrane plane", or "none".
+    pub fn summary(&self) -> String {
+        let parts: Vec<String> = Rejection::ALL
+            .iter()
+            .filter(|&&r| self.get(r) > 0)
+            .map(|&r| format!("{} {}", self.get(r), r.describe()))
+            .collect();
+        if parts.is_empty() {
+            "none".into()
+        } else {
+            parts.join(", ")
+        }
+    }
+}
+
+impl std::ops::AddAssign for RejectionCounts {
+    fn add_assign(&mut self, other: Self) {
+        for (a, b) in self.0.iter_mut().zip(other.0) {
+            *a += b;
         }
     }
 }
@@ -56,6 +176,12 @@ pub struct Segmentation {
     pub plane_height_m: Option<f64>,
     /// Complete units (the broken first and last strokes dropped).
     pub units: Vec<UnitSpan>,
+    /// Candidates turned down, by reason.
+    pub rejected: RejectionCounts,
+    /// Samples missing in the capture.
+    pub missing_frames: usize,
+    /// Of those, samples filled by interpolation.
+    pub filled_frames: usize,
 }
 
 /// Fill gaps of at most `max_gap` frames by linear interpolation; longer gaps stay `None`.
@@ -87,62 +213,148 @@ pub fn fill_gaps(samples: &[Option<DVec3>], max_gap: usize) -> Vec<Option<DVec3>
     out
 }
 
-/// Find impacts and units in a tip trajectory sampled at `rate_hz`, with +z up.
-pub fn segment(tip: &[Option<DVec3>], rate_hz: f64, params: &SegmentParams) -> Segmentation {
-    let filled = fill_gaps(tip, (params.max_gap_s * rate_hz).round() as usize);
-    let n = filled.len();
-    let height: Vec<f64> = filled.iter().map(|p| p.map_or(f64::NAN, |p| p.z)).collect();
-    let velocity = vertical_velocity(&height, rate_hz);
-    let window = ((params.reversal_window_s * rate_hz).round() as usize).max(1);
-    let mut candidates: Vec<usize> = (1..n.saturating_sub(1))
-        .filter(|&i| {
-            let h = height[i];
-            h.is_finite()
-                && h <= height[i - 1]
-                && h < height[i + 1]
-                && velocity[i.saturating_sub(window)..i]
-                    .iter()
-                    .any(|v| *v < -params.min_approach_speed)
-                && velocity[i + 1..(i + 1 + window).min(n)]
-                    .iter()
-                    .any(|v| *v > 0.0)
-        })
-        .collect();
-    let plane = median(candidates.iter().map(|&i| height[i]).collect());
-    if let Some(plane) = plane {
-        candidates.retain(|&i| (height[i] - plane).abs() <= params.plane_tolerance_m);
+/// An impact found in a height series.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Impact {
+    /// Frame of the height minimum.
+    pub frame: usize,
+    /// Height there, m.
+    pub height_m: f64,
+    /// Fastest descent in the window before, m/s.
+    pub approach_mps: f64,
+    /// Upward velocity change across the minimum per unit time, m/s².
+    pub reversal_accel: f64,
+}
+
+/// Find impacts in a height series sampled at `rate_hz` (NaN where unseen): every
+/// prominent minimum judged as described in the module doc, the membrane plane estimated
+/// and applied when `params.plane_tolerance_m` is set. Returns the impacts in time order,
+/// the plane height, and the rejected candidates by reason.
+pub fn find_impacts(
+    height: &[f64],
+    rate_hz: f64,
+    params: &SegmentParams,
+) -> (Vec<Impact>, Option<f64>, RejectionCounts) {
+    let n = height.len();
+    let frames = |s: f64| ((s * rate_hz).round() as usize).max(1);
+    let window = frames(params.reversal_window_s);
+    let k = frames(params.reversal_velocity_s);
+    let dt = 1.0 / rate_hz;
+    let slope = |a: usize, b: usize| (height[b] - height[a]) / ((b - a) as f64 * dt);
+    let mut rejected = RejectionCounts::default();
+    let mut accepted: Vec<Impact> = Vec::new();
+    for i in 1..n.saturating_sub(1) {
+        let h = height[i];
+        if !(h.is_finite() && h <= height[i - 1] && h < height[i + 1]) {
+            continue;
+        }
+        let before = &height[i.saturating_sub(window)..i];
+        let after = &height[i + 1..(i + 1 + window).min(n)];
+        let rise = |side: &[f64]| {
+            side.iter()
+                .copied()
+                .filter(|x| x.is_finite())
+                .fold(f64::NEG_INFINITY, f64::max)
+                - h
+        };
+        let lowest_near = before.iter().chain(after).all(|&x| x.is_nan() || x >= h);
+        if !lowest_near
+            || rise(before) < params.min_prominence_m
+            || rise(after) < params.min_prominence_m
+        {
+            continue;
+        }
+        let near = &height[i.saturating_sub(k)..(i + k + 1).min(n)];
+        if i < k || i + k >= n || near.iter().any(|x| !x.is_finite()) {
+            rejected.add(Rejection::NearGap);
+            continue;
+        }
+        let approach = (i.saturating_sub(window).max(k)..=i)
+            .map(|j| -slope(j - k, j))
+            .filter(|v| v.is_finite())
+            .fold(0.0, f64::max);
+        let rebound = (i..(i + window).min(n - 1 - k))
+            .map(|j| slope(j, j + k))
+            .filter(|v| v.is_finite())
+            .fold(0.0, f64::max);
+        let reversal_accel = (i.saturating_sub(1).max(k)..=(i + 1).min(n - 1 - k))
+            .map(|j| (slope(j, j + k) - slope(j - k, j)) / (k as f64 * dt))
+            .fold(0.0, f64::max);
+        let reason = if approach < params.min_approach_speed {
+            Some(Rejection::SlowApproach)
+        } else if reversal_accel < params.min_reversal_accel {
+            Some(Rejection::SoftTurn)
+        } else if rebound < params.min_rebound_speed {
+            Some(Rejection::NoRebound)
+        } else {
+            None
+        };
+        match reason {
+            Some(r) => rejected.add(r),
+            None => accepted.push(Impact {
+                frame: i,
+                height_m: h,
+                approach_mps: approach,
+                reversal_accel,
+            }),
+        }
     }
-    let min_gap = (params.min_interval_s * rate_hz).round() as usize;
-    let mut impacts: Vec<usize> = Vec::with_capacity(candidates.len());
-    for c in candidates {
+    let plane = median(accepted.iter().map(|c| c.height_m).collect());
+    if let (Some(plane), Some(tolerance)) = (plane, params.plane_tolerance_m) {
+        accepted.retain(|c| {
+            let keep = (c.height_m - plane).abs() <= tolerance;
+            if !keep {
+                rejected.add(Rejection::OffPlane);
+            }
+            keep
+        });
+    }
+    let min_gap = frames(params.min_interval_s);
+    let mut impacts: Vec<Impact> = Vec::with_capacity(accepted.len());
+    for c in accepted {
         match impacts.last_mut() {
-            Some(last) if c - *last < min_gap => {
-                if height[c] < height[*last] {
+            Some(last) if c.frame - last.frame < min_gap => {
+                if c.height_m < last.height_m {
                     *last = c;
                 }
+                rejected.add(Rejection::TooClose);
             }
             _ => impacts.push(c),
         }
     }
+    (impacts, plane, rejected)
+}
+
+/// Find impacts and units in a tip trajectory sampled at `rate_hz`, with +z up.
+pub fn segment(tip: &[Option<DVec3>], rate_hz: f64, params: &SegmentParams) -> Segmentation {
+    let filled = fill_gaps(tip, (params.max_gap_s * rate_hz).round() as usize);
+    let missing_frames = tip.iter().filter(|p| p.is_none()).count();
+    let still_missing = filled.iter().filter(|p| p.is_none()).count();
+    let height: Vec<f64> = filled.iter().map(|p| p.map_or(f64::NAN, |p| p.z)).collect();
+    let (found, plane, rejected) = find_impacts(&height, rate_hz, params);
+    let impacts: Vec<usize> = found.iter().map(|i| i.frame).collect();
+    let n = height.len();
+    let k = ((params.rebound_velocity_s * rate_hz).round() as usize).max(1);
+    let velocity = vertical_velocity(&height, rate_hz, k);
     let rebound_ends: Vec<Option<usize>> = impacts
         .iter()
         .enumerate()
-        .map(|(k, &i)| {
+        .map(|(j, &i)| {
             rebound_end(
                 &velocity,
                 i,
-                impacts.get(k + 1).copied().unwrap_or(n),
+                impacts.get(j + 1).copied().unwrap_or(n),
                 params,
             )
         })
         .collect();
     let units = (1..impacts.len().saturating_sub(1))
-        .filter_map(|k| {
-            let start = rebound_ends[k - 1]?;
-            let end = rebound_ends[k]?;
-            (start < impacts[k] && end > impacts[k]).then_some(UnitSpan {
+        .filter_map(|j| {
+            let start = rebound_ends[j - 1]?;
+            let end = rebound_ends[j]?;
+            (start < impacts[j] && end > impacts[j]).then_some(UnitSpan {
                 start,
-                impact: impacts[k],
+                impact: impacts[j],
                 end,
             })
         })
@@ -151,6 +363,9 @@ pub fn segment(tip: &[Option<DVec3>], rate_hz: f64, params: &SegmentParams) -> S
         impacts,
         plane_height_m: plane,
         units,
+        rejected,
+        missing_frames,
+        filled_frames: missing_frames - still_missing,
     }
 }
 
@@ -181,18 +396,17 @@ fn rebound_end(
         .filter(|&e| e < next)
 }
 
-/// Central-difference vertical velocity, m/s (NaN next to missing samples).
-fn vertical_velocity(height: &[f64], rate_hz: f64) -> Vec<f64> {
+/// Central-difference vertical velocity over ±`k` frames (fewer at the ends), m/s; NaN
+/// next to missing samples.
+fn vertical_velocity(height: &[f64], rate_hz: f64, k: usize) -> Vec<f64> {
     let n = height.len();
     (0..n)
         .map(|i| {
-            let a = height[i.saturating_sub(1)];
-            let b = height[(i + 1).min(n - 1)];
-            let span = ((i + 1).min(n - 1) - i.saturating_sub(1)) as f64;
-            if span == 0.0 {
+            let (a, b) = (i.saturating_sub(k), (i + k).min(n - 1));
+            if a == b {
                 0.0
             } else {
-                (b - a) * rate_hz / span
+                (height[b] - height[a]) * rate_hz / (b - a) as f64
             }
         })
         .collect()

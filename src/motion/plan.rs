@@ -3,6 +3,11 @@
 //! the motion unit chosen for it from the database — the nearest by playing mode, impact
 //! location, dynamic, grip and hand, with a seeded choice among near equals so repeats
 //! are not robotic (the same seed gives the same plan).
+//!
+//! A database need not hold every label (real captures often have one hand, a few modes,
+//! one dynamic): the nearest unit is taken all the same, and [`substitutions`] lists the
+//! beats whose unit is of another mode, hand, location, dynamic or grip than asked, for
+//! the user to be told.
 
 use super::sticking::{self, Method};
 use crate::base::rng::Rng;
@@ -53,24 +58,174 @@ impl Default for PlanParams {
     }
 }
 
-/// How far apart a unit's labels are from what a stroke needs (0 = the same).
-fn match_cost(
-    u: &UnitEntry,
-    mode: PlayingMode,
-    location: ImpactLocation,
-    dynamic: Dynamic,
-    grip: Grip,
-    hand: Side,
-) -> f64 {
-    let (r1, a1) = u.location.polar();
-    let (r2, a2) = location.polar();
-    let angle = ((a1 - a2 + 540.0).rem_euclid(360.0) - 180.0).abs() / 180.0;
-    10.0 * f64::from(u.mode != mode)
-        + 3.0 * (r1 - r2).abs()
-        + 0.5 * angle
-        + 2.0 * (u.dynamic.velocity() - dynamic.velocity()).abs()
-        + 5.0 * f64::from(u.grip != grip)
-        + 1.0 * f64::from(u.hand != hand)
+/// What a motion unit is labelled with, or what a stroke asks of one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Labels {
+    pub mode: PlayingMode,
+    pub hand: Side,
+    pub location: ImpactLocation,
+    pub dynamic: Dynamic,
+    pub grip: Grip,
+}
+
+impl Labels {
+    /// The labels of unit `u`.
+    pub fn of(u: &UnitEntry) -> Labels {
+        Labels {
+            mode: u.mode,
+            hand: u.hand,
+            location: u.location,
+            dynamic: u.dynamic,
+            grip: u.grip,
+        }
+    }
+
+    /// How far apart unit `u`'s labels are from these (0 = the same): a mode costs 10, a
+    /// grip 5, a hand 1, the radius 3 per head radius, the angle 0.5 per half turn, the
+    /// dynamic 2 per unit of velocity.
+    pub fn cost(&self, u: &UnitEntry) -> f64 {
+        let (r1, a1) = u.location.polar();
+        let (r2, a2) = self.location.polar();
+        let angle = ((a1 - a2 + 540.0).rem_euclid(360.0) - 180.0).abs() / 180.0;
+        10.0 * f64::from(u.mode != self.mode)
+            + 3.0 * (r1 - r2).abs()
+            + 0.5 * angle
+            + 2.0 * (u.dynamic.velocity() - self.dynamic.velocity()).abs()
+            + 5.0 * f64::from(u.grip != self.grip)
+            + 1.0 * f64::from(u.hand != self.hand)
+    }
+
+    /// Which labels of `other` differ from these as a player names them: the dynamic by
+    /// its nearest marking, the location by the nearest of centre, playing spot and rim
+    /// (so velocity 0.6 played from an mf unit, or a point near the playing spot from a
+    /// playing-spot unit, is no substitution).
+    pub fn differences(&self, other: &Labels) -> Differences {
+        Differences {
+            mode: self.mode != other.mode,
+            hand: self.hand != other.hand,
+            location: named_location(self.location) != named_location(other.location),
+            dynamic: self.dynamic.nearest_mark() != other.dynamic.nearest_mark(),
+            grip: self.grip != other.grip,
+        }
+    }
+
+    /// The labels in words, e.g. "accent, right, mf": mode, hand and dynamic, then the
+    /// location and the grip where `shown` says so.
+    pub fn describe(&self, shown: &Differences) -> String {
+        let mut words = vec![self.mode.name().to_string(), side_name(self.hand).into()];
+        if shown.location {
+            words.push(self.location.name());
+        }
+        words.push(dynamic_name(self.dynamic));
+        if shown.grip {
+            words.push(format!("{:?}", self.grip));
+        }
+        words.join(", ")
+    }
+}
+
+/// Which labels differ.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Differences {
+    pub mode: bool,
+    pub hand: bool,
+    pub location: bool,
+    pub dynamic: bool,
+    pub grip: bool,
+}
+
+impl Differences {
+    /// Whether any label differs.
+    pub fn any(&self) -> bool {
+        self.mode || self.hand || self.location || self.dynamic || self.grip
+    }
+}
+
+/// "left" or "right".
+pub fn side_name(side: Side) -> &'static str {
+    match side {
+        Side::Left => "left",
+        Side::Right => "right",
+    }
+}
+
+/// A marking's name ("mf"), or an exact velocity with its nearest marking ("0.60 ≈ mf").
+fn dynamic_name(dynamic: Dynamic) -> String {
+    match dynamic {
+        Dynamic::Velocity(v) => format!("{v:.2} ≈ {}", dynamic.nearest_mark()),
+        mark => mark.nearest_mark().to_string(),
+    }
+}
+
+/// The named location (centre, playing spot, rim) nearest in radius to `location`.
+fn named_location(location: ImpactLocation) -> ImpactLocation {
+    let radius = location.polar().0;
+    [
+        ImpactLocation::Centre,
+        ImpactLocation::PlayingSpot,
+        ImpactLocation::Rim,
+    ]
+    .into_iter()
+    .min_by(|a, b| {
+        (a.polar().0 - radius)
+            .abs()
+            .total_cmp(&(b.polar().0 - radius).abs())
+    })
+    .expect("three named locations")
+}
+
+/// A beat played with a unit whose labels differ from what its stroke asked.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Substitution {
+    /// Index of the beat in the score.
+    pub beat: usize,
+    pub wanted: Labels,
+    pub used: Labels,
+}
+
+impl std::fmt::Display for Substitution {
+    /// E.g. "beat 12 (staccato, right, mf): no such unit; used accent, right, mf".
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let shown = self.wanted.differences(&self.used);
+        write!(
+            f,
+            "beat {} ({}): no such unit; used {}",
+            self.beat,
+            self.wanted.describe(&shown),
+            self.used.describe(&shown)
+        )
+    }
+}
+
+/// What `stroke` of `score` asks of its unit.
+pub fn wanted(stroke: &PlannedStroke, score: &Score) -> Labels {
+    Labels {
+        mode: stroke.mode,
+        hand: stroke.hand,
+        location: score.beats[stroke.beat].location,
+        dynamic: stroke.dynamic,
+        grip: score.grip,
+    }
+}
+
+/// The beats of `strokes` (planned for `score` with `db`) played with a unit whose labels
+/// differ from what was asked ([`Labels::differences`]), each beat and pair of labels
+/// once (a roll's strokes share their beat), in time order.
+pub fn substitutions(strokes: &[PlannedStroke], score: &Score, db: &MotionDb) -> Vec<Substitution> {
+    let mut found: Vec<Substitution> = Vec::new();
+    for s in strokes {
+        let wanted = wanted(s, score);
+        let used = Labels::of(&db.index.units[s.unit]);
+        let substitution = Substitution {
+            beat: s.beat,
+            wanted,
+            used,
+        };
+        if wanted.differences(&used).any() && !found.contains(&substitution) {
+            found.push(substitution);
+        }
+    }
+    found
 }
 
 /// Why a score could not be planned.
@@ -143,13 +298,8 @@ fn choose_units(strokes: &mut [PlannedStroke], score: &Score, db: &MotionDb, par
     let rng = Rng::new(params.seed);
     let mut last = [usize::MAX; 2];
     for (i, s) in strokes.iter_mut().enumerate() {
-        let location = score.beats[s.beat].location;
-        let costs: Vec<f64> = db
-            .index
-            .units
-            .iter()
-            .map(|u| match_cost(u, s.mode, location, s.dynamic, score.grip, s.hand))
-            .collect();
+        let wanted = wanted(s, score);
+        let costs: Vec<f64> = db.index.units.iter().map(|u| wanted.cost(u)).collect();
         let best = costs.iter().copied().fold(f64::INFINITY, f64::min);
         let h = crate::mocap::db::side_index(s.hand);
         let mut near: Vec<usize> = (0..costs.len())
@@ -206,6 +356,85 @@ mod tests {
             assert_eq!((u.mode, u.grip), (s.mode, etude.score.grip));
             assert!((u.dynamic.velocity() - s.dynamic.velocity()).abs() < 0.15);
         }
+    }
+
+    /// A database without staccato units: the études' staccato beats are played with the
+    /// nearest units of another mode and listed, once per beat; the other beats only
+    /// where their dynamic has no unit (the soft legato: mp played from mf or p).
+    #[test]
+    fn substitutions_list_the_beats_without_their_units() {
+        let mut db = shipped_db();
+        db.index.units.retain(|u| u.mode != PlayingMode::Staccato);
+        let etude = demo("etude-modes.ron");
+        let strokes = plan(&etude.score, &etude.kit, &db, &PlanParams::default()).unwrap();
+        let found = substitutions(&strokes, &etude.score, &db);
+        let beats = |f: &dyn Fn(&crate::score::Beat) -> bool| -> Vec<usize> {
+            (0..etude.score.beats.len())
+                .filter(|&b| f(&etude.score.beats[b]))
+                .collect()
+        };
+        let staccato = beats(&|b| b.mode == PlayingMode::Staccato);
+        let listed: Vec<usize> = found.iter().map(|s| s.beat).collect();
+        let mut expected = [staccato.clone(), beats(&|b| b.dynamic == Dynamic::Mp)].concat();
+        expected.sort();
+        assert_eq!(listed, expected);
+        for s in found.iter().filter(|s| staccato.contains(&s.beat)) {
+            assert_eq!(s.wanted.mode, PlayingMode::Staccato);
+            assert_ne!(s.used.mode, PlayingMode::Staccato);
+            let stroke = (strokes.iter())
+                .find(|t| t.beat == s.beat && t.hand == s.wanted.hand)
+                .unwrap();
+            assert_eq!(s.wanted, wanted(stroke, &etude.score));
+        }
+    }
+
+    /// A substitution reads as a note naming the labels that differ, the location and
+    /// grip only when they do.
+    #[test]
+    fn a_substitution_reads_as_a_note() {
+        let wanted = Labels {
+            mode: PlayingMode::Staccato,
+            hand: Side::Right,
+            location: ImpactLocation::PlayingSpot,
+            dynamic: Dynamic::Mf,
+            grip: Grip::French,
+        };
+        let note = |used: Labels| {
+            Substitution {
+                beat: 12,
+                wanted,
+                used,
+            }
+            .to_string()
+        };
+        let accent = Labels {
+            mode: PlayingMode::Accent,
+            ..wanted
+        };
+        assert_eq!(
+            note(accent),
+            "beat 12 (staccato, right, mf): no such unit; used accent, right, mf"
+        );
+        let rim = Labels {
+            location: ImpactLocation::Rim,
+            grip: Grip::German,
+            dynamic: Dynamic::Velocity(0.6),
+            ..wanted
+        };
+        assert_eq!(
+            note(rim),
+            "beat 12 (staccato, right, playing spot, mf, French): no such unit; \
+             used staccato, right, rim, 0.60 ≈ mf, German"
+        );
+        let near = Labels {
+            location: ImpactLocation::Point {
+                radius: 0.6,
+                angle_deg: 20.0,
+            },
+            dynamic: Dynamic::Velocity(0.6),
+            ..wanted
+        };
+        assert!(!wanted.differences(&near).any(), "{}", note(near));
     }
 
     /// The same seed gives the same plan; another seed varies the units, not the strokes.

@@ -21,10 +21,9 @@ pub mod strikes;
 use crate::body::ik::{self, IkParams};
 use crate::body::model::BodyModel;
 use crate::body::sim::{Motion, Pipeline, Reference, SimError, SimParams, Simulator};
-use crate::body::skeleton::{Pose, REST, Skeleton};
+use crate::body::skeleton::Skeleton;
 use crate::drum::{DrumError, DrumSet, ModeConfig};
 use crate::kit::Kit;
-use crate::kit::Side;
 use crate::mocap::db::MotionDb;
 use crate::motion::compose::{ComposeParams, Composition};
 use crate::motion::perform;
@@ -467,7 +466,8 @@ impl Run<'_> {
             (previous, _) => {
                 let model = BodyModel::new(skeleton, params.mass_kg);
                 let first = targets.reference(&Warp::default());
-                let initial = initial_pose(&model, &first);
+                let initial =
+                    ik::posture_reaching(&model.skeleton, [first.tips[0][0], first.tips[1][0]]);
                 let sim = Simulator::new(
                     &model,
                     &first,
@@ -653,26 +653,4 @@ impl RenderError {
             SimError::Cancelled => RenderError::Cancelled,
         }
     }
-}
-
-/// The posture the body starts in: both tips on the reference's first targets.
-fn initial_pose(model: &BodyModel, reference: &Reference) -> Pose {
-    let params = IkParams {
-        max_iterations: 500,
-        use_trunk: false,
-        ..IkParams::default()
-    };
-    let mut pose = REST;
-    for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
-        pose = ik::solve(
-            &model.skeleton,
-            &pose,
-            side,
-            reference.tips[h][0],
-            None,
-            &params,
-        )
-        .pose;
-    }
-    pose
 }

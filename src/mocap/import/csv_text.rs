@@ -51,6 +51,53 @@ pub(super) fn rows(text: &str) -> impl Iterator<Item = Row<'_>> {
     })
 }
 
+/// Every line of `text`, split at `sep` ([`split_cells_on`]); line endings LF or CRLF.
+pub(super) fn rows_on(text: &str, sep: Option<char>) -> impl Iterator<Item = Row<'_>> {
+    text.lines().enumerate().map(move |(i, l)| Row {
+        line: i + 1,
+        cells: split_cells_on(l, sep),
+    })
+}
+
+/// The file as text, whatever its encoding: UTF-16 (little or big endian) when it starts
+/// with that byte-order mark; else UTF-8 (a BOM dropped) when it is valid UTF-8; else
+/// Windows-1252 (which every byte decodes in, so Latin-1 exports keep their "°" and "é").
+pub(super) fn decode_text(bytes: &[u8]) -> Cow<'_, str> {
+    let utf16 = |b: &[u8], unit: fn([u8; 2]) -> u16| -> Cow<'_, str> {
+        let units = b.chunks_exact(2).map(|c| unit([c[0], c[1]]));
+        Cow::Owned(
+            char::decode_utf16(units)
+                .map(|c| c.unwrap_or(char::REPLACEMENT_CHARACTER))
+                .collect(),
+        )
+    };
+    if let Some(rest) = bytes.strip_prefix(b"\xff\xfe") {
+        return utf16(rest, u16::from_le_bytes);
+    }
+    if let Some(rest) = bytes.strip_prefix(b"\xfe\xff") {
+        return utf16(rest, u16::from_be_bytes);
+    }
+    let bytes = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes);
+    match std::str::from_utf8(bytes) {
+        Ok(s) => Cow::Borrowed(s),
+        Err(_) => Cow::Owned(bytes.iter().map(|&b| windows_1252(b)).collect()),
+    }
+}
+
+/// The character a Windows-1252 byte stands for (the five unassigned bytes map to the C1
+/// control of the same number, as browsers do).
+fn windows_1252(b: u8) -> char {
+    const HIGH: [char; 32] = [
+        '€', '\u{81}', '‚', 'ƒ', '„', '…', '†', '‡', 'ˆ', '‰', 'Š', '‹', 'Œ', '\u{8d}', 'Ž',
+        '\u{8f}', '\u{90}', '‘', '’', '“', '”', '•', '–', '—', '˜', '™', 'š', '›', 'œ', '\u{9d}',
+        'ž', 'Ÿ',
+    ];
+    match b {
+        0x80..=0x9f => HIGH[usize::from(b - 0x80)],
+        _ => char::from(b),
+    }
+}
+
 /// Split one line at commas. A cell in double quotes may hold commas; `""` inside quotes
 /// is a quote. Cells are trimmed of spaces and tabs.
 /// The data rows of `rows`: blank lines at the end are skipped, a blank line followed by
@@ -77,9 +124,19 @@ pub(super) fn data_rows<'a>(
 }
 
 pub(super) fn split_cells(line: &str) -> Vec<Cow<'_, str>> {
+    split_cells_on(line, Some(','))
+}
+
+/// Split one line at `sep`, or at runs of spaces and tabs when `sep` is `None` (then no
+/// cell is empty and quotes are not special). With a separator, a cell in double quotes
+/// may hold it; `""` inside quotes is a quote. Cells are trimmed of spaces and tabs.
+pub(super) fn split_cells_on(line: &str, sep: Option<char>) -> Vec<Cow<'_, str>> {
     let line = line.strip_suffix('\r').unwrap_or(line);
+    let Some(sep) = sep else {
+        return line.split_whitespace().map(Cow::Borrowed).collect();
+    };
     if !line.contains('"') {
-        return line.split(',').map(|c| Cow::Borrowed(c.trim())).collect();
+        return line.split(sep).map(|c| Cow::Borrowed(c.trim())).collect();
     }
     let mut cells = Vec::new();
     let mut cur = String::new();
@@ -92,7 +149,9 @@ pub(super) fn split_cells(line: &str) -> Vec<Cow<'_, str>> {
                 chars.next();
             }
             '"' => quoted = !quoted,
-            ',' if !quoted => cells.push(Cow::Owned(std::mem::take(&mut cur).trim().to_string())),
+            c if c == sep && !quoted => {
+                cells.push(Cow::Owned(std::mem::take(&mut cur).trim().to_string()))
+            }
             _ => cur.push(c),
         }
     }
@@ -225,6 +284,25 @@ mod tests {
         assert!(check_width(Path::new("f"), &r, 1).is_err());
         assert_eq!(shorten("abc"), "abc");
         assert_eq!(shorten(&"é".repeat(50)).chars().count(), 41);
+    }
+
+    #[test]
+    fn splits_on_other_separators_and_decodes_any_encoding() {
+        assert_eq!(
+            split_cells_on("a\t\"b\tc\"\t", Some('\t')),
+            vec!["a", "b\tc", ""]
+        );
+        assert_eq!(
+            split_cells_on("1;2,5;;", Some(';')),
+            vec!["1", "2,5", "", ""]
+        );
+        assert_eq!(split_cells_on("  1  2\t3 \r", None), vec!["1", "2", "3"]);
+        let rows: Vec<_> = rows_on("a b\r\nc", None).collect();
+        assert_eq!((rows[1].line, rows[1].cell(0)), (2, "c"));
+        assert_eq!(decode_text(b"\xef\xbb\xbfx\xc2\xb0"), "x°");
+        assert_eq!(decode_text(b"Winkel \xb0 \x80 \x9d"), "Winkel ° € \u{9d}");
+        assert_eq!(decode_text(b"\xff\xfea\x00\xe9\x00"), "aé");
+        assert_eq!(decode_text(b"\xfe\xff\x00a\x00\xe9"), "aé");
     }
 
     #[test]

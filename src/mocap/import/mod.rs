@@ -12,12 +12,21 @@
 //! * [`motive`]: OptiTrack Motive CSV export, format version 1.2x.
 //! * [`vicon`]: Vicon Nexus CSV export (the `Trajectories` section).
 //! * [`plain_csv`]: our own documented CSV (`time_s,<label>_x,<label>_y,<label>_z,…`).
+//! * [`trc`]: OpenSim / Cortex TRC marker files (read through [`table`]).
+//! * [`table`] with a [`profile::CaptureProfile`]: any other column-mapped text export
+//!   (Qualisys TSV, Vicon and Motive CSV with any names, …), described in RON
+//!   ([`read_with_profile`]); shipped profiles are in `mocap/profiles/`.
 
 pub mod c3d;
 mod csv_text;
 pub mod motive;
 pub mod plain_csv;
+pub mod profile;
+pub mod table;
+pub mod trc;
 pub mod vicon;
+
+pub use profile::CaptureProfile;
 
 use super::take::{ImportError, Take};
 use std::path::Path;
@@ -33,6 +42,8 @@ pub enum Format {
     Vicon,
     /// Our own plain CSV.
     Csv,
+    /// OpenSim / Cortex TRC.
+    Trc,
 }
 
 impl Format {
@@ -44,6 +55,7 @@ impl Format {
             "motive" | "optitrack" => Some(Format::Motive),
             "vicon" | "nexus" => Some(Format::Vicon),
             "csv" | "plain" | "plain-csv" | "plain_csv" => Some(Format::Csv),
+            "trc" => Some(Format::Trc),
             _ => None,
         }
     }
@@ -55,12 +67,14 @@ impl Format {
             Format::Motive => "motive",
             Format::Vicon => "vicon",
             Format::Csv => "csv",
+            Format::Trc => "trc",
         }
     }
 
     /// Guess the format from the file's content, falling back on its extension (`.c3d`).
     /// Text files are told apart by their first line: `Format Version,…` is Motive, a
-    /// Vicon section name (`Trajectories`, `Devices`, …) is Vicon, `time_s,…` is plain CSV.
+    /// Vicon section name (`Trajectories`, `Devices`, …) is Vicon, `time_s,…` is plain CSV,
+    /// `PathFileType…` (tab- or space-separated) is TRC.
     pub fn guess(path: &Path, bytes: &[u8]) -> Option<Format> {
         if let [first, 0x50, ..] = bytes {
             // Header byte 1: the parameter block number (a small binary value, never a
@@ -88,6 +102,10 @@ impl Format {
             }
             if cell.eq_ignore_ascii_case("time_s") {
                 return Some(Format::Csv);
+            }
+            let word = line.split(['\t', ' ', ',']).next().unwrap_or("");
+            if word.eq_ignore_ascii_case("PathFileType") {
+                return Some(Format::Trc);
             }
         }
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
@@ -171,8 +189,9 @@ pub fn read_with_unit(
                 "start of file",
                 "cannot tell the capture format: expected a C3D file, an OptiTrack Motive \
                  CSV export (first line \"Format Version,…\"), a Vicon CSV export (a \
-                 \"Trajectories\" section) or a plain CSV (header \"time_s,…\"); name the \
-                 format explicitly if it is one of these",
+                 \"Trajectories\" section), an OpenSim TRC file (\"PathFileType…\") or a plain \
+                 CSV (header \"time_s,…\"); name the format explicitly if it is one of these, \
+                 or read it with a capture profile",
             )
         })?,
     };
@@ -196,7 +215,24 @@ pub fn read_bytes_with_unit(
         Format::Motive => motive::read(path, bytes, unit),
         Format::Vicon => vicon::read(path, bytes, unit),
         Format::Csv => plain_csv::read(path, bytes, unit),
+        Format::Trc => trc::read(path, bytes, unit),
     }
+}
+
+/// Read a column-mapped text capture as `profile` describes it (see [`profile`] and
+/// [`table`]); `unit` ("mm", "cm" or "m") overrides every unit the profile or file gives.
+/// Hands are not in the take: look them up with [`CaptureProfile::hand_of`].
+pub fn read_with_profile(
+    path: &Path,
+    profile: &CaptureProfile,
+    unit: Option<&str>,
+) -> Result<Take, ImportError> {
+    let unit = parse_unit_override(path, unit)?;
+    let bytes = std::fs::read(path).map_err(|source| ImportError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    table::read(path, &bytes, profile, unit)
 }
 
 fn parse_unit_override(path: &Path, unit: Option<&str>) -> Result<Option<LengthUnit>, ImportError> {
@@ -223,7 +259,14 @@ mod tests {
         assert_eq!(Format::from_name("nexus"), Some(Format::Vicon));
         assert_eq!(Format::from_name("csv"), Some(Format::Csv));
         assert_eq!(Format::from_name("bvh"), None);
-        for f in [Format::C3d, Format::Motive, Format::Vicon, Format::Csv] {
+        assert_eq!(Format::from_name("TRC"), Some(Format::Trc));
+        for f in [
+            Format::C3d,
+            Format::Motive,
+            Format::Vicon,
+            Format::Csv,
+            Format::Trc,
+        ] {
             assert_eq!(Format::from_name(f.name()), Some(f));
         }
         let p = Path::new("x.csv");
@@ -240,10 +283,27 @@ mod tests {
             Some(Format::Vicon)
         );
         assert_eq!(Format::guess(p, b"time_s,a_x,a_y,a_z\n"), Some(Format::Csv));
+        assert_eq!(
+            Format::guess(p, b"PathFileType\t4\t(X/Y/Z)\ta.trc\n"),
+            Some(Format::Trc)
+        );
         assert_eq!(Format::guess(p, b"\nPlain text"), None);
         assert_eq!(Format::guess(p, b"\x02\x50\x00"), Some(Format::C3d));
         assert_eq!(Format::guess(Path::new("a.C3D"), b""), Some(Format::C3d));
         assert_eq!(Format::guess(p, b""), None);
+    }
+
+    #[test]
+    fn reads_files_with_a_profile_or_as_trc() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/capture");
+        let tsv = dir.join("qualisys_3d_200hz.tsv");
+        let profile = CaptureProfile::shipped("qualisys-3d").unwrap();
+        let take = read_with_profile(&tsv, &profile, Some("cm")).unwrap();
+        assert_eq!((take.file_unit.as_str(), take.rate_hz), ("cm", 200.0));
+        assert!(read_with_profile(&tsv, &profile, Some("furlong")).is_err());
+        assert!(read_with_profile(&dir.join("missing.tsv"), &profile, None).is_err());
+        let trc = read(&dir.join("opensim_walk.trc"), None).unwrap();
+        assert_eq!(trc.labels(), vec!["R.Stick.Tip", "L.Stick.Tip", "C7"]);
     }
 
     #[test]
