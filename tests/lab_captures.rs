@@ -93,6 +93,7 @@ fn run(capture: &GeneratedCapture, dir: &Path, kit: &Kit, habits: &HabitBook) ->
         hand: None,
         performer: "test".into(),
         segment: Default::default(),
+        dynamic_speeds: Vec::new(),
     };
     let mut db = MotionDb::empty("test");
     let report = ingest::ingest(&mut db, &path, &take, &options).unwrap_or_else(|e| panic!("{e}"));
@@ -243,6 +244,7 @@ fn a_manual_alignment_is_applied() {
             hand: None,
             performer: "test".into(),
             segment: Default::default(),
+            dynamic_speeds: Vec::new(),
         },
     )
     .unwrap();

@@ -208,6 +208,14 @@ pub fn import(args: ImportArgs) -> anyhow::Result<()> {
         .map(CaptureProfile::resolve)
         .transpose()?;
     let align = alignment(&args)?;
+    // Strokes without a dynamic label get the shipped performer's marking for their speed.
+    let speeds = if args.dynamic.is_some() {
+        Vec::new()
+    } else {
+        MotionDb::load(&crate::mocap::db::default_dir())
+            .map(|db| crate::mocap::ingest::dynamic_speeds(&db))
+            .unwrap_or_default()
+    };
     let sources = if args.pair {
         if !args.files.len().is_multiple_of(2) {
             anyhow::bail!(
@@ -238,6 +246,7 @@ pub fn import(args: ImportArgs) -> anyhow::Result<()> {
             hand: args.hand,
             performer: args.performer.clone(),
             segment: Default::default(),
+            dynamic_speeds: speeds.clone(),
         };
         let report = ingest(&mut db, &source.path, &source.take, &options)?;
         print_report(source, &report, &align);
@@ -509,11 +518,19 @@ fn print_report(source: &Source, report: &IngestReport, align: &Alignment) {
             x.map_or("-".into(), |x| format!("{:.2} {unit}", x * scale))
         };
         println!(
-            "  {:?} stick \"{}\": {} impacts -> {} units; rejected: {}; {} missing frames ({} filled)",
+            "  {:?} stick \"{}\": {} impacts -> {} units{}; rejected: {}; {} missing frames ({} filled)",
             h.hand,
             h.label,
             h.impacts.len(),
             h.units,
+            if h.units_with_gaps > 0 {
+                format!(
+                    " ({} more left out for a gap over 50 ms)",
+                    h.units_with_gaps
+                )
+            } else {
+                String::new()
+            },
             h.rejected.summary(),
             h.missing_frames,
             h.filled_frames

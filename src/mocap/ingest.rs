@@ -10,7 +10,9 @@
 
 use super::align::{self, HabitBook, HandFit, HandStrokes, Target, Transform};
 use super::db::{MotionDb, TakeData, TakeEntry, UnitEntry};
-use super::segment::{RejectionCounts, SegmentParams, find_impacts, segment};
+use super::segment::{
+    Impact, RejectionCounts, SegmentParams, UnitSpan, fill_gaps, find_impacts, segment,
+};
 use super::take::{ImportError, Take, Track};
 use super::tip_estimate::{self, TipEstimate, TipEstimateError};
 use crate::kit::{Kit, Side};
@@ -47,6 +49,10 @@ pub struct IngestOptions {
     pub hand: Option<Side>,
     pub performer: String,
     pub segment: SegmentParams,
+    /// Impact speed of each dynamic marking ([`dynamic_speeds`] of the shipped database):
+    /// when no dynamic is given or in the file name, each stroke gets the marking whose
+    /// speed is nearest its own. Empty: mf, with a notice.
+    pub dynamic_speeds: Vec<(Dynamic, f64)>,
 }
 
 /// How a take is placed in the performer frame.
@@ -120,6 +126,8 @@ pub struct HandReport {
     pub impacts: Vec<usize>,
     /// Units added.
     pub units: usize,
+    /// Units left out for a gap too long to fill inside them.
+    pub units_with_gaps: usize,
     /// Candidates turned down, by reason.
     pub rejected: RejectionCounts,
     /// Samples missing in the capture, and of those filled by interpolation.
@@ -187,13 +195,15 @@ pub fn ingest(
         "impact location",
         &mut notices,
     );
-    let dynamic = pick(
-        options.dynamic,
-        from_path.dynamic,
-        Dynamic::Mf,
-        "dynamic",
-        &mut notices,
-    );
+    // Without a dynamic given, each stroke's comes from its impact speed when a speed
+    // table is at hand (else mf, said in a notice).
+    let fixed_dynamic = options.dynamic.or(from_path.dynamic);
+    let dynamic = match (fixed_dynamic, options.dynamic_speeds.is_empty()) {
+        (Some(d), _) => d,
+        (None, false) => Dynamic::Mf,
+        (None, true) => pick(None, None, Dynamic::Mf, "dynamic", &mut notices),
+    };
+    let by_speed = fixed_dynamic.is_none() && !options.dynamic_speeds.is_empty();
     let grip = pick(
         options.grip,
         from_path.grip,
@@ -280,11 +290,19 @@ pub fn ingest(
     let mut hands = Vec::new();
     for (s, seg) in sticks.into_iter().zip(segmentations) {
         let stats = stroke_stats(&s.tip, rate, &options.segment);
+        // The stored tip has its short gaps filled as segmentation saw them; a unit with a
+        // longer gap inside is left out (composition would have to jump over it).
+        let filled = fill_gaps(&s.tip, (options.segment.max_gap_s * rate).round() as usize);
+        let (whole, gapped): (Vec<&UnitSpan>, Vec<&UnitSpan>) = seg
+            .units
+            .iter()
+            .partition(|span| filled[span.start..=span.end].iter().all(Option::is_some));
         hands.push(HandReport {
             hand: s.hand,
             label: s.label.clone(),
             impacts: seg.impacts.clone(),
-            units: seg.units.len(),
+            units: whole.len(),
+            units_with_gaps: gapped.len(),
             rejected: seg.rejected,
             missing_frames: seg.missing_frames,
             filled_frames: seg.filled_frames,
@@ -294,21 +312,45 @@ pub fn ingest(
             lift_m: stats.1,
             impact_speed_mps: stats.2,
         });
-        db.index
-            .units
-            .extend(seg.units.iter().map(|span| UnitEntry {
-                take: take_index,
-                start: span.start,
-                impact: span.impact,
-                end: span.end,
-                hand: s.hand,
-                mode,
-                location,
-                dynamic,
-                grip,
-            }));
-        tips[crate::mocap::db::side_index(s.hand)] = s
-            .tip
+        let impacts = impacts_of(&s.tip, rate, &options.segment);
+        let unit_dynamic = |frame: usize| {
+            let speed = impacts
+                .iter()
+                .find(|i| i.frame.abs_diff(frame) <= 1)
+                .map(|i| i.approach_mps);
+            match speed {
+                Some(v) if by_speed => dynamic_for_speed(&options.dynamic_speeds, v),
+                _ => dynamic,
+            }
+        };
+        let first_unit = db.index.units.len();
+        db.index.units.extend(whole.iter().map(|span| UnitEntry {
+            take: take_index,
+            start: span.start,
+            impact: span.impact,
+            end: span.end,
+            hand: s.hand,
+            mode,
+            location,
+            dynamic: unit_dynamic(span.impact),
+            grip,
+        }));
+        if by_speed {
+            let added = &db.index.units[first_unit..];
+            let counts: Vec<String> = Dynamic::MARKS
+                .iter()
+                .filter_map(|&(d, _, name)| {
+                    let n = added.iter().filter(|u| u.dynamic == d).count();
+                    (n > 0).then(|| format!("{n} {name}"))
+                })
+                .collect();
+            notices.push(format!(
+                "{:?} stick: no dynamic given or in the file name; each stroke's read from its impact speed against the shipped performer's: {}",
+                s.hand,
+                if counts.is_empty() { "none".into() } else { counts.join(", ") }
+            ));
+        }
+        tips[crate::mocap::db::side_index(s.hand)] = filled
             .iter()
             .map(|p| p.map(|p| transform.point(p)))
             .collect();
@@ -515,11 +557,8 @@ fn stroke_stats(
     rate_hz: f64,
     params: &SegmentParams,
 ) -> (Option<f64>, Option<f64>, Option<f64>) {
-    let height: Vec<f64> = super::segment::fill_gaps(tip, (params.max_gap_s * rate_hz) as usize)
-        .iter()
-        .map(|p| p.map_or(f64::NAN, |p| p.z))
-        .collect();
-    let (impacts, _, _) = find_impacts(&height, rate_hz, params);
+    let height = heights(tip, rate_hz, params);
+    let impacts = impacts_of(tip, rate_hz, params);
     let median = |mut xs: Vec<f64>| {
         xs.retain(|x| x.is_finite());
         xs.sort_by(f64::total_cmp);
@@ -542,6 +581,66 @@ fn stroke_stats(
         .collect();
     let speeds = impacts.iter().map(|i| i.approach_mps).collect();
     (median(intervals), median(lifts), median(speeds))
+}
+
+/// A tip's heights with its short gaps filled (NaN where still unseen), m.
+fn heights(tip: &[Option<DVec3>], rate_hz: f64, params: &SegmentParams) -> Vec<f64> {
+    fill_gaps(tip, (params.max_gap_s * rate_hz).round() as usize)
+        .iter()
+        .map(|p| p.map_or(f64::NAN, |p| p.z))
+        .collect()
+}
+
+/// The impacts of a tip, with their approach speeds.
+fn impacts_of(tip: &[Option<DVec3>], rate_hz: f64, params: &SegmentParams) -> Vec<Impact> {
+    find_impacts(&heights(tip, rate_hz, params), rate_hz, params).0
+}
+
+/// The median impact (approach) speed of each dynamic marking in a database, m/s, in
+/// marking order: the table [`IngestOptions::dynamic_speeds`] reads strokes against.
+pub fn dynamic_speeds(db: &MotionDb) -> Vec<(Dynamic, f64)> {
+    let params = SegmentParams::default();
+    let mut speeds: Vec<(Dynamic, f64)> = Vec::new();
+    for (t, data) in db.takes.iter().enumerate() {
+        for side in [Side::Left, Side::Right] {
+            let units: Vec<&UnitEntry> = db
+                .index
+                .units
+                .iter()
+                .filter(|u| u.take == t && u.hand == side)
+                .collect();
+            if units.is_empty() {
+                continue;
+            }
+            for i in impacts_of(data.tip(side), data.rate_hz, &params) {
+                if let Some(u) = units.iter().find(|u| u.impact.abs_diff(i.frame) <= 1) {
+                    let mark = u.dynamic.nearest_mark();
+                    if let Some(&(d, _, _)) = Dynamic::MARKS.iter().find(|m| m.2 == mark) {
+                        speeds.push((d, i.approach_mps));
+                    }
+                }
+            }
+        }
+    }
+    Dynamic::MARKS
+        .iter()
+        .filter_map(|&(d, _, _)| {
+            let mut v: Vec<f64> = speeds.iter().filter(|s| s.0 == d).map(|s| s.1).collect();
+            v.sort_by(f64::total_cmp);
+            (!v.is_empty()).then(|| (d, v[v.len() / 2]))
+        })
+        .collect()
+}
+
+/// The marking whose speed in `table` is nearest `speed` (by ratio).
+fn dynamic_for_speed(table: &[(Dynamic, f64)], speed: f64) -> Dynamic {
+    table
+        .iter()
+        .min_by(|a, b| {
+            let d = |v: f64| (speed.max(1e-3) / v.max(1e-3)).ln().abs();
+            d(a.1).total_cmp(&d(b.1))
+        })
+        .map_or(Dynamic::Mf, |t| t.0)
 }
 
 /// The given label, else the one from the path, else `default` with a notice.
@@ -683,6 +782,7 @@ mod tests {
             hand: None,
             performer: "test".into(),
             segment: SegmentParams::default(),
+            dynamic_speeds: Vec::new(),
         };
         let report = ingest(&mut db, Path::new("legato_rim_f.csv"), &take, &options).unwrap();
         assert_eq!(report.units(), [0, 6], "{report:?}");
