@@ -93,7 +93,7 @@ fn run(capture: &GeneratedCapture, dir: &Path, kit: &Kit, habits: &HabitBook) ->
         hand: None,
         performer: "test".into(),
         segment: Default::default(),
-        dynamic_speeds: Vec::new(),
+        dynamic_speeds: Default::default(),
     };
     let mut db = MotionDb::empty("test");
     let report = ingest::ingest(&mut db, &path, &take, &options).unwrap_or_else(|e| panic!("{e}"));
@@ -244,7 +244,7 @@ fn a_manual_alignment_is_applied() {
             hand: None,
             performer: "test".into(),
             segment: Default::default(),
-            dynamic_speeds: Vec::new(),
+            dynamic_speeds: Default::default(),
         },
     )
     .unwrap();
@@ -304,4 +304,91 @@ fn cli_pairs_one_stick_files_and_aligns_on_two_drums() {
         stdout.contains("Left stick") && stdout.contains("Right stick"),
         "{stdout}"
     );
+}
+
+/// Without a dynamic label, each imported stroke gets the marking whose impact speed in the
+/// shipped database is nearest its own: on a marker capture of p, mf and f strokes the
+/// labels follow the truth's order (the mean true velocity rises with the label) and most
+/// strokes get their own marking or a neighbour.
+#[test]
+fn dynamics_are_read_from_impact_speeds() {
+    let db = shipped_db();
+    let speeds = ingest::dynamic_speeds(&db);
+    for (kind, table) in &speeds.by_kind {
+        assert!(table.len() >= 3, "{kind:?} {table:?}");
+        assert!(
+            table.windows(2).all(|w| w[0].1 < w[1].1),
+            "louder markings strike faster in the shipped database: {kind:?} {table:?}"
+        );
+    }
+    let capture = labcorpus::generate(&db, 16, &LabStyle::typical(Layout::Vicon)).unwrap();
+    let dir = std::env::temp_dir().join(format!("timpanist-lab-dyn-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (name, bytes) = &capture.files[0];
+    std::fs::write(dir.join(name), bytes).unwrap();
+    let path = dir.join(name);
+    let take = read(Layout::Vicon, &path);
+    std::fs::remove_dir_all(&dir).ok();
+    let track = &capture.truth.tracks[0];
+    let mut tips = [None, None];
+    tips[timpanist::mocap::db::side_index(track.hand)] = Some(track.label.clone());
+    let mut out = MotionDb::empty("test");
+    let report = ingest::ingest(
+        &mut out,
+        &path,
+        &take,
+        &IngestOptions {
+            tips,
+            up: UpAxis::Z,
+            tip_offset_m: None,
+            align: Alignment::None,
+            mode: capture.truth.source.mode,
+            location: None,
+            dynamic: None,
+            grip: capture.truth.source.grip,
+            hand: None,
+            performer: "test".into(),
+            segment: Default::default(),
+            dynamic_speeds: speeds,
+        },
+    )
+    .unwrap();
+    assert!(report.notices.iter().any(|n| n.contains("impact speed")));
+    let rate = capture.truth.rate_hz;
+    let pairs: Vec<(f64, f64)> = out
+        .index
+        .units
+        .iter()
+        .filter_map(|u| {
+            let truth = track
+                .impacts
+                .iter()
+                .find(|i| (i.time_s * rate - u.impact as f64).abs() <= 2.0)?
+                .dynamic?;
+            Some((u.dynamic.velocity(), truth.velocity()))
+        })
+        .collect();
+    assert!(pairs.len() >= 15, "{pairs:?}");
+    let close = pairs
+        .iter()
+        .filter(|(ours, truth)| (ours - truth).abs() <= 0.13)
+        .count();
+    eprintln!(
+        "{close} of {} strokes within one marking of the truth",
+        pairs.len()
+    );
+    assert!(close * 10 >= pairs.len() * 7, "{pairs:?}");
+    let mean_truth = |label: f64| {
+        let v: Vec<f64> = pairs.iter().filter(|p| p.0 == label).map(|p| p.1).collect();
+        v.iter().sum::<f64>() / v.len().max(1) as f64
+    };
+    let labels: Vec<f64> = {
+        let mut l: Vec<f64> = pairs.iter().map(|p| p.0).collect();
+        l.sort_by(f64::total_cmp);
+        l.dedup();
+        l
+    };
+    for w in labels.windows(2) {
+        assert!(mean_truth(w[0]) <= mean_truth(w[1]), "{pairs:?}");
+    }
 }

@@ -210,7 +210,7 @@ pub fn import(args: ImportArgs) -> anyhow::Result<()> {
     let align = alignment(&args)?;
     // Strokes without a dynamic label get the shipped performer's marking for their speed.
     let speeds = if args.dynamic.is_some() {
-        Vec::new()
+        Default::default()
     } else {
         MotionDb::load(&crate::mocap::db::default_dir())
             .map(|db| crate::mocap::ingest::dynamic_speeds(&db))

@@ -51,8 +51,8 @@ pub struct IngestOptions {
     pub segment: SegmentParams,
     /// Impact speed of each dynamic marking ([`dynamic_speeds`] of the shipped database):
     /// when no dynamic is given or in the file name, each stroke gets the marking whose
-    /// speed is nearest its own. Empty: mf, with a notice.
-    pub dynamic_speeds: Vec<(Dynamic, f64)>,
+    /// speed, for the take's grip and mode, is nearest its own. Empty: mf, with a notice.
+    pub dynamic_speeds: DynamicSpeeds,
 }
 
 /// How a take is placed in the performer frame.
@@ -319,7 +319,9 @@ pub fn ingest(
                 .find(|i| i.frame.abs_diff(frame) <= 1)
                 .map(|i| i.approach_mps);
             match speed {
-                Some(v) if by_speed => dynamic_for_speed(&options.dynamic_speeds, v),
+                Some(v) if by_speed => {
+                    dynamic_for_speed(options.dynamic_speeds.for_kind(grip, mode), v)
+                }
                 _ => dynamic,
             }
         };
@@ -596,11 +598,37 @@ fn impacts_of(tip: &[Option<DVec3>], rate_hz: f64, params: &SegmentParams) -> Ve
     find_impacts(&heights(tip, rate_hz, params), rate_hz, params).0
 }
 
-/// The median impact (approach) speed of each dynamic marking in a database, m/s, in
-/// marking order: the table [`IngestOptions::dynamic_speeds`] reads strokes against.
-pub fn dynamic_speeds(db: &MotionDb) -> Vec<(Dynamic, f64)> {
+/// How fast each dynamic marking strikes, per grip and playing mode (an accent strikes
+/// faster than a legato at the same marking) and over all strokes: median impact
+/// (approach) speeds, m/s, in marking order.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DynamicSpeeds {
+    pub overall: SpeedTable,
+    pub by_kind: Vec<((Grip, PlayingMode), SpeedTable)>,
+}
+
+/// Median impact speed per dynamic marking, m/s.
+pub type SpeedTable = Vec<(Dynamic, f64)>;
+
+impl DynamicSpeeds {
+    /// The table for strokes of `grip` and `mode`, else the overall one.
+    pub fn for_kind(&self, grip: Grip, mode: PlayingMode) -> &[(Dynamic, f64)] {
+        self.by_kind
+            .iter()
+            .find(|(k, _)| *k == (grip, mode))
+            .map_or(&self.overall, |(_, t)| t)
+    }
+
+    /// Whether there is nothing to read speeds against.
+    pub fn is_empty(&self) -> bool {
+        self.overall.is_empty()
+    }
+}
+
+/// The [`DynamicSpeeds`] of a database (the shipped one, for [`IngestOptions`]).
+pub fn dynamic_speeds(db: &MotionDb) -> DynamicSpeeds {
     let params = SegmentParams::default();
-    let mut speeds: Vec<(Dynamic, f64)> = Vec::new();
+    let mut samples: Vec<((Grip, PlayingMode), Dynamic, f64)> = Vec::new();
     for (t, data) in db.takes.iter().enumerate() {
         for side in [Side::Left, Side::Right] {
             let units: Vec<&UnitEntry> = db
@@ -613,23 +641,37 @@ pub fn dynamic_speeds(db: &MotionDb) -> Vec<(Dynamic, f64)> {
                 continue;
             }
             for i in impacts_of(data.tip(side), data.rate_hz, &params) {
-                if let Some(u) = units.iter().find(|u| u.impact.abs_diff(i.frame) <= 1) {
-                    let mark = u.dynamic.nearest_mark();
-                    if let Some(&(d, _, _)) = Dynamic::MARKS.iter().find(|m| m.2 == mark) {
-                        speeds.push((d, i.approach_mps));
-                    }
+                let Some(u) = units.iter().find(|u| u.impact.abs_diff(i.frame) <= 1) else {
+                    continue;
+                };
+                let mark = u.dynamic.nearest_mark();
+                if let Some(&(d, _, _)) = Dynamic::MARKS.iter().find(|m| m.2 == mark) {
+                    samples.push(((u.grip, u.mode), d, i.approach_mps));
                 }
             }
         }
     }
-    Dynamic::MARKS
-        .iter()
-        .filter_map(|&(d, _, _)| {
-            let mut v: Vec<f64> = speeds.iter().filter(|s| s.0 == d).map(|s| s.1).collect();
-            v.sort_by(f64::total_cmp);
-            (!v.is_empty()).then(|| (d, v[v.len() / 2]))
-        })
-        .collect()
+    let table = |keep: &dyn Fn(&(Grip, PlayingMode)) -> bool| -> SpeedTable {
+        Dynamic::MARKS
+            .iter()
+            .filter_map(|&(d, _, _)| {
+                let mut v: Vec<f64> = samples
+                    .iter()
+                    .filter(|s| s.1 == d && keep(&s.0))
+                    .map(|s| s.2)
+                    .collect();
+                v.sort_by(f64::total_cmp);
+                (!v.is_empty()).then(|| (d, v[v.len() / 2]))
+            })
+            .collect()
+    };
+    let mut kinds: Vec<(Grip, PlayingMode)> = samples.iter().map(|s| s.0).collect();
+    kinds.sort_by_key(|k| format!("{k:?}"));
+    kinds.dedup();
+    DynamicSpeeds {
+        overall: table(&|_| true),
+        by_kind: kinds.iter().map(|&k| (k, table(&|x| *x == k))).collect(),
+    }
 }
 
 /// The marking whose speed in `table` is nearest `speed` (by ratio).
@@ -782,7 +824,7 @@ mod tests {
             hand: None,
             performer: "test".into(),
             segment: SegmentParams::default(),
-            dynamic_speeds: Vec::new(),
+            dynamic_speeds: DynamicSpeeds::default(),
         };
         let report = ingest(&mut db, Path::new("legato_rim_f.csv"), &take, &options).unwrap();
         assert_eq!(report.units(), [0, 6], "{report:?}");
