@@ -11,7 +11,7 @@ use timpanist::mocap::align::{self, HabitBook};
 use timpanist::mocap::db::MotionDb;
 use timpanist::mocap::import::{self, CaptureProfile, Format};
 use timpanist::mocap::ingest::{self, Alignment, IngestOptions, UpAxis};
-use timpanist::mocap::labcorpus::{self, GeneratedCapture, LabStyle, Layout};
+use timpanist::mocap::labcorpus::{self, GeneratedCapture, LabStyle, Layout, Truth};
 use timpanist::mocap::take::Take;
 
 fn shipped_db() -> MotionDb {
@@ -42,6 +42,49 @@ fn read(layout: Layout, path: &Path) -> Take {
     .unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// The options a user would give for `truth`'s capture: its stick labels, up axis and
+/// labels, the alignment `align`, no dynamic.
+fn options_for(truth: &Truth, align: Alignment) -> IngestOptions {
+    let mut tips = [None, None];
+    for t in &truth.tracks {
+        tips[timpanist::mocap::db::side_index(t.hand)] = Some(t.label.clone());
+    }
+    IngestOptions {
+        tips,
+        up: if truth.up_axis == "Y" {
+            UpAxis::Y
+        } else {
+            UpAxis::Z
+        },
+        tip_offset_m: None,
+        align,
+        mode: Some(
+            truth
+                .source
+                .mode
+                .unwrap_or(timpanist::score::PlayingMode::Legato),
+        ),
+        location: truth.source.location,
+        dynamic: None,
+        grip: truth.source.grip,
+        hand: None,
+        performer: "test".into(),
+        segment: Default::default(),
+        dynamic_speeds: Default::default(),
+    }
+}
+
+/// Write a capture's files into `dir` and read its first back as a user would.
+fn write_and_read(capture: &GeneratedCapture, dir: &Path) -> (PathBuf, Take) {
+    std::fs::create_dir_all(dir).unwrap();
+    for (name, bytes) in &capture.files {
+        std::fs::write(dir.join(name), bytes).unwrap();
+    }
+    let path = dir.join(&capture.truth.files[0]);
+    let take = read(capture.truth.layout, &path);
+    (path, take)
+}
+
 /// What one capture gave back, against its truth.
 #[derive(Debug)]
 struct Outcome {
@@ -58,43 +101,16 @@ struct Outcome {
 /// Import `capture` into a fresh database with `--align auto` and compare.
 fn run(capture: &GeneratedCapture, dir: &Path, kit: &Kit, habits: &HabitBook) -> Outcome {
     let truth = &capture.truth;
-    for (name, bytes) in &capture.files {
-        std::fs::write(dir.join(name), bytes).unwrap();
-    }
-    let path = dir.join(&truth.files[0]);
-    let take = read(truth.layout, &path);
-    let up = if truth.up_axis == "Y" {
-        UpAxis::Y
-    } else {
-        UpAxis::Z
-    };
-    let mut tips = [None, None];
-    for t in &truth.tracks {
-        tips[timpanist::mocap::db::side_index(t.hand)] = Some(t.label.clone());
-    }
-    let options = IngestOptions {
-        tips,
-        up,
-        tip_offset_m: None,
-        align: Alignment::Auto {
+    let (path, take) = write_and_read(capture, dir);
+    let options = options_for(
+        truth,
+        Alignment::Auto {
             kit: kit.clone(),
             drum: None,
             habits: habits.clone(),
         },
-        mode: Some(
-            truth
-                .source
-                .mode
-                .unwrap_or(timpanist::score::PlayingMode::Legato),
-        ),
-        location: truth.source.location,
-        dynamic: None,
-        grip: truth.source.grip,
-        hand: None,
-        performer: "test".into(),
-        segment: Default::default(),
-        dynamic_speeds: Default::default(),
-    };
+    );
+    let up = options.up;
     let mut db = MotionDb::empty("test");
     let report = ingest::ingest(&mut db, &path, &take, &options).unwrap_or_else(|e| panic!("{e}"));
     // Strokes: every true impact matched by a found one within 2 frames.
@@ -215,37 +231,17 @@ fn a_manual_alignment_is_applied() {
     let db = shipped_db();
     let capture = labcorpus::generate(&db, 3, &LabStyle::typical(Layout::Vicon).clean()).unwrap();
     let dir = std::env::temp_dir().join(format!("timpanist-lab-manual-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    for (name, bytes) in &capture.files {
-        std::fs::write(dir.join(name), bytes).unwrap();
-    }
-    let path = dir.join(&capture.truth.files[0]);
-    let take = read(Layout::Vicon, &path);
+    let (path, take) = write_and_read(&capture, &dir);
     std::fs::remove_dir_all(&dir).ok();
     let track = &capture.truth.tracks[0];
     let side = timpanist::mocap::db::side_index(track.hand);
-    let mut tips = [None, None];
-    tips[side] = Some(track.label.clone());
     let transform = align::Transform::parse("0.5,-1,0.02,90").unwrap();
     let mut out = MotionDb::empty("test");
     ingest::ingest(
         &mut out,
         &path,
         &take,
-        &IngestOptions {
-            tips,
-            up: UpAxis::Z,
-            tip_offset_m: None,
-            align: Alignment::Manual(transform),
-            mode: Some(timpanist::score::PlayingMode::Legato),
-            location: None,
-            dynamic: None,
-            grip: None,
-            hand: None,
-            performer: "test".into(),
-            segment: Default::default(),
-            dynamic_speeds: Default::default(),
-        },
+        &options_for(&capture.truth, Alignment::Manual(transform)),
     )
     .unwrap();
     let raw = take.track(&track.label).unwrap().positions[10].unwrap();
@@ -323,33 +319,17 @@ fn dynamics_are_read_from_impact_speeds() {
     }
     let capture = labcorpus::generate(&db, 16, &LabStyle::typical(Layout::Vicon)).unwrap();
     let dir = std::env::temp_dir().join(format!("timpanist-lab-dyn-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let (name, bytes) = &capture.files[0];
-    std::fs::write(dir.join(name), bytes).unwrap();
-    let path = dir.join(name);
-    let take = read(Layout::Vicon, &path);
+    let (path, take) = write_and_read(&capture, &dir);
     std::fs::remove_dir_all(&dir).ok();
     let track = &capture.truth.tracks[0];
-    let mut tips = [None, None];
-    tips[timpanist::mocap::db::side_index(track.hand)] = Some(track.label.clone());
     let mut out = MotionDb::empty("test");
     let report = ingest::ingest(
         &mut out,
         &path,
         &take,
         &IngestOptions {
-            tips,
-            up: UpAxis::Z,
-            tip_offset_m: None,
-            align: Alignment::None,
-            mode: capture.truth.source.mode,
-            location: None,
-            dynamic: None,
-            grip: capture.truth.source.grip,
-            hand: None,
-            performer: "test".into(),
-            segment: Default::default(),
             dynamic_speeds: speeds,
+            ..options_for(&capture.truth, Alignment::None)
         },
     )
     .unwrap();

@@ -176,11 +176,7 @@ pub fn read_with_unit(
     format: Option<Format>,
     unit: Option<&str>,
 ) -> Result<Take, ImportError> {
-    let unit = parse_unit_override(path, unit)?;
-    let bytes = std::fs::read(path).map_err(|source| ImportError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let (bytes, unit) = read_file(path, unit)?;
     let format = match format {
         Some(f) => f,
         None => Format::guess(path, &bytes).ok_or_else(|| {
@@ -227,12 +223,22 @@ pub fn read_with_profile(
     profile: &CaptureProfile,
     unit: Option<&str>,
 ) -> Result<Take, ImportError> {
+    let (bytes, unit) = read_file(path, unit)?;
+    table::read(path, &bytes, profile, unit)
+}
+
+/// The bytes of a capture file and the unit override parsed (checked first, so a bad
+/// `--unit` is said before any reading).
+fn read_file(
+    path: &Path,
+    unit: Option<&str>,
+) -> Result<(Vec<u8>, Option<LengthUnit>), ImportError> {
     let unit = parse_unit_override(path, unit)?;
     let bytes = std::fs::read(path).map_err(|source| ImportError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    table::read(path, &bytes, profile, unit)
+    Ok((bytes, unit))
 }
 
 fn parse_unit_override(path: &Path, unit: Option<&str>) -> Result<Option<LengthUnit>, ImportError> {
