@@ -24,8 +24,12 @@ fn fixture(name: &str) -> PathBuf {
         .join(name)
 }
 
-/// Read a generated capture as a user would: the named format or a capture profile.
+/// Read a generated capture as a user would: the named format or a capture profile (a
+/// `.c3d` file as C3D, whatever layout it was made from).
 fn read(layout: Layout, path: &Path) -> Take {
+    if path.extension().is_some_and(|e| e == "c3d") {
+        return import::read(path, Some(Format::C3d)).unwrap_or_else(|e| panic!("{e}"));
+    }
     match layout {
         Layout::Motive => import::read(path, Some(Format::Motive)),
         Layout::Vicon => import::read(path, Some(Format::Vicon)),
@@ -183,6 +187,18 @@ fn lab_captures_come_back() {
             labcorpus::generate(&db, (k * 11 + 5) % db.index.takes.len(), &style).unwrap()
         })
         .collect();
+    // The most common lab file of all: C3D (millimetres, Z up), here a Vicon marker capture
+    // written again by our C3D writer.
+    let vicon = labcorpus::generate(&db, 40, &LabStyle::typical(Layout::Vicon)).unwrap();
+    let marker_take = write_and_read(&vicon, &dir).1;
+    let name = vicon.truth.files[0].replace(".csv", ".c3d");
+    let mut c3d = vicon.clone();
+    c3d.files = vec![(
+        name.clone(),
+        timpanist::io::c3d_write::write_c3d(&marker_take),
+    )];
+    c3d.truth.files = vec![name];
+    captures.push(c3d);
     let x = std::fs::read_to_string(fixture("trajoptdrums/JointCenters_XPose_cm.csv")).unwrap();
     let y = std::fs::read_to_string(fixture("trajoptdrums/JointCenters_YPose_cm.csv")).unwrap();
     captures
