@@ -599,8 +599,8 @@ pub fn columns(file: &Path, profile: Option<&str>) -> anyhow::Result<()> {
 }
 
 /// Write the lab-style test corpus into `dir`: one capture per layout from takes of the
-/// shipped database (several modes and both hands), and one from the real TrajOptDrums
-/// stroke, with `truth.ron`.
+/// shipped database (several modes and both hands), the Vicon one again as C3D, and one
+/// from the real TrajOptDrums stroke, with `truth.ron`.
 pub fn corpus(dir: &Path, seed: u64) -> anyhow::Result<()> {
     use crate::mocap::labcorpus::{self, LabStyle, Layout};
     let db = MotionDb::load(&crate::mocap::db::default_dir())?;
@@ -612,6 +612,16 @@ pub fn corpus(dir: &Path, seed: u64) -> anyhow::Result<()> {
             ..LabStyle::typical(layout)
         };
         captures.push(labcorpus::generate(&db, (k * 7 + 3) % takes, &style)?);
+    }
+    // C3D, the commonest lab file: a Vicon marker capture written again as C3D.
+    if let Some(vicon) = captures.iter().find(|c| c.truth.layout == Layout::Vicon) {
+        let (name, bytes) = &vicon.files[0];
+        let take = crate::mocap::import::read_bytes(Path::new(name), bytes, Format::Vicon)?;
+        let c3d_name = name.replace(".csv", ".c3d");
+        let mut c3d = vicon.clone();
+        c3d.files = vec![(c3d_name.clone(), crate::io::c3d_write::write_c3d(&take))];
+        c3d.truth.files = vec![c3d_name];
+        captures.push(c3d);
     }
     let style = LabStyle {
         seed,

@@ -329,8 +329,9 @@ pub enum MocapCommand {
         profile: Option<String>,
     },
     /// Write a test corpus of captures the way real labs write them (lab offset and
-    /// turn, millimetres, rigid bodies off the tip, one stick per file, gaps, noise,
-    /// several layouts) from the shipped database, with the ground truth in truth.ron.
+    /// turn, millimetres, rigid bodies off the tip, one stick per file, gaps, noise;
+    /// Motive, Vicon, Qualisys 6D, TRC, C3D and a vendor CSV) from the shipped database and
+    /// the real TrajOptDrums stroke, with the ground truth in truth.ron.
     Corpus {
         /// The folder to write.
         output: PathBuf,
