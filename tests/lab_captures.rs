@@ -388,3 +388,31 @@ fn dynamics_are_read_from_impact_speeds() {
         assert!(mean_truth(w[0]) <= mean_truth(w[1]), "{pairs:?}");
     }
 }
+
+/// A lab capture imported without `--align` is kept where it is, and the import says its
+/// impacts lie on no drum and points to `--align auto`; aligned, it says nothing of it.
+#[test]
+fn cli_points_lab_coordinates_to_align() {
+    let db = shipped_db();
+    let capture = labcorpus::generate(&db, 3, &LabStyle::typical(Layout::Vicon)).unwrap();
+    let dir = std::env::temp_dir().join(format!("timpanist-lab-hint-{}", std::process::id()));
+    let (path, _) = write_and_read(&capture, &dir);
+    let run = |align: &str| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_timpanist"))
+            .args(["mocap", "import", "--mode", "legato", "--align", align])
+            .arg(&path)
+            .arg("-o")
+            .arg(dir.join(format!("db-{align}")))
+            .output()
+            .unwrap();
+        assert!(out.status.success());
+        String::from_utf8_lossy(&out.stderr).to_string()
+    };
+    let (kept, aligned) = (run("none"), run("auto"));
+    std::fs::remove_dir_all(&dir).ok();
+    assert!(
+        kept.contains("on no drum") && kept.contains("--align auto"),
+        "{kept}"
+    );
+    assert!(!aligned.contains("on no drum"), "{aligned}");
+}

@@ -250,6 +250,9 @@ pub fn import(args: ImportArgs) -> anyhow::Result<()> {
         };
         let report = ingest(&mut db, &source.path, &source.take, &options)?;
         print_report(source, &report, &align);
+        if matches!(align, Alignment::None) {
+            warn_if_off_the_kit(&source.path, &report);
+        }
     }
     std::fs::create_dir_all(&args.output)
         .map_err(|e| anyhow::anyhow!("{}: {e}", args.output.display()))?;
@@ -482,6 +485,31 @@ fn resolve_tips(
         );
     }
     Ok(tips)
+}
+
+/// A take kept in its own coordinates whose impacts are nowhere near a drum of the
+/// standard kit was most likely captured in lab coordinates: say so.
+fn warn_if_off_the_kit(path: &Path, report: &IngestReport) {
+    let kit = Kit::standard();
+    for h in &report.hands {
+        let Some(c) = h.impact_centroid_m else {
+            continue;
+        };
+        let on_a_drum = kit.drums.iter().any(|d| {
+            c.truncate().distance(d.centre().truncate()) <= d.radius_m() + 0.1
+                && (c.z - d.placement.head_height_m).abs() <= 0.15
+        });
+        if !on_a_drum {
+            eprintln!(
+                "note: {}: the {:?} stick's impacts lie around ({:.2}, {:.2}, {:.2}) m, on no drum of the standard kit: if the capture is in lab coordinates, import it with --align auto (or --align \"x,y,z,yaw\")",
+                path.display(),
+                h.hand,
+                c.x,
+                c.y,
+                c.z
+            );
+        }
+    }
 }
 
 /// Whether a track label names a stick or its tip (not an arm marker).

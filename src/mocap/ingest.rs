@@ -137,6 +137,8 @@ pub struct HandReport {
     pub tip_estimate: Option<TipEstimate>,
     /// Where the impacts landed after alignment.
     pub fit: Option<HandFit>,
+    /// The mean tip position at the impacts, as stored (after alignment), m.
+    pub impact_centroid_m: Option<DVec3>,
     /// Medians over the strokes: time between impacts, s; lift (top of the stroke above
     /// its impact), m; approach speed into the head, m/s.
     pub interval_s: Option<f64>,
@@ -308,6 +310,11 @@ pub fn ingest(
             filled_frames: seg.filled_frames,
             tip_estimate: s.estimate,
             fit: fits.iter().find(|f| f.hand == s.hand).copied(),
+            impact_centroid_m: {
+                let at: Vec<DVec3> = seg.impacts.iter().filter_map(|&i| filled[i]).collect();
+                (!at.is_empty())
+                    .then(|| transform.point(at.iter().sum::<DVec3>() / at.len() as f64))
+            },
             interval_s: stats.0,
             lift_m: stats.1,
             impact_speed_mps: stats.2,
