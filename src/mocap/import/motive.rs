@@ -15,8 +15,11 @@
 //!
 //! * Line 1: key/value pairs. Used: `Export Frame Rate` (else `Capture Frame Rate`) for
 //!   the rate, `Length Units` (`Meters`, `Centimeters`, `Millimeters`; metres if absent),
-//!   `Rotation Type` (only `Quaternion` is supported; Euler types are refused with a
-//!   clear error, as their axis convention is not pinned down here) and `Total Exported
+//!   `Rotation Type` (`Quaternion`, or Euler angles in degrees in one of the orders `XYZ`,
+//!   `XZY`, `YXZ`, `YZX`, `ZXY`, `ZYX`: Motive's Euler angles are relative (intrinsic) and
+//!   right-handed, so `XYZ` turns about X, then the new Y, then the new Z — R =
+//!   Rx·Ry·Rz — with each angle in the column of its axis; NaturalPoint, "Changes in
+//!   Motive's Reported Euler Angles", Motive 1.6 and later) and `Total Exported
 //!   Frames` (checked against the rows, so a truncated export is caught).
 //! * Header rows until the `Frame` row: `Type`, `Name`, optionally `ID` (told apart by
 //!   their second cell, or by order when it is empty), and the Rotation/Position row.
@@ -64,6 +67,8 @@ struct Meta<'r> {
     unit: LengthUnit,
     /// `Rotation Type`: the value's column and text.
     rotation_type: Option<(usize, &'r str)>,
+    /// The axes of an Euler rotation type, in order (0 = X); `None` for quaternions.
+    euler: Option<[usize; 3]>,
     /// `Total Exported Frames`, when given.
     total_frames: Option<usize>,
 }
@@ -183,13 +188,16 @@ fn read_meta<'r>(
         })?),
         _ => None,
     };
-    Ok(Meta {
+    let mut meta = Meta {
         line: first.line,
         rate_hz,
         unit,
         rotation_type: meta("Rotation Type"),
+        euler: None,
         total_frames,
-    })
+    };
+    meta.euler = euler_order(path, &meta)?;
+    Ok(meta)
 }
 
 /// The header rows between line 1 and the `Frame` row (blank lines before them
@@ -298,7 +306,7 @@ fn group_columns(
 }
 
 /// Check that every track has all three position columns and, if it has rotation
-/// columns, all four of them in quaternion form.
+/// columns, all of them: four for quaternions, three for Euler angles.
 fn check_entities(
     path: &Path,
     entities: &[Entity],
@@ -318,33 +326,64 @@ fn check_entities(
         }
         let rot = e.rotation.iter().filter(|c| c.is_some()).count();
         if rot > 0 {
-            if let Some((col, t)) = meta
-                .rotation_type
-                .filter(|(_, t)| !t.eq_ignore_ascii_case("Quaternion"))
-            {
-                return Err(ImportError::format(
-                    path,
-                    csv_text::place(meta.line, col),
-                    format!(
-                        "expected Rotation Type Quaternion, found \"{}\" (Euler angles are not \
-                         supported: export again with Rotation Type Quaternion)",
-                        csv_text::shorten(t)
-                    ),
-                ));
-            }
-            if rot != 4 {
+            let euler = euler_order(path, meta)?;
+            let (want, names) = match euler {
+                Some(_) => (3, "X, Y and Z"),
+                None => (4, "X, Y, Z and W"),
+            };
+            if rot != want || (euler.is_some() && e.rotation[3].is_some()) {
                 return Err(ImportError::format(
                     path,
                     csv_text::place(rows.kind.line, e.first_col),
                     format!(
-                        "expected Rotation X, Y, Z and W columns for \"{}\", found {rot} of them",
-                        e.label
+                        "expected Rotation {names} columns for \"{}\" (Rotation Type {}), found {rot} of them",
+                        e.label,
+                        meta.rotation_type.map_or("Quaternion", |(_, t)| t)
                     ),
                 ));
             }
         }
     }
     Ok(())
+}
+
+/// The Euler order the `Rotation Type` names (`None`: quaternions, also when absent), or
+/// an error naming the place for a type Motive does not write.
+fn euler_order(path: &Path, meta: &Meta) -> Result<Option<[usize; 3]>, ImportError> {
+    let Some((col, text)) = meta.rotation_type else {
+        return Ok(None);
+    };
+    if text.eq_ignore_ascii_case("Quaternion") {
+        return Ok(None);
+    }
+    let axes: Vec<usize> = text
+        .to_ascii_uppercase()
+        .chars()
+        .filter_map(|c| "XYZ".find(c))
+        .collect();
+    match axes[..] {
+        [a, b, c] if text.len() == 3 && a != b && b != c && a != c => Ok(Some([a, b, c])),
+        _ => Err(ImportError::format(
+            path,
+            csv_text::place(meta.line, col),
+            format!(
+                "expected Rotation Type Quaternion, XYZ, XZY, YXZ, YZX, ZXY or ZYX, found \"{}\"",
+                csv_text::shorten(text)
+            ),
+        )),
+    }
+}
+
+/// The rotation of Motive's relative (intrinsic) Euler angles: about the first axis of
+/// `order`, then the new second, then the new third; `degrees` holds the X, Y and Z
+/// angles.
+fn intrinsic(order: [usize; 3], degrees: glam::DVec3) -> glam::DQuat {
+    let axis = |i: usize| [glam::DVec3::X, glam::DVec3::Y, glam::DVec3::Z][i];
+    order
+        .iter()
+        .map(|&i| glam::DQuat::from_axis_angle(axis(i), degrees[i].to_radians()))
+        .fold(glam::DQuat::IDENTITY, |q, r| q * r)
+        .normalize()
 }
 
 /// Read the data rows after the `Frame` row (line `frame_line`) into one track per
@@ -394,10 +433,15 @@ fn read_data<'a>(
             track
                 .positions
                 .push(csv_text::position(path, &row, [x, y, z], scale)?);
-            if let [Some(qx), Some(qy), Some(qz), Some(qw)] = e.rotation {
-                track
+            match (e.rotation, meta.euler) {
+                ([Some(qx), Some(qy), Some(qz), Some(qw)], None) => track
                     .rotations
-                    .push(quaternion(path, &row, [qx, qy, qz, qw])?);
+                    .push(quaternion(path, &row, [qx, qy, qz, qw])?),
+                ([Some(rx), Some(ry), Some(rz), None], Some(order)) => {
+                    let degrees = csv_text::position(path, &row, [rx, ry, rz], 1.0)?;
+                    track.rotations.push(degrees.map(|a| intrinsic(order, a)));
+                }
+                _ => {}
             }
         }
         frames += 1;
@@ -496,6 +540,7 @@ fn unique_labels(entities: &[Entity]) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::DQuat;
 
     const HEAD: &str = "Format Version,1.23,Take Name,t,Export Frame Rate,100.000000,Total Exported Frames,2,Rotation Type,Quaternion,Length Units,Millimeters\n\n";
 
@@ -525,6 +570,42 @@ mod tests {
         assert_eq!(take.tracks[1].positions[0], None);
     }
 
+    /// Euler rotation types: relative (intrinsic) angles in degrees, each in its axis's
+    /// column, composed in the named order.
+    #[test]
+    fn euler_rotation_types() {
+        let body = ",Type,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body\n\
+                    ,Name,A,A,A,A,A,A\n\
+                    ,,Rotation,Rotation,Rotation,Position,Position,Position\n\
+                    Frame,Time (Seconds),X,Y,Z,X,Y,Z\n\
+                    0,0,30,-20,90,1,2,3\n1,0.01,,,,,,\n";
+        let (x, y, z) = (
+            30f64.to_radians(),
+            (-20f64).to_radians(),
+            90f64.to_radians(),
+        );
+        for (order, want) in [
+            (
+                "XYZ",
+                DQuat::from_rotation_x(x) * DQuat::from_rotation_y(y) * DQuat::from_rotation_z(z),
+            ),
+            (
+                "ZYX",
+                DQuat::from_rotation_z(z) * DQuat::from_rotation_y(y) * DQuat::from_rotation_x(x),
+            ),
+            (
+                "YZX",
+                DQuat::from_rotation_y(y) * DQuat::from_rotation_z(z) * DQuat::from_rotation_x(x),
+            ),
+        ] {
+            let text = format!("{}{body}", HEAD.replace("Quaternion", order));
+            let take = read(p(), text.as_bytes(), None).unwrap();
+            let q = take.tracks[0].rotations[0].unwrap();
+            assert!(q.dot(want).abs() > 1.0 - 1e-12, "{order}: {q} vs {want}");
+            assert_eq!(take.tracks[0].rotations[1], None, "a gap stays a gap");
+        }
+    }
+
     #[test]
     fn errors() {
         let body = ",Type,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body\n\
@@ -535,8 +616,12 @@ mod tests {
         let cases = [
             (format!("Format,1\n\n{body}{ok_rows}"), "line 1, column 1"),
             (
+                format!("{}{body}{ok_rows}", HEAD.replace("Quaternion", "Matrix")),
+                "line 1, column 10: expected Rotation Type Quaternion, XYZ",
+            ),
+            (
                 format!("{}{body}{ok_rows}", HEAD.replace("Quaternion", "XYZ")),
-                "line 1, column 10: expected Rotation Type Quaternion",
+                "expected Rotation X, Y and Z columns for \"A\" (Rotation Type XYZ), found 4",
             ),
             (
                 format!("{}{body}{ok_rows}", HEAD.replace("Millimeters", "Inches")),
