@@ -97,7 +97,7 @@ fn add_beat_set_mode_undo_redo() {
     // Half-way between two beats of the demo, in the Left lane.
     let tick = 960 * 4 * 2 + 480;
     assert!(before.iter().all(|b| b.tick != tick));
-    let at = h.state().timeline_point(tick, Hand::Left).unwrap();
+    let at = common::steady_timeline_point(&mut h, tick, Hand::Left);
     click(&mut h, at);
     let app = h.state();
     let beats = &app.loaded().unwrap().score.beats;
@@ -225,7 +225,7 @@ fn drag_handle_in_3d_is_one_step() {
 fn save_and_reopen() {
     let dir = tempfile::tempdir().unwrap();
     let mut h = harness(Some(demo()), dir.path());
-    let at = h.state().timeline_point(960 * 3, Hand::Right).unwrap();
+    let at = common::steady_timeline_point(&mut h, 960 * 3, Hand::Right);
     click(&mut h, at);
     let edited = h.state().loaded().unwrap().score.clone();
     let target = dir.path().join("saved.ron");
@@ -246,7 +246,7 @@ fn quit_with_unsaved_changes_asks() {
     let dir = tempfile::tempdir().unwrap();
     let mut h = harness(Some(demo()), dir.path());
     assert!(h.state_mut().request_quit(), "nothing to lose yet");
-    let at = h.state().timeline_point(960 * 3, Hand::Right).unwrap();
+    let at = common::steady_timeline_point(&mut h, 960 * 3, Hand::Right);
     click(&mut h, at);
     assert!(!h.state_mut().request_quit());
     settle(&mut h);
@@ -372,11 +372,11 @@ fn a_new_beat_goes_on_a_drum_of_its_hand() {
         settle(&mut h);
         assert!(h.state().selection().beats.is_empty());
         let before = h.state().loaded().unwrap().score.beats.clone();
-        let at = h.state().timeline_point(tick, hand).unwrap();
+        let at = common::steady_timeline_point(&mut h, tick, hand);
         click(&mut h, at);
         let beats = &h.state().loaded().unwrap().score.beats;
         let added: Vec<_> = beats.iter().filter(|b| !before.contains(b)).collect();
-        assert_eq!(added.len(), 1, "{hand:?}");
+        assert_eq!(added.len(), 1, "{hand:?} at {at:?}");
         let drum = &kit.drums[added[0].drum];
         assert_eq!(
             Some(drum.preferred_hand),

@@ -44,3 +44,23 @@ pub fn settle(h: &mut Harness<'static, EditorApp>) {
     h.state_mut().wait_for_composition();
     h.run();
 }
+
+/// Where `tick` lies in `hand`'s lane once the layout has stopped moving (a panel that
+/// opens or closes animates over a few frames, and a click aimed at the first frame's
+/// geometry can land beside its lane): the point two settled frames agree on.
+pub fn steady_timeline_point(
+    h: &mut Harness<'static, EditorApp>,
+    tick: u64,
+    hand: timpanist::score::Hand,
+) -> egui::Pos2 {
+    let mut point = h.state().timeline_point(tick, hand);
+    for _ in 0..30 {
+        settle(h);
+        let now = h.state().timeline_point(tick, hand);
+        if now == point {
+            break;
+        }
+        point = now;
+    }
+    point.expect("the timeline has been drawn")
+}
