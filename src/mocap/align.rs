@@ -25,6 +25,7 @@
 //! and how far each hand's centroid lies from its target.
 
 use super::db::MotionDb;
+use crate::base::stats::median;
 use crate::body::skeleton::{Joint, Skeleton};
 use crate::kit::{Kit, Side};
 use crate::score::{Grip, ImpactLocation, PlayingMode};
@@ -203,15 +204,11 @@ pub fn fit(
         .map(|(s, t)| (t.point - rotation * s.centroid()).truncate() * weight(s))
         .sum::<DVec2>()
         / total;
-    let mut offsets: Vec<f64> = pairs
-        .iter()
-        .flat_map(|(s, t)| {
-            let head = kit.drums[t.drum].placement.head_height_m;
-            s.impacts.iter().map(move |p| head - p.z)
-        })
-        .collect();
-    offsets.sort_by(f64::total_cmp);
-    let vertical = offsets[offsets.len() / 2];
+    let vertical = median(pairs.iter().flat_map(|(s, t)| {
+        let head = kit.drums[t.drum].placement.head_height_m;
+        s.impacts.iter().map(move |p| head - p.z)
+    }))
+    .unwrap_or(0.0);
     Ok(Transform {
         yaw_rad: yaw,
         translation_m: horizontal.extend(vertical),

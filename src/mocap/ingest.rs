@@ -15,6 +15,7 @@ use super::segment::{
 };
 use super::take::{ImportError, Take, Track};
 use super::tip_estimate::{self, TipEstimate, TipEstimateError};
+use crate::base::stats::median;
 use crate::kit::{Kit, Side};
 use crate::score::{Dynamic, Grip, ImpactLocation, PlayingMode};
 use glam::{DQuat, DVec3};
@@ -568,27 +569,18 @@ fn stroke_stats(
 ) -> (Option<f64>, Option<f64>, Option<f64>) {
     let height = heights(tip, rate_hz, params);
     let impacts = impacts_of(tip, rate_hz, params);
-    let median = |mut xs: Vec<f64>| {
-        xs.retain(|x| x.is_finite());
-        xs.sort_by(f64::total_cmp);
-        (!xs.is_empty()).then(|| xs[xs.len() / 2])
-    };
     let intervals = impacts
         .windows(2)
-        .map(|w| (w[1].frame - w[0].frame) as f64 / rate_hz)
-        .collect();
-    let lifts = impacts
-        .windows(2)
-        .map(|w| {
-            height[w[0].frame..w[1].frame]
-                .iter()
-                .copied()
-                .filter(|h| h.is_finite())
-                .fold(f64::NEG_INFINITY, f64::max)
-                - w[1].height_m
-        })
-        .collect();
-    let speeds = impacts.iter().map(|i| i.approach_mps).collect();
+        .map(|w| (w[1].frame - w[0].frame) as f64 / rate_hz);
+    let lifts = impacts.windows(2).map(|w| {
+        height[w[0].frame..w[1].frame]
+            .iter()
+            .copied()
+            .filter(|h| h.is_finite())
+            .fold(f64::NEG_INFINITY, f64::max)
+            - w[1].height_m
+    });
+    let speeds = impacts.iter().map(|i| i.approach_mps);
     (median(intervals), median(lifts), median(speeds))
 }
 
@@ -662,13 +654,8 @@ pub fn dynamic_speeds(db: &MotionDb) -> DynamicSpeeds {
         Dynamic::MARKS
             .iter()
             .filter_map(|&(d, _, _)| {
-                let mut v: Vec<f64> = samples
-                    .iter()
-                    .filter(|s| s.1 == d && keep(&s.0))
-                    .map(|s| s.2)
-                    .collect();
-                v.sort_by(f64::total_cmp);
-                (!v.is_empty()).then(|| (d, v[v.len() / 2]))
+                let speeds = samples.iter().filter(|s| s.1 == d && keep(&s.0));
+                Some((d, median(speeds.map(|s| s.2))?))
             })
             .collect()
     };

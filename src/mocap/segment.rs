@@ -16,6 +16,7 @@
 //! previous stroke's rebound to the end of its own rebound; the first and last strokes of a
 //! take are dropped as broken.
 
+use crate::base::stats::median;
 use glam::DVec3;
 
 /// Segmentation thresholds.
@@ -299,7 +300,7 @@ pub fn find_impacts(
             }),
         }
     }
-    let plane = median(accepted.iter().map(|c| c.height_m).collect());
+    let plane = median(accepted.iter().map(|c| c.height_m));
     if let (Some(plane), Some(tolerance)) = (plane, params.plane_tolerance_m) {
         accepted.retain(|c| {
             let keep = (c.height_m - plane).abs() <= tolerance;
@@ -410,15 +411,6 @@ fn vertical_velocity(height: &[f64], rate_hz: f64, k: usize) -> Vec<f64> {
             }
         })
         .collect()
-}
-
-fn median(mut xs: Vec<f64>) -> Option<f64> {
-    xs.retain(|x| x.is_finite());
-    if xs.is_empty() {
-        return None;
-    }
-    xs.sort_by(f64::total_cmp);
-    Some(xs[xs.len() / 2])
 }
 
 #[cfg(test)]

@@ -38,6 +38,7 @@
 //! impacts a little. When the tip offset is known, give it.
 
 use super::segment::{SegmentParams, find_impacts};
+use crate::base::stats::median;
 use glam::{DMat3, DMat4, DQuat, DVec3, DVec4};
 
 /// The estimated tip offset and how well the capture determines it.
@@ -192,7 +193,7 @@ fn prior_offset(
     let axis = turning_axis(poses, rate_hz);
     let lateral = (axis - g * axis.dot(g)).normalize_or(g.any_orthonormal_vector());
     let forward = lateral.cross(g).normalize_or(DVec3::X);
-    let origin_height = median(at.iter().map(|p| p.0.z).collect());
+    let origin_height = median_or_zero(at.iter().map(|p| p.0.z));
     let a = (head_height_m - origin_height).min(0.0);
     let b = (PRIOR_LENGTH_M * PRIOR_LENGTH_M - a * a).max(0.01).sqrt();
     // The tip is the end that comes down fastest (farthest from the grip it turns about).
@@ -205,12 +206,11 @@ fn prior_offset(
             plane_tolerance_m: None,
             ..SegmentParams::default()
         };
-        median(
+        median_or_zero(
             find_impacts(&z, rate_hz, &params)
                 .0
                 .iter()
-                .map(|i| i.approach_mps)
-                .collect(),
+                .map(|i| i.approach_mps),
         )
     };
     let (ahead, behind) = (g * a + forward * b, g * a - forward * b);
@@ -277,9 +277,9 @@ fn reliable(rows: Vec<(DVec3, f64)>, keep: &[bool], noise_var: f64) -> Vec<(DVec
 /// 3°) or four median deviations of the median `g`, whichever is wider. A minimum found at
 /// another phase of the stroke has the stick at another angle.
 fn usual_angles(rows: &[(DVec3, f64)]) -> Vec<bool> {
-    let component = |f: fn(DVec3) -> f64| median(rows.iter().map(|r| f(r.0)).collect());
+    let component = |f: fn(DVec3) -> f64| median_or_zero(rows.iter().map(|r| f(r.0)));
     let centre = DVec3::new(component(|g| g.x), component(|g| g.y), component(|g| g.z));
-    let spread = median(rows.iter().map(|r| r.0.distance(centre)).collect());
+    let spread = median_or_zero(rows.iter().map(|r| r.0.distance(centre)));
     let limit = (4.0 * spread).max(0.05);
     rows.iter().map(|r| r.0.distance(centre) <= limit).collect()
 }
@@ -296,11 +296,10 @@ fn rotation_noise_var(poses: &[Option<Pose>]) -> f64 {
             Some(axis * wrap(angle))
         })
         .collect();
-    let squares: Vec<f64> = steps
+    let squares = steps
         .windows(2)
-        .filter_map(|w| Some((w[1]? - w[0]?).length_squared()))
-        .collect();
-    median(squares) / (6.0 * 2.37)
+        .filter_map(|w| Some((w[1]? - w[0]?).length_squared()));
+    median_or_zero(squares) / (6.0 * 2.37)
 }
 
 /// An angle in (−π, π].
@@ -388,7 +387,7 @@ fn fit(
                 .map(|&(g, z)| z + g.dot(solution.0) - solution.1)
                 .collect();
             let spread = mad(&residuals).max(1e-4);
-            let centre = median(residuals.clone());
+            let centre = median_or_zero(residuals.iter().copied());
             keep = residuals
                 .iter()
                 .zip(&usual)
@@ -442,13 +441,9 @@ fn solve(
     (x.truncate(), x.w, covariance)
 }
 
-fn median(mut xs: Vec<f64>) -> f64 {
-    xs.retain(|x| x.is_finite());
-    if xs.is_empty() {
-        return 0.0;
-    }
-    xs.sort_by(f64::total_cmp);
-    xs[xs.len() / 2]
+/// The median of the finite values, 0 for none.
+fn median_or_zero(xs: impl IntoIterator<Item = f64>) -> f64 {
+    median(xs).unwrap_or(0.0)
 }
 
 /// Median absolute deviation from the median (infinite for no values).
@@ -456,8 +451,8 @@ fn mad(xs: &[f64]) -> f64 {
     if xs.is_empty() {
         return f64::INFINITY;
     }
-    let m = median(xs.to_vec());
-    median(xs.iter().map(|x| (x - m).abs()).collect())
+    let m = median_or_zero(xs.iter().copied());
+    median_or_zero(xs.iter().map(|x| (x - m).abs()))
 }
 
 #[cfg(test)]

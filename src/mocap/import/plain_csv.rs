@@ -230,9 +230,7 @@ fn rate_from_times(path: &Path, times: &[(usize, f64)]) -> Result<f64, ImportErr
         }
         steps.push(t1 - t0);
     }
-    let mut sorted = steps.clone();
-    sorted.sort_by(f64::total_cmp);
-    let median = sorted[sorted.len() / 2];
+    let median = crate::base::stats::median(steps.iter().copied()).unwrap_or(0.0);
     for (step, w) in steps.iter().zip(times.windows(2)) {
         if (step - median).abs() > 0.01 * median {
             return Err(ImportError::format(

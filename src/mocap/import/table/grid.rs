@@ -209,9 +209,7 @@ pub(super) fn rate_from_times(
              `rate_hz` in the profile), found one",
         ));
     }
-    let mut steps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
-    steps.sort_by(f64::total_cmp);
-    let median = steps[steps.len() / 2];
+    let median = crate::base::stats::median(times.windows(2).map(|w| w[1] - w[0])).unwrap_or(0.0);
     let frames: f64 = times
         .windows(2)
         .map(|w| ((w[1] - w[0]) / median).round().max(1.0))
