@@ -242,9 +242,7 @@ impl HeadModes {
         Ok(HeadModes {
             radius_m: a,
             centre: drum.centre(),
-            toward_player: (-drum.centre().truncate())
-                .try_normalize()
-                .unwrap_or(DVec2::NEG_Y),
+            toward_player: drum.toward_player(),
             modes,
         })
     }

@@ -151,12 +151,14 @@ impl Drum {
     /// 1 rim) and an angle in degrees measured from the direction pointing from the head
     /// centre to the player, counter-clockwise seen from above.
     pub fn point_on_head(&self, radius_fraction: f64, angle_deg: f64) -> DVec3 {
-        let centre = self.centre();
-        let to_player = (-centre.truncate())
-            .try_normalize()
-            .unwrap_or(glam::DVec2::NEG_Y);
-        let dir = glam::DVec2::from_angle(angle_deg.to_radians()).rotate(to_player);
-        centre + (dir * radius_fraction * self.radius_m()).extend(0.0)
+        let dir = glam::DVec2::from_angle(angle_deg.to_radians()).rotate(self.toward_player());
+        self.centre() + (dir * radius_fraction * self.radius_m()).extend(0.0)
+    }
+
+    /// The horizontal unit vector from the head centre toward the player, who stands at the
+    /// origin (−y for a drum placed at the origin itself).
+    pub fn toward_player(&self) -> glam::DVec2 {
+        (-self.centre().truncate()).normalize_or(glam::DVec2::NEG_Y)
     }
 
     /// Frequency of the (1,1) mode at the kit tuning predicted from the membrane,
@@ -222,6 +224,17 @@ impl Kit {
     /// The standard four-drum set (32, 29, 26, 23 inch).
     pub fn standard() -> Kit {
         Kit::bundled("standard").expect("the standard kit is bundled")
+    }
+
+    /// The drum whose head centre is horizontally nearest `point` (m), among the drums
+    /// `hand` prefers when given; `None` when there is no such drum.
+    pub fn nearest_drum(&self, point: DVec3, hand: Option<Side>) -> Option<usize> {
+        (0..self.drums.len())
+            .filter(|&i| hand.is_none_or(|h| self.drums[i].preferred_hand == h))
+            .min_by(|&a, &b| {
+                let d = |i: usize| self.drums[i].centre().truncate().distance(point.truncate());
+                d(a).total_cmp(&d(b))
+            })
     }
 
     /// Drums whose range holds `pitch`, by index.

@@ -24,9 +24,9 @@
 //! [`report`] says how well it fits: how far the aligned impacts lie from the head plane
 //! and how far each hand's centroid lies from its target.
 
-use super::db::MotionDb;
+use super::db::{MotionDb, side_index};
 use crate::base::stats::median;
-use crate::body::skeleton::{Joint, Skeleton};
+use crate::body::skeleton::Joint;
 use crate::kit::{Kit, Side};
 use crate::score::{Grip, ImpactLocation, PlayingMode};
 use glam::{DQuat, DVec2, DVec3};
@@ -160,19 +160,6 @@ pub enum AlignError {
     NoFacing(f64),
 }
 
-/// The direction from a drum's head centre toward the player (at the origin), horizontal.
-pub fn toward_player(kit: &Kit, drum: usize) -> DVec2 {
-    (-kit.drums[drum].centre().truncate()).normalize_or(DVec2::NEG_Y)
-}
-
-/// Index (left 0, right 1) of a hand.
-fn side_index(side: Side) -> usize {
-    match side {
-        Side::Left => 0,
-        Side::Right => 1,
-    }
-}
-
 /// Fit the lab → performer transform of one take: `strokes[k]` belong at `targets[k]`.
 pub fn fit(
     strokes: &[HandStrokes],
@@ -226,7 +213,7 @@ fn facing_yaw(
     let mut travel: f64 = 0.0;
     for (s, t) in pairs {
         let h = side_index(s.hand);
-        let toward = toward_player(kit, t.drum);
+        let toward = kit.drums[t.drum].toward_player();
         let expected = [
             habits.approach_angle_rad[h],
             habits.lift_angle_rad[h],
@@ -300,7 +287,7 @@ pub fn report(
 pub fn measure_habits(strokes: &[(HandStrokes, usize)], kit: &Kit) -> Habits {
     let mut sums = [[DVec2::ZERO; 2]; 3];
     for (s, drum) in strokes {
-        let toward = toward_player(kit, *drum);
+        let toward = kit.drums[*drum].toward_player();
         // Express a cue in the drum's frame: x toward the player.
         let local = |v: DVec2| DVec2::new(v.dot(toward), toward.perp_dot(v));
         for (k, cue) in s.cues().into_iter().enumerate() {
@@ -349,7 +336,7 @@ impl HabitBook {
 /// kinematics on the synthetic performer's skeleton: 1.75 m, the kit's first mallet), on
 /// the drum nearest its impact.
 pub fn habits_of(db: &MotionDb, kit: &Kit) -> HabitBook {
-    let skeleton = Skeleton::new(1.75, kit.mallets.first().map_or(0.37, |m| m.length_m));
+    let skeleton = super::synth::performer_skeleton(kit);
     let mut groups: Vec<(StrokeKind, Vec<(HandStrokes, usize)>)> = Vec::new();
     for u in &db.index.units {
         let Some(data) = db.takes.get(u.take) else {
@@ -364,10 +351,7 @@ pub fn habits_of(db: &MotionDb, kit: &Kit) -> HabitBook {
             let grip = frames.position[Joint::arm(u.hand)[3].index()];
             strokes.sticks.push((frames.tip(u.hand) - grip).truncate());
         }
-        let Some(drum) = (0..kit.drums.len()).min_by(|&a, &b| {
-            let d = |i: usize| kit.drums[i].centre().truncate().distance(impact.truncate());
-            d(a).total_cmp(&d(b))
-        }) else {
+        let Some(drum) = kit.nearest_drum(impact, None) else {
             continue;
         };
         let key = (u.grip, u.mode, u.location.name());
@@ -445,7 +429,7 @@ mod tests {
     ) -> HandStrokes {
         let h = side_index(hand);
         let target = kit.drums[drum].point_on_head(2.0 / 3.0, 0.0);
-        let toward = toward_player(kit, drum);
+        let toward = kit.drums[drum].toward_player();
         let turn_back = DQuat::from_rotation_z(-lab.yaw_rad);
         let cue = |angle: f64, length: f64| {
             (turn_back * (DVec2::from_angle(angle).rotate(toward) * length).extend(0.0)).truncate()

@@ -222,6 +222,12 @@ struct SynthTake {
     strokes: Vec<(f64, Dynamic)>,
 }
 
+/// The synthetic performer's skeleton: 1.75 m tall, holding `kit`'s first mallets (the
+/// body the shipped database's joint angles belong to).
+pub fn performer_skeleton(kit: &Kit) -> Skeleton {
+    Skeleton::new(1.75, kit.mallets.first().map_or(0.37, |m| m.length_m))
+}
+
 /// The synthetic performer.
 pub struct Performer {
     pub skeleton: Skeleton,
@@ -242,7 +248,7 @@ impl Performer {
     pub fn new() -> Performer {
         let kit = Kit::standard();
         Performer {
-            skeleton: Skeleton::new(1.75, kit.mallets[0].length_m),
+            skeleton: performer_skeleton(&kit),
             kit,
             height_scale: [1.0, 1.0],
         }
@@ -302,7 +308,7 @@ impl Performer {
         let height = nominal * self.height_scale[grip_index(grip)];
         let reference = reference_pose(grip);
         let drum = &self.kit.drums[self.drum_for(hand)];
-        let toward_player = (-drum.centre().truncate()).normalize().extend(0.0);
+        let toward_player = drum.toward_player().extend(0.0);
         let (radius, angle) = location.polar();
         let mut labels: Vec<Dynamic> = vec![dynamics[0]];
         for d in dynamics {

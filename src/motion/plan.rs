@@ -266,9 +266,7 @@ pub fn plan(
                 hand,
                 time_s: tempo.seconds_at(tick as f64),
                 target,
-                toward_player: (-drum.centre().truncate())
-                    .normalize_or(glam::DVec2::NEG_Y)
-                    .extend(0.0),
+                toward_player: drum.toward_player().extend(0.0),
                 drum: beat.drum,
                 mode: beat.mode,
                 dynamic: beat.dynamic,

@@ -149,17 +149,10 @@ pub(super) fn mean(points: &[DVec3]) -> DVec3 {
 /// drums `hand` plays by default, if given): index and name.
 pub(super) fn nearest_drum(point: DVec3, hand: Option<Side>) -> (usize, String) {
     let kit = Kit::standard();
-    let (i, drum) = kit
-        .drums
-        .iter()
-        .enumerate()
-        .filter(|(_, d)| hand.is_none_or(|h| d.preferred_hand == h))
-        .min_by(|a, b| {
-            let d = |c: DVec3| c.truncate().distance(point.truncate());
-            d(a.1.centre()).total_cmp(&d(b.1.centre()))
-        })
+    let i = kit
+        .nearest_drum(point, hand)
         .expect("the standard kit has a drum for each hand");
-    (i, drum.name.clone())
+    (i, kit.drums[i].name.clone())
 }
 
 /// Mixes two samples: linear interpolation of positions, slerp of rotations.
