@@ -10,9 +10,7 @@
 
 use super::align::{self, HabitBook, HandFit, HandStrokes, Target, Transform};
 use super::db::{MotionDb, TakeData, TakeEntry, UnitEntry};
-use super::segment::{
-    Impact, RejectionCounts, SegmentParams, UnitSpan, fill_gaps, find_impacts, segment,
-};
+use super::segment::{Impact, RejectionCounts, SegmentParams, UnitSpan, fill_gaps, segment};
 use super::take::{ImportError, Take, Track};
 use super::tip_estimate::{self, TipEstimate, TipEstimateError};
 use crate::base::stats::median;
@@ -253,9 +251,9 @@ pub fn ingest(
         .iter()
         .map(|s| segment(&s.tip, rate, &options.segment))
         .collect();
-    let transform = match &options.align {
-        Alignment::None => Transform::IDENTITY,
-        Alignment::Manual(t) => *t,
+    let (transform, fits) = match &options.align {
+        Alignment::None => (Transform::IDENTITY, Vec::new()),
+        Alignment::Manual(t) => (*t, Vec::new()),
         Alignment::Auto { kit, habits, .. } => {
             let strokes: Vec<HandStrokes> = sticks
                 .iter()
@@ -263,39 +261,21 @@ pub fn ingest(
                 .map(|(s, seg)| s.strokes(rate, &seg.impacts))
                 .collect();
             let targets = target_list(options, path, &sticks, location)?;
-            align::fit(
-                &strokes,
-                &targets,
-                kit,
-                &habits.for_stroke(grip, mode, location),
-            )
-            .map_err(|e| ImportError::format(path, "alignment", e.to_string()))?
+            let habits = habits.for_stroke(grip, mode, location);
+            let transform = align::fit(&strokes, &targets, kit, &habits)
+                .map_err(|e| ImportError::format(path, "alignment", e.to_string()))?;
+            let fits = align::report(&strokes, &targets, kit, &transform);
+            (transform, fits)
         }
-    };
-    let fits = match &options.align {
-        Alignment::Auto { kit, .. } => {
-            let strokes: Vec<HandStrokes> = sticks
-                .iter()
-                .zip(&segmentations)
-                .map(|(s, seg)| s.strokes(rate, &seg.impacts))
-                .collect();
-            align::report(
-                &strokes,
-                &target_list(options, path, &sticks, location)?,
-                kit,
-                &transform,
-            )
-        }
-        _ => Vec::new(),
     };
     let take_index = db.index.takes.len();
     let mut tips: [Vec<Option<DVec3>>; 2] = [vec![None; take.frames], vec![None; take.frames]];
     let mut hands = Vec::new();
     for (s, seg) in sticks.into_iter().zip(segmentations) {
-        let stats = stroke_stats(&s.tip, rate, &options.segment);
         // The stored tip has its short gaps filled as segmentation saw them; a unit with a
         // longer gap inside is left out (composition would have to jump over it).
         let filled = fill_gaps(&s.tip, (options.segment.max_gap_s * rate).round() as usize);
+        let stats = stroke_stats(&filled, &seg.found, rate);
         let (whole, gapped): (Vec<&UnitSpan>, Vec<&UnitSpan>) = seg
             .units
             .iter()
@@ -320,11 +300,11 @@ pub fn ingest(
             lift_m: stats.1,
             impact_speed_mps: stats.2,
         });
-        let impacts = impacts_of(&s.tip, rate, &options.segment);
         let unit_dynamic = |frame: usize| {
-            let speed = impacts
+            let speed = seg
+                .found
                 .iter()
-                .find(|i| i.frame.abs_diff(frame) <= 1)
+                .find(|i| i.frame == frame)
                 .map(|i| i.approach_mps);
             match speed {
                 Some(v) if by_speed => {
@@ -561,14 +541,14 @@ fn find_track<'a>(path: &Path, take: &'a Take, label: &str) -> Result<&'a Track,
     })
 }
 
-/// Medians of the interval between impacts, the lift and the approach speed of a tip.
+/// Medians of the interval between `impacts`, the lift and the approach speed of a tip
+/// (`filled`: its short gaps filled).
 fn stroke_stats(
-    tip: &[Option<DVec3>],
+    filled: &[Option<DVec3>],
+    impacts: &[Impact],
     rate_hz: f64,
-    params: &SegmentParams,
 ) -> (Option<f64>, Option<f64>, Option<f64>) {
-    let height = heights(tip, rate_hz, params);
-    let impacts = impacts_of(tip, rate_hz, params);
+    let height: Vec<f64> = filled.iter().map(|p| p.map_or(f64::NAN, |p| p.z)).collect();
     let intervals = impacts
         .windows(2)
         .map(|w| (w[1].frame - w[0].frame) as f64 / rate_hz);
@@ -582,19 +562,6 @@ fn stroke_stats(
     });
     let speeds = impacts.iter().map(|i| i.approach_mps);
     (median(intervals), median(lifts), median(speeds))
-}
-
-/// A tip's heights with its short gaps filled (NaN where still unseen), m.
-fn heights(tip: &[Option<DVec3>], rate_hz: f64, params: &SegmentParams) -> Vec<f64> {
-    fill_gaps(tip, (params.max_gap_s * rate_hz).round() as usize)
-        .iter()
-        .map(|p| p.map_or(f64::NAN, |p| p.z))
-        .collect()
-}
-
-/// The impacts of a tip, with their approach speeds.
-fn impacts_of(tip: &[Option<DVec3>], rate_hz: f64, params: &SegmentParams) -> Vec<Impact> {
-    find_impacts(&heights(tip, rate_hz, params), rate_hz, params).0
 }
 
 /// How fast each dynamic marking strikes, per grip and playing mode (an accent strikes
@@ -639,7 +606,7 @@ pub fn dynamic_speeds(db: &MotionDb) -> DynamicSpeeds {
             if units.is_empty() {
                 continue;
             }
-            for i in impacts_of(data.tip(side), data.rate_hz, &params) {
+            for i in segment(data.tip(side), data.rate_hz, &params).found {
                 let Some(u) = units.iter().find(|u| u.impact.abs_diff(i.frame) <= 1) else {
                     continue;
                 };

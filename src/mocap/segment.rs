@@ -173,6 +173,8 @@ pub struct UnitSpan {
 pub struct Segmentation {
     /// Every impact frame, in order.
     pub impacts: Vec<usize>,
+    /// The same impacts with their heights, approach speeds and reversals.
+    pub found: Vec<Impact>,
     /// The estimated membrane height, m (`None` without impacts).
     pub plane_height_m: Option<f64>,
     /// Complete units (the broken first and last strokes dropped).
@@ -362,6 +364,7 @@ pub fn segment(tip: &[Option<DVec3>], rate_hz: f64, params: &SegmentParams) -> S
         .collect();
     Segmentation {
         impacts,
+        found,
         plane_height_m: plane,
         units,
         rejected,
