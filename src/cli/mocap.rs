@@ -1,6 +1,7 @@
 //! `timpanist mocap synth | stats`: build the synthetic motion database and summarise a
 //! database (per playing mode and grip, per dynamic, and joint limits).
 
+use crate::base::ron_file::FileError;
 use crate::body::skeleton::Joint;
 use crate::kit::{Kit, Side};
 use crate::mocap::align::{self, Transform};
@@ -207,13 +208,21 @@ pub fn import(args: ImportArgs) -> anyhow::Result<()> {
         .as_deref()
         .map(CaptureProfile::resolve)
         .transpose()?;
-    let align = alignment(&args)?;
+    // The shipped database, read once and only if needed: the alignment's habits, the
+    // dynamics' speeds.
+    let loaded = std::cell::OnceCell::new();
+    let shipped = || {
+        loaded
+            .get_or_init(|| MotionDb::load(&crate::mocap::db::default_dir()))
+            .as_ref()
+    };
+    let align = alignment(&args, &shipped)?;
     // Strokes without a dynamic label get the shipped performer's marking for their speed.
     let speeds = if args.dynamic.is_some() {
         Default::default()
     } else {
-        MotionDb::load(&crate::mocap::db::default_dir())
-            .map(|db| crate::mocap::ingest::dynamic_speeds(&db))
+        shipped()
+            .map(crate::mocap::ingest::dynamic_speeds)
             .unwrap_or_default()
     };
     let sources = if args.pair {
@@ -266,8 +275,12 @@ pub fn import(args: ImportArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The alignment `--align` asks for, with the kit and drum it needs.
-fn alignment(args: &ImportArgs) -> anyhow::Result<Alignment> {
+/// The alignment `--align` asks for, with the kit and drum it needs (`shipped`: the
+/// shipped database, whose strokes the facing is read against).
+fn alignment<'d>(
+    args: &ImportArgs,
+    shipped: &dyn Fn() -> Result<&'d MotionDb, &'d FileError>,
+) -> anyhow::Result<Alignment> {
     match args.align.trim().to_ascii_lowercase().as_str() {
         "none" | "" => Ok(Alignment::None),
         "auto" => {
@@ -280,9 +293,8 @@ fn alignment(args: &ImportArgs) -> anyhow::Result<Alignment> {
                 .as_deref()
                 .map(|name| find_drum(&kit, name))
                 .transpose()?;
-            let shipped = crate::mocap::db::default_dir();
-            let habits = match MotionDb::load(&shipped) {
-                Ok(db) => align::habits_of(&db, &kit),
+            let habits = match shipped() {
+                Ok(db) => align::habits_of(db, &kit),
                 Err(e) => {
                     eprintln!(
                         "note: {e}; the player is assumed to lift straight back toward themselves"
@@ -323,30 +335,34 @@ fn find_drum(kit: &Kit, name: &str) -> anyhow::Result<usize> {
         })
 }
 
-/// Read one capture with the profile or format given.
+/// Read one capture with the profile or format given, with the format it was read as
+/// (`None` through a profile).
 fn read_take(
     path: &Path,
     args: &ImportArgs,
     profile: Option<&CaptureProfile>,
-) -> anyhow::Result<Take> {
+) -> anyhow::Result<(Take, Option<Format>)> {
+    let unit = args.unit.as_deref();
     Ok(match profile {
-        Some(p) => crate::mocap::import::read_with_profile(path, p, args.unit.as_deref())?,
-        None => crate::mocap::import::read_with_unit(path, args.format, args.unit.as_deref())?,
+        Some(p) => (
+            crate::mocap::import::read_with_profile(path, p, unit)?,
+            None,
+        ),
+        None => {
+            let (take, format) = crate::mocap::import::read_detecting(path, args.format, unit)?;
+            (take, Some(format))
+        }
     })
 }
 
 /// The up axis: `--up`, else the profile's, else Y for Motive files and Z otherwise.
-fn up_axis(path: &Path, args: &ImportArgs, profile: Option<&CaptureProfile>) -> UpAxis {
+fn up_axis(args: &ImportArgs, profile: Option<&CaptureProfile>, format: Option<Format>) -> UpAxis {
     args.up
         .or_else(|| profile.and_then(|p| p.up.map(Into::into)))
-        .unwrap_or_else(|| {
-            let bytes = std::fs::read(path).unwrap_or_default();
-            let format = args.format.or_else(|| Format::guess(path, &bytes));
+        .unwrap_or(match format {
             // Motive and OpenSim (TRC) are Y up by convention; Vicon, Qualisys, C3D Z up.
-            match format {
-                Some(Format::Motive | Format::Trc) => UpAxis::Y,
-                _ => UpAxis::Z,
-            }
+            Some(Format::Motive | Format::Trc) => UpAxis::Y,
+            _ => UpAxis::Z,
         })
 }
 
@@ -357,11 +373,11 @@ fn single_source(
     profile: Option<&CaptureProfile>,
     only: Option<Side>,
 ) -> anyhow::Result<Source> {
-    let take = read_take(path, args, profile)?;
+    let (take, format) = read_take(path, args, profile)?;
     let tips = resolve_tips(path, &take, args, profile, only)?;
     Ok(Source {
         path: path.to_path_buf(),
-        up: up_axis(path, args, profile),
+        up: up_axis(args, profile, format),
         tip_offset_m: args
             .tip_offset_m
             .or_else(|| profile.and_then(CaptureProfile::tip_offset)),

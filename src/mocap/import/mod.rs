@@ -176,6 +176,16 @@ pub fn read_with_unit(
     format: Option<Format>,
     unit: Option<&str>,
 ) -> Result<Take, ImportError> {
+    read_detecting(path, format, unit).map(|(take, _)| take)
+}
+
+/// [`read_with_unit`], also saying which format the file was read as (the one given, or
+/// the one recognised).
+pub fn read_detecting(
+    path: &Path,
+    format: Option<Format>,
+    unit: Option<&str>,
+) -> Result<(Take, Format), ImportError> {
     let (bytes, unit) = read_file(path, unit)?;
     let format = match format {
         Some(f) => f,
@@ -191,7 +201,7 @@ pub fn read_with_unit(
             )
         })?,
     };
-    read_bytes_with_unit(path, &bytes, format, unit)
+    Ok((read_bytes_with_unit(path, &bytes, format, unit)?, format))
 }
 
 /// Read a capture held in memory; `path` is only used for [`Take::source`] and errors.
