@@ -37,7 +37,7 @@
 //! which the alignment to the drum (`mocap::align`) absorbs; it bends the path between
 //! impacts a little. When the tip offset is known, give it.
 
-use super::segment::{SegmentParams, find_impacts};
+use super::segment::{Impact, SegmentParams, find_impacts};
 use crate::base::stats::median;
 use glam::{DMat3, DMat4, DQuat, DVec3, DVec4};
 
@@ -122,16 +122,26 @@ fn point(pose: Pose, d: DVec3) -> DVec3 {
     pose.0 + pose.1 * d
 }
 
+/// The impacts of the body point `d`: segmentation of its height without the plane test
+/// (a point off the tip meets the head at heights that vary with the stick's angle).
+fn impacts_of_point(poses: &[Option<Pose>], d: DVec3, rate_hz: f64) -> Vec<Impact> {
+    let z: Vec<f64> = poses
+        .iter()
+        .map(|s| s.map_or(f64::NAN, |s| point(s, d).z))
+        .collect();
+    let params = SegmentParams {
+        plane_tolerance_m: None,
+        ..SegmentParams::default()
+    };
+    find_impacts(&z, rate_hz, &params).0
+}
+
 /// The impact frames every point of the stick agrees on: impacts are found on the origin
 /// and on probe points [`PROBE_LENGTH_M`] from it along 26 directions, and a frame is an
 /// impact when at least [`CONSENSUS`] of the probes find one within [`NEAR_FRAMES`] of
 /// it (a contact turns the whole stick; a minimum at another phase of the stroke is
 /// one point's alone). Each kept impact is placed at the median of its votes.
 fn impact_frames(poses: &[Option<Pose>], rate_hz: f64) -> Vec<usize> {
-    let params = SegmentParams {
-        plane_tolerance_m: None,
-        ..SegmentParams::default()
-    };
     let mut probes = vec![DVec3::ZERO];
     for x in -1..=1 {
         for y in -1..=1 {
@@ -146,12 +156,7 @@ fn impact_frames(poses: &[Option<Pose>], rate_hz: f64) -> Vec<usize> {
     let mut votes: Vec<usize> = probes
         .iter()
         .flat_map(|&d| {
-            let z: Vec<f64> = poses
-                .iter()
-                .map(|s| s.map_or(f64::NAN, |s| point(s, d).z))
-                .collect();
-            find_impacts(&z, rate_hz, &params)
-                .0
+            impacts_of_point(poses, d, rate_hz)
                 .into_iter()
                 .map(|i| i.frame)
         })
@@ -198,17 +203,8 @@ fn prior_offset(
     let b = (PRIOR_LENGTH_M * PRIOR_LENGTH_M - a * a).max(0.01).sqrt();
     // The tip is the end that comes down fastest (farthest from the grip it turns about).
     let speed = |d: DVec3| {
-        let z: Vec<f64> = poses
-            .iter()
-            .map(|s| s.map_or(f64::NAN, |s| point(s, d).z))
-            .collect();
-        let params = SegmentParams {
-            plane_tolerance_m: None,
-            ..SegmentParams::default()
-        };
         median_or_zero(
-            find_impacts(&z, rate_hz, &params)
-                .0
+            impacts_of_point(poses, d, rate_hz)
                 .iter()
                 .map(|i| i.approach_mps),
         )
@@ -227,13 +223,7 @@ fn turning_axis(poses: &[Option<Pose>], rate_hz: f64) -> DVec3 {
     let mut scatter = DMat3::ZERO;
     for w in poses.windows(2) {
         if let (Some(a), Some(b)) = (w[0], w[1]) {
-            let (axis, angle) = (a.1.conjugate() * b.1).to_axis_angle();
-            let angle = if angle > std::f64::consts::PI {
-                angle - std::f64::consts::TAU
-            } else {
-                angle
-            };
-            let omega = axis * angle * rate_hz;
+            let omega = turn_between(a, b) * rate_hz;
             scatter += DMat3::from_cols(omega * omega.x, omega * omega.y, omega * omega.z);
         }
     }
@@ -290,11 +280,7 @@ fn usual_angles(rows: &[(DVec3, f64)]) -> Vec<bool> {
 fn rotation_noise_var(poses: &[Option<Pose>]) -> f64 {
     let steps: Vec<Option<DVec3>> = poses
         .windows(2)
-        .map(|w| {
-            let (a, b) = (w[0]?, w[1]?);
-            let (axis, angle) = (a.1.conjugate() * b.1).to_axis_angle();
-            Some(axis * wrap(angle))
-        })
+        .map(|w| Some(turn_between(w[0]?, w[1]?)))
         .collect();
     let squares = steps
         .windows(2)
@@ -302,13 +288,16 @@ fn rotation_noise_var(poses: &[Option<Pose>]) -> f64 {
     median_or_zero(squares) / (6.0 * 2.37)
 }
 
-/// An angle in (−π, π].
-fn wrap(angle: f64) -> f64 {
-    if angle > std::f64::consts::PI {
+/// The body's turn from pose `a` to pose `b` as a rotation vector in the body frame
+/// (axis times angle, the angle in (−π, π]), rad.
+fn turn_between(a: Pose, b: Pose) -> DVec3 {
+    let (axis, angle) = (a.1.conjugate() * b.1).to_axis_angle();
+    let angle = if angle > std::f64::consts::PI {
         angle - std::f64::consts::TAU
     } else {
         angle
-    }
+    };
+    axis * angle
 }
 
 /// Eigenvalues and unit eigenvectors of a symmetric 3×3 matrix (cyclic Jacobi
