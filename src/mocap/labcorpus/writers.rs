@@ -48,6 +48,14 @@ pub(super) fn decimals(layout: Layout, unit: LengthUnit) -> usize {
         }
 }
 
+/// The x, y, z cells of every track at frame `f`, in track order.
+fn marker_cells(out: &OutTake, f: usize, scale: f64, decimals: usize) -> Vec<String> {
+    out.tracks
+        .iter()
+        .flat_map(|t| xyz_cells(t.positions[f], scale, decimals))
+        .collect()
+}
+
 /// A position's three cells in the file unit (empty when missing).
 pub(super) fn xyz_cells(p: Option<DVec3>, scale: f64, decimals: usize) -> [String; 3] {
     match p {
@@ -192,12 +200,12 @@ pub(super) fn vicon(out: &OutTake, style: &LabStyle) -> String {
     let _ = writeln!(s, ",,{units}");
     let (scale, d) = (1.0 / unit.metres(), decimals(Layout::Vicon, unit));
     for &f in &out.rows {
-        let cells: Vec<String> = out
-            .tracks
-            .iter()
-            .flat_map(|t| xyz_cells(t.positions[f], scale, d))
-            .collect();
-        let _ = writeln!(s, "{},0,{}", f + 1, cells.join(","));
+        let _ = writeln!(
+            s,
+            "{},0,{}",
+            f + 1,
+            marker_cells(out, f, scale, d).join(",")
+        );
     }
     s
 }
@@ -293,12 +301,8 @@ pub(super) fn trc(out: &OutTake, style: &LabStyle) -> String {
     let _ = writeln!(s, "\t\t{}\n", axes.join("\t"));
     let (scale, d) = (1.0 / unit.metres(), decimals(Layout::Trc, unit));
     for &f in &out.rows {
-        let cells: Vec<String> = out
-            .tracks
-            .iter()
-            .flat_map(|t| xyz_cells(t.positions[f], scale, d))
-            .collect();
-        let _ = writeln!(s, "{}\t{:.5}\t{}", f + 1, f as f64 / r, cells.join("\t"));
+        let cells = marker_cells(out, f, scale, d).join("\t");
+        let _ = writeln!(s, "{}\t{:.5}\t{cells}", f + 1, f as f64 / r);
     }
     s
 }
