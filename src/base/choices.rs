@@ -47,8 +47,12 @@ pub enum IkMethod {
     DampedLeastSquares,
 }
 
-/// Default number of mode orientations per head.
-pub const DEFAULT_MODE_COUNT: usize = 24;
+/// Default number of mode orientations per head in the mechanics (the stick meets them;
+/// the sound is full-band regardless). A point force on a head excites every mode, and a
+/// truncated set leaves its highest modes to carry the local response: with 24 the 32-inch
+/// head (top mode ≈ 500 Hz) threw a free mallet back and caught it again every 2 ms, with
+/// 48 a free ff stroke still came back at 19 N, with 100 at most 3 N.
+pub const DEFAULT_MODE_COUNT: usize = 100;
 /// Largest number of mode orientations per head.
 pub const MAX_MODE_COUNT: usize = 200;
 

@@ -101,11 +101,28 @@ pub fn pd_torques(
     target_w: &[DVec3; JOINT_COUNT],
     bias: &[DVec3; JOINT_COUNT],
 ) -> [DVec3; JOINT_COUNT] {
-    std::array::from_fn(|j| {
-        let e = quaternion_error(state.q[j], target[j]);
-        let tau = gains.stiffness[j] * e - gains.damping[j] * (state.w[j] - target_w[j]) + bias[j];
-        tau.clamp_length_max(gains.max_torque[j])
-    })
+    std::array::from_fn(|j| pd_torque(gains, state, j, target[j], target_w[j], bias[j], 1.0))
+}
+
+/// The PD torque of joint `j` toward `target` (target angular velocity `target_w`, child
+/// frame) plus feed-forward `bias`, with the joint holding the fraction `held` (0–1] of its
+/// control: stiffness and feed-forward times `held`, damping times √`held` (the damping
+/// ratio unchanged), clamped to its torque limit. A relaxed grip (`held` ≪ 1) lets the
+/// stick turn freely about the fulcrum.
+pub fn pd_torque(
+    gains: &Gains,
+    state: &State,
+    j: usize,
+    target: DQuat,
+    target_w: DVec3,
+    bias: DVec3,
+    held: f64,
+) -> DVec3 {
+    let e = quaternion_error(state.q[j], target);
+    let tau = held * (gains.stiffness[j] * e)
+        - held.sqrt() * (gains.damping[j] * (state.w[j] - target_w))
+        + held * bias;
+    tau.clamp_length_max(gains.max_torque[j])
 }
 
 /// Torques that hold `pose` still against gravity.

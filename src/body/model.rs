@@ -80,6 +80,28 @@ impl BodyModel {
         }
     }
 
+    /// The same body holding mallets of `mass_kg` instead of Table 1's sticks (the seed's
+    /// drumsticks; a timpani mallet weighs 40–50 g): a third of the mass in the felt head
+    /// at the tip and the rest in a uniform shaft, so the centre of mass is at 2/3 of the
+    /// length, the transverse inertia about it m·L²/9, and the mass a free mallet presents
+    /// at its tip when it pivots about the grip 5/9 of it (as the drum's contact assumes).
+    pub fn holding_mallets(mut self, mass_kg: f64) -> BodyModel {
+        for side in [crate::kit::Side::Left, crate::kit::Side::Right] {
+            let segment = &mut self.segments[Joint::arm(side)[3].index()];
+            let axis = segment.axis_m;
+            let l = axis.length();
+            let axial = 0.5 * mass_kg * segment.radius_m * segment.radius_m;
+            let transverse = mass_kg * l * l / 9.0;
+            let dir = axis.try_normalize().unwrap_or(DVec3::Z);
+            let r = DMat3::from_quat(glam::DQuat::from_rotation_arc(DVec3::Z, dir));
+            segment.mass_kg = mass_kg;
+            segment.com_m = axis * (2.0 / 3.0);
+            segment.inertia =
+                r * DMat3::from_diagonal(DVec3::new(transverse, transverse, axial)) * r.transpose();
+        }
+        self
+    }
+
     /// Total simulated mass, kg.
     pub fn simulated_mass_kg(&self) -> f64 {
         self.segments.iter().map(|s| s.mass_kg).sum()
@@ -118,6 +140,23 @@ mod tests {
     /// The simulated segments carry 61.5 % of the body mass (Table 1 without pelvis and
     /// legs); inertias are symmetric positive definite; a stick spins about its own axis
     /// with an inertia near 1e-5 kg·m² (guide §5).
+    /// A mallet pivoting freely about the grip presents 5/9 of its mass at the tip,
+    /// as the drum contact assumes.
+    #[test]
+    fn mallets_present_five_ninths_at_the_tip() {
+        let body = BodyModel::default().holding_mallets(0.045);
+        let stick = body.segments[Joint::GripR.index()];
+        let l = stick.axis_m.length();
+        let d = stick.axis_m.normalize();
+        // Inertia about the grip for a turn perpendicular to the stick.
+        let n = d.any_orthonormal_vector();
+        let about_com = n.dot(stick.inertia * n);
+        let about_grip = about_com + stick.mass_kg * stick.com_m.length_squared();
+        let at_tip = about_grip / (l * l);
+        assert!((at_tip - 0.025).abs() < 1e-12, "{at_tip}");
+        assert_eq!(stick.mass_kg, 0.045);
+    }
+
     #[test]
     fn mass_properties() {
         let body = BodyModel::default();

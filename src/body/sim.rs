@@ -16,7 +16,7 @@
 //! Task rate 250 Hz and simulation rate 10 kHz by default (40 sub-steps). The run stops
 //! with an error naming the time if the state becomes non-finite or diverges.
 
-use super::control::{Gains, limit_torques, pd_torques, rotation_error};
+use super::control::{Gains, limit_torques, pd_torque, pd_torques, rotation_error};
 use super::dynamics::{Dynamics, State};
 use super::ik::{self, IkParams};
 use super::limits::JointLimits;
@@ -93,6 +93,12 @@ pub struct Reference {
     /// Where the performer looks per sample (m, performer frame): the neck and head turn
     /// toward it ([`super::gaze::look_at`]); `None` keeps them as the posture has them.
     pub gaze: Option<Vec<DVec3>>,
+    /// Per sample, the fraction of each hand's grip control held, [left, right]: 1 firm,
+    /// near 0 relaxed. A player lets the stick go around an impact so it rebounds freely
+    /// about the fulcrum: the grip's PD and feed-forward scale by it, and HIMC's nested IK
+    /// stops chasing that stick's tip (its arm follows the task-rate posture) in the same
+    /// proportion. `None` holds both grips firm throughout.
+    pub grip: Option<[Vec<f64>; 2]>,
 }
 
 /// What the body did, at the task rate.
@@ -526,7 +532,30 @@ impl Simulator {
                     }
                 }
             }
+            let held = reference.grip.as_ref().map(|grip| {
+                let at = |h: usize| grip[h][k - 1] + (grip[h][k] - grip[h][k - 1]) * u;
+                [at(0), at(1)]
+            });
+            if let Some(held) = held {
+                self.relax_feedback(&mut goal, &from, &to, u, held);
+            }
             let mut tau = pd_torques(&self.gains, &self.state, &goal, &target_w, &bias);
+            if let Some(held) = held {
+                for (side, fraction) in [Side::Left, Side::Right].into_iter().zip(held) {
+                    if fraction < 1.0 {
+                        let j = Joint::arm(side)[3].index();
+                        tau[j] = pd_torque(
+                            &self.gains,
+                            &self.state,
+                            j,
+                            goal[j],
+                            target_w[j],
+                            bias[j],
+                            fraction,
+                        );
+                    }
+                }
+            }
             if self.params.limits.iter().any(Option::is_some) {
                 let stops = limit_torques(
                     &self.gains,
@@ -567,6 +596,25 @@ impl Simulator {
         let q = self.state.q;
         self.record(&q);
         self.check_tracking(reference, k)
+    }
+
+    /// While a grip is relaxed (`held` < 1), HIMC's nested IK no longer chases that stick's
+    /// tip: the arm's PD goal moves from the nested solution toward the task-rate posture
+    /// (the lerp of `from` and `to` at `u`) in proportion, so a stick rebounding off a head
+    /// is not pulled straight back down by the arm.
+    fn relax_feedback(&self, goal: &mut Pose, from: &Pose, to: &Pose, u: f64, held: [f64; 2]) {
+        if self.pipeline != Pipeline::Himc {
+            return;
+        }
+        for (side, fraction) in [Side::Left, Side::Right].into_iter().zip(held) {
+            if fraction < 1.0 {
+                for j in Joint::arm(side) {
+                    let j = j.index();
+                    let planned = from[j].lerp(to[j], u);
+                    goal[j] = planned.slerp(goal[j], fraction.clamp(0.0, 1.0));
+                }
+            }
+        }
     }
 
     /// Stop when a tip at task sample `k` is farther than the limit from its target.
@@ -631,6 +679,7 @@ mod tests {
             poses: None,
             beats: vec![(0.02, 3), (0.06, 4)],
             gaze: None,
+            grip: None,
         };
         let params = SimParams {
             frequency_hz: [2000.0; JOINT_COUNT],
@@ -671,6 +720,7 @@ mod tests {
             poses: None,
             beats: vec![(1.9, 7)],
             gaze: None,
+            grip: None,
         };
         let run = |limit: f64| {
             let params = SimParams {
@@ -713,6 +763,7 @@ mod tests {
             poses: None,
             beats: Vec::new(),
             gaze: None,
+            grip: None,
         };
         let params = SimParams::default();
         let (a, b) = (reference(0.0), reference(0.5));

@@ -21,9 +21,11 @@ pub const SIM_RATE_HZ: f64 = 10_000.0;
 /// (guide §5).
 pub const PLAYING_SPOT_FRACTION: f64 = 0.6;
 /// Downward tip speed at impact for velocity 1 (MIDI 127), m/s: impact speed =
-/// `FULL_SPEED_MPS` × velocity, so pp 1.46, p 2.16, mp 2.82, mf 3.53, f 4.23, ff 4.94 m/s
-/// (chosen so mf–ff strokes on the standard kit peak at 62–107 N as seed 000 reports).
-pub const FULL_SPEED_MPS: f64 = 5.6;
+/// `FULL_SPEED_MPS` × velocity, so pp 2.08, p 3.09, mp 4.03, mf 5.04, f 6.05, ff 7.06 m/s
+/// (chosen so a free mf–ff stroke on the 26-inch drum peaks at 62–107 N as seed 000
+/// reports, on the 100-mode head: its local compliance asks faster strokes than real
+/// players' 1.5–3.7 m/s for those forces, see README "Strokes").
+pub const FULL_SPEED_MPS: f64 = 8.0;
 
 /// Downward impact speed for a dynamic, m/s (linear in MIDI velocity, see [`FULL_SPEED_MPS`]).
 pub fn impact_speed_mps(dynamic: Dynamic) -> f64 {

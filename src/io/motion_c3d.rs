@@ -87,6 +87,7 @@ mod tests {
             poses: None,
             beats: Vec::new(),
             gaze: None,
+            grip: None,
         };
         let bytes = to_c3d(&motion, &reference, &skeleton);
         let back = read(Path::new("motion.c3d"), &bytes, None).unwrap();

@@ -340,8 +340,11 @@ impl Performance {
         self.commits.push(commit.clone());
         let last_s = self.targets.knots(cluster.end - 1, 0.0)[1].0;
         let until = (((last_s + LOOKAHEAD_S) * rate).ceil() as usize).clamp(commit.samples, n);
-        type Attempt = ((usize, usize, usize, f64), Vec<f64>, Vec<f64>, usize);
+        type Attempt = ((usize, usize, bool, usize, f64), Vec<f64>, Vec<f64>, usize);
         let mut best: Option<Attempt> = None;
+        // Per stroke of the cluster, the (depth, peak force) its attempts met, for the
+        // secant on the depth.
+        let mut tried: Vec<Vec<(f64, f64)>> = vec![Vec::new(); cluster.len()];
         let mut attempt = 0;
         let mut diverged = false;
         loop {
@@ -373,20 +376,19 @@ impl Performance {
                 strikes::match_range(strokes, cluster.clone(), contacts, commit.drums.contacts());
             let mut missed = 0;
             let mut worst = 0.0f64;
-            let mut on_force = true;
-            // Strokes whose force is off its aim by more than a factor of two.
-            let mut far_off = 0;
-            for (i, m) in cluster.clone().zip(&matches) {
+            // Strokes whose force is off its aim by more than the tolerance.
+            let mut off_force = 0;
+            for ((i, m), tried) in cluster.clone().zip(&matches).zip(&mut tried) {
                 match m {
                     Some(c) => {
                         worst = worst.max((contacts[*c].start_s - strokes[i].time_s).abs());
                         let ratio = contacts[*c].peak_force_n / aims.force_n[i];
-                        on_force &= (ratio - 1.0).abs() <= aims.force_tolerance;
+                        tried.push((self.targets.depth(i), contacts[*c].peak_force_n));
                         if ratio < GRAZE_FRACTION {
                             // A graze is not a stroke: as bad as none.
                             missed += 1;
-                        } else if !(0.5..=2.0).contains(&ratio) {
-                            far_off += 1;
+                        } else if (ratio - 1.0).abs() > aims.force_tolerance {
+                            off_force += 1;
                         }
                     }
                     None => missed += 1,
@@ -399,8 +401,10 @@ impl Performance {
                     !claimed.contains(c) && contacts[*c].peak_force_n >= strikes::RECONTACT_MIN_N
                 })
                 .count();
-            // A stroke that does not sound is worse than one whose force is off.
-            let key = (missed, far_off, recontacts, worst);
+            // A stroke that does not sound is worse than a stick falling back on a head,
+            // that worse than a contact out of time, and that worse than a force off.
+            let late = worst > aims.acceptable_s;
+            let key = (missed, recontacts, late, off_force, worst);
             if best.as_ref().is_none_or(|b| key <= b.0) {
                 best = Some((
                     key,
@@ -409,11 +413,10 @@ impl Performance {
                     attempt,
                 ));
             }
-            let on_time = missed + recontacts == 0 && worst <= aims.tolerance_s;
-            let acceptable = missed + far_off + recontacts == 0
-                && worst <= aims.acceptable_s
-                && attempt >= aims.settle_attempts;
-            if (on_time && on_force) || acceptable || attempt >= aims.max_attempts {
+            let clean = missed + recontacts + off_force == 0;
+            let on_time = clean && worst <= aims.tolerance_s;
+            let acceptable = clean && !late && attempt >= aims.settle_attempts;
+            if on_time || acceptable || attempt >= aims.max_attempts {
                 break;
             }
             // Only the cluster's own contacts (the record is borrowed from the drums).
@@ -421,8 +424,8 @@ impl Performance {
                 .iter()
                 .map(|m| m.map(|c| contacts[c].clone()))
                 .collect();
-            for (i, contact) in cluster.clone().zip(found) {
-                self.correct(i, contact.as_ref(), strokes[i].time_s, aims);
+            for ((i, contact), tried) in cluster.clone().zip(found).zip(&tried) {
+                self.correct(i, contact.as_ref(), strokes[i].time_s, aims, tried);
             }
         }
         let (_, shifts, depths, kept) = best.expect("one attempt ran");
@@ -448,16 +451,19 @@ impl Performance {
         Ok(())
     }
 
-    /// Late contacts play their target earlier; weak strokes aim deeper (the felt's Hertz
-    /// force grows about as the square of how far the hand drives through). A deeper aim
-    /// reaches the head earlier, by about the extra depth over the impact speed: the shift
-    /// allows for that so the two corrections do not fight.
+    /// Late contacts play their target earlier; strokes off their force aim deeper or
+    /// shallower (a deeper strike-through drives the stick faster into the head): by the
+    /// secant through the two latest attempts' (depth, force) when they differ, else as
+    /// if the force grew with the square of the depth. A deeper aim reaches the head
+    /// earlier, by about the extra depth over the impact speed: the shift allows for that
+    /// so the two corrections do not fight.
     fn correct(
         &mut self,
         i: usize,
         contact: Option<&crate::drum::ContactEvent>,
         scheduled_s: f64,
         aims: &Aims,
+        tried: &[(f64, f64)],
     ) {
         let aim = aims.force_n[i];
         let mut shift = self.shift_s[i] + contact.map_or(0.0, |c| c.start_s - scheduled_s);
@@ -465,7 +471,18 @@ impl Performance {
         if !force.is_some_and(|f| (f / aim - 1.0).abs() <= aims.force_tolerance) {
             let old = self.targets.depth(i);
             let ratio = force.map_or(2.0, |f| (aim / f.max(1e-3)).sqrt().clamp(0.6, 1.6));
-            let depth = (old * ratio).clamp(0.002, MAX_DEPTH_M);
+            let depth = match tried {
+                [.., (d0, f0), (d1, f1)] if (d1 - d0).abs() > 1e-5 && (f1 - f0).abs() > 0.5 => {
+                    let slope = (f1 - f0) / (d1 - d0);
+                    if slope > 0.0 {
+                        (d1 + (aim - f1) / slope).clamp(0.5 * old, 2.0 * old)
+                    } else {
+                        old * ratio
+                    }
+                }
+                _ => old * ratio,
+            }
+            .clamp(0.002, MAX_DEPTH_M);
             if let Some(c) = contact {
                 shift -= (depth - old) / c.impact_speed_mps.max(0.5);
             }

@@ -32,7 +32,7 @@ use crate::score::{LoadedScore, Settings};
 use crate::sound::{Audio, SoundError, SoundModel, SoundState, Touch};
 use compensate::{Aims, Performance, Stage};
 use glam::DVec3;
-use reference::{StrikeShape, Targets, Warp};
+use reference::{Release, StrikeShape, Targets, Warp};
 use std::time::{Duration, Instant};
 use strikes::{StrikeEvent, Timing};
 
@@ -71,6 +71,8 @@ pub struct RenderParams {
     pub force_tolerance: f64,
     /// Half-width of the strike-through dip, s.
     pub strike_half_width_s: f64,
+    /// How the grip lets the stick go around each impact.
+    pub release: Release,
     /// Sound rendered after the last motion sample, s.
     pub tail_s: f64,
     /// Every PD gain multiplied by this.
@@ -118,15 +120,16 @@ impl Default for RenderParams {
             mallet: 0,
             height_m: crate::body::skeleton::DEFAULT_HEIGHT_M,
             mass_kg: 70.0,
-            max_attempts: 6,
+            max_attempts: 8,
             timing_tolerance_s: 0.0015,
-            timing_acceptable_s: 0.004,
+            timing_acceptable_s: 0.0025,
             settle_attempts: 3,
             strike_depth_m: 0.018,
-            force_at_silence_n: 15.0,
-            force_range_n: 95.0,
-            force_tolerance: 0.25,
+            force_at_silence_n: 5.0,
+            force_range_n: 107.0,
+            force_tolerance: 0.12,
             strike_half_width_s: 0.012,
+            release: Release::DEFAULT,
             tail_s: 2.5,
             gain_scale: 1.0,
         }
@@ -356,6 +359,7 @@ pub fn render_composition(
     let shape = StrikeShape {
         ball_radius_m: law.ball_radius_m,
         half_width_s: params.strike_half_width_s,
+        release: params.release,
     };
     let targets = Targets::new(&composition, &shape, params.strike_depth_m);
     let touches = touches(&loaded.score);
@@ -464,7 +468,8 @@ impl Run<'_> {
                 (performance, sound, Some(from), changed_s)
             }
             (previous, _) => {
-                let model = BodyModel::new(skeleton, params.mass_kg);
+                let model =
+                    BodyModel::new(skeleton, params.mass_kg).holding_mallets(self.mallet.mass_kg);
                 let first = targets.reference(&Warp::default());
                 let initial =
                     ik::posture_reaching(&model.skeleton, [first.tips[0][0], first.tips[1][0]]);
