@@ -33,16 +33,23 @@ fn render_file(path: &Path, db: &MotionDb) -> Rendering {
 }
 
 /// Every scored stroke of every demo score yields a contact; over all of them the median
-/// |contact − scheduled| is under 2 ms and the worst under 5 ms; peak forces are in the
-/// range of real strikes; the audio is finite and never clips.
+/// |contact − scheduled| is under 1 ms and the worst under 3 ms; peak forces are in the
+/// range of real strikes; the audio is finite and never clips. The sticks rebound: at
+/// most 4 of the 291 strokes (1.4 %; 3 measured) are followed by the stick falling back
+/// on the head with 5 N or more. Force follows the dynamic (see [`forces_follow_dynamics`]).
 #[test]
 fn demo_scores_strike_every_beat_on_time() {
     let db = db();
     let mut all = Vec::new();
+    let mut recontacts = 0;
     for path in demo_scores() {
         let r = render_file(&path, &db);
         assert_eq!(r.timing.missed, 0, "{}: {:?}", path.display(), r.timing);
+        if path.ends_with("dynamics-ladder.ron") {
+            forces_follow_dynamics(&r.events);
+        }
         for e in r.events.iter().filter(|e| e.beat.is_some()) {
+            recontacts += usize::from(e.recontacts > 0);
             all.push((e.contact_s - e.scheduled_s.unwrap()).abs());
             assert!(
                 (5.0..300.0).contains(&e.peak_force_n) && e.duration_ms > 0.5,
@@ -67,10 +74,68 @@ fn demo_scores_strike_every_beat_on_time() {
     all.sort_by(f64::total_cmp);
     let median = all[all.len() / 2];
     let worst = all[all.len() - 1];
-    println!("{} strokes: median {median} s, worst {worst} s", all.len());
+    println!(
+        "{} strokes: median {median} s, worst {worst} s, {recontacts} with re-contacts",
+        all.len()
+    );
     assert!(
-        median < 0.002 && worst < 0.005,
+        median < 0.001 && worst < 0.003,
         "median {median} s, worst {worst} s"
+    );
+    assert!(recontacts <= 4, "{recontacts} of {} strokes", all.len());
+}
+
+/// The dynamics ladder (every mode × pp…ff, both hands, two drums): per mode the median
+/// peak force rises strictly from pp to ff, every stroke is within ±20 % of its (mode,
+/// dynamic) median, ff's median is 60–110 N and pp's about a third of it (within 25–50 %).
+fn forces_follow_dynamics(events: &[timpanist::render::strikes::StrikeEvent]) {
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        let n = v.len();
+        0.5 * (v[(n - 1) / 2] + v[n / 2])
+    };
+    let scored: Vec<_> = events.iter().filter(|e| e.beat.is_some()).collect();
+    let mut modes: Vec<&str> = scored.iter().filter_map(|e| e.mode).collect();
+    modes.sort();
+    modes.dedup();
+    assert_eq!(modes.len(), PlayingMode::ALL.len());
+    for mode in modes {
+        let mut previous = 0.0;
+        for (_, _, name) in Dynamic::MARKS {
+            let forces: Vec<f64> = scored
+                .iter()
+                .filter(|e| e.mode == Some(mode) && e.dynamic == Some(name))
+                .map(|e| e.peak_force_n)
+                .collect();
+            assert!(!forces.is_empty(), "{mode} {name}");
+            let m = median(forces.clone());
+            assert!(
+                m > previous,
+                "{mode} {name}: {m:.1} N after {previous:.1} N"
+            );
+            for f in &forces {
+                assert!(
+                    (f / m - 1.0).abs() <= 0.2,
+                    "{mode} {name}: {f:.1} N, median {m:.1} N"
+                );
+            }
+            previous = m;
+        }
+    }
+    let of = |d: &str| {
+        median(
+            scored
+                .iter()
+                .filter(|e| e.dynamic == Some(d))
+                .map(|e| e.peak_force_n)
+                .collect(),
+        )
+    };
+    let (pp, ff) = (of("pp"), of("ff"));
+    assert!((60.0..=110.0).contains(&ff), "ff {ff:.1} N");
+    assert!(
+        (0.25..=0.5).contains(&(pp / ff)),
+        "pp {pp:.1} N, ff {ff:.1} N"
     );
 }
 
