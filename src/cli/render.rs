@@ -324,7 +324,9 @@ fn print_stats(r: &Rendering) {
         })
         .collect();
     println!(
-        "force aims (15 N + 95 N x velocity): {} of {} strokes off by more than {:.0} %{}{}",
+        "force aims ({:.0} N + {:.0} N x velocity): {} of {} strokes off by more than {:.0} %{}{}",
+        r.params.force_at_silence_n,
+        r.params.force_range_n,
         off.len(),
         strokes.len(),
         FORCE_AIM_TOLERANCE * 100.0,
