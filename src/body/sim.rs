@@ -95,9 +95,8 @@ pub struct Reference {
     pub gaze: Option<Vec<DVec3>>,
     /// Per sample, the fraction of each hand's grip control held, [left, right]: 1 firm,
     /// near 0 relaxed. A player lets the stick go around an impact so it rebounds freely
-    /// about the fulcrum: the grip's PD and feed-forward scale by it, and HIMC's nested IK
-    /// stops chasing that stick's tip (its arm follows the task-rate posture) in the same
-    /// proportion. `None` holds both grips firm throughout.
+    /// about the fulcrum: the grip's PD and feed-forward scale by it (the arm keeps
+    /// aiming). `None` holds both grips firm throughout.
     pub grip: Option<[Vec<f64>; 2]>,
 }
 
@@ -536,9 +535,6 @@ impl Simulator {
                 let at = |h: usize| grip[h][k - 1] + (grip[h][k] - grip[h][k - 1]) * u;
                 [at(0), at(1)]
             });
-            if let Some(held) = held {
-                self.relax_feedback(&mut goal, &from, &to, u, held);
-            }
             let mut tau = pd_torques(&self.gains, &self.state, &goal, &target_w, &bias);
             if let Some(held) = held {
                 for (side, fraction) in [Side::Left, Side::Right].into_iter().zip(held) {
@@ -596,25 +592,6 @@ impl Simulator {
         let q = self.state.q;
         self.record(&q);
         self.check_tracking(reference, k)
-    }
-
-    /// While a grip is relaxed (`held` < 1), HIMC's nested IK no longer chases that stick's
-    /// tip: the arm's PD goal moves from the nested solution toward the task-rate posture
-    /// (the lerp of `from` and `to` at `u`) in proportion, so a stick rebounding off a head
-    /// is not pulled straight back down by the arm.
-    fn relax_feedback(&self, goal: &mut Pose, from: &Pose, to: &Pose, u: f64, held: [f64; 2]) {
-        if self.pipeline != Pipeline::Himc {
-            return;
-        }
-        for (side, fraction) in [Side::Left, Side::Right].into_iter().zip(held) {
-            if fraction < 1.0 {
-                for j in Joint::arm(side) {
-                    let j = j.index();
-                    let planned = from[j].lerp(to[j], u);
-                    goal[j] = planned.slerp(goal[j], fraction.clamp(0.0, 1.0));
-                }
-            }
-        }
     }
 
     /// Stop when a tip at task sample `k` is farther than the limit from its target.
