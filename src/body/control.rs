@@ -25,11 +25,12 @@ pub struct Gains {
 
 /// Natural frequency of each joint's PD loop, Hz: the trunk, neck and head slow, the arms
 /// and sticks fast enough to follow a stroke. Measured on the shipped database
-/// (`timpanist evaluate`): arms at 25–40 Hz leave HIMC 2–3 % of the stroke amplitude
-/// behind, at 75–120 Hz 1.0–1.7 %; at 10 kHz even 120 Hz is ω·dt ≈ 0.08, far inside the
-/// explicit integrator's stability.
+/// (`timpanist evaluate --trials 5`): arms at 25–40 Hz leave HIMC 2–3 % of the stroke
+/// amplitude behind, at 75–120 Hz 0.6–1.2 %, at 112–180 Hz 0.5–0.9 % (the error is the
+/// recovery from the trials' 2° posture turns: unperturbed HIMC stays within 0.2 %); at
+/// 10 kHz even 180 Hz is ω·dt ≈ 0.11, far inside the explicit integrator's stability.
 pub const DEFAULT_FREQUENCY_HZ: [f64; JOINT_COUNT] = [
-    8.0, 8.0, 8.0, 75.0, 90.0, 105.0, 120.0, 75.0, 90.0, 105.0, 120.0,
+    8.0, 8.0, 8.0, 112.5, 135.0, 157.5, 180.0, 112.5, 135.0, 157.5, 180.0,
 ];
 
 impl Gains {

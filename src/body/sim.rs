@@ -488,8 +488,12 @@ impl Simulator {
         let (from, to) = (self.target(reference, k - 1), self.target(reference, k));
         let target_w = self.target_velocity(reference, k);
         let next_w = self.target_velocity(reference, k + 1);
+        // The target's acceleration at the middle of this interval (the velocities over
+        // the intervals before and after it, centred), so the feed-forward is not half a
+        // task step early.
+        let prev_w = self.target_velocity(reference, k.saturating_sub(1).max(1));
         let qdd: [DVec3; JOINT_COUNT] =
-            std::array::from_fn(|j| (next_w[j] - target_w[j]) * reference.rate_hz);
+            std::array::from_fn(|j| (next_w[j] - prev_w[j]) * (0.5 * reference.rate_hz));
         // Feed-forward inverse dynamics of the target motion, once per task step.
         let bias = self.dynamics.inverse_dynamics(
             &State {
