@@ -20,8 +20,8 @@ fn db() -> MotionDb {
 }
 
 /// HIMC's tip RMS error is below ID's for every playing mode (seed 000's finding) when the
-/// simulated player's anthropometry differs from the performer's, and under 2 % of the
-/// motion amplitude (the issue aims for 1 %; see README).
+/// simulated player's anthropometry differs from the performer's, and under 1 % of the
+/// motion amplitude (0.43–0.78 % over these two trials; see README).
 #[test]
 fn himc_beats_id_for_every_mode() {
     let report = evaluate::evaluate(
@@ -51,7 +51,7 @@ fn himc_beats_id_for_every_mode() {
             m.id.rms_e_m
         );
         assert!(
-            m.himc.rms_e_m < 0.02 * m.amplitude_m,
+            m.himc.rms_e_m < 0.01 * m.amplitude_m,
             "{}: HIMC {} m for {} m",
             m.mode,
             m.himc.rms_e_m,
