@@ -659,3 +659,25 @@ impl RenderError {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::score::Dynamic;
+
+    /// The force aims rise strictly with the markings, pp is about a third of ff, and a
+    /// `Velocity(v)` aims between the markings around it.
+    #[test]
+    fn force_aims_follow_the_dynamic() {
+        let p = RenderParams::default();
+        let aims: Vec<f64> = Dynamic::MARKS.iter().map(|m| p.force_aim_n(m.0)).collect();
+        assert!(aims.windows(2).all(|w| w[0] < w[1]), "{aims:?}");
+        let ratio = aims[0] / aims[5];
+        assert!((0.28..=0.4).contains(&ratio), "pp/ff {ratio}");
+        let v = p.force_aim_n(Dynamic::Velocity(0.6));
+        assert!(
+            p.force_aim_n(Dynamic::Mp) < v && v < p.force_aim_n(Dynamic::Mf),
+            "{v}"
+        );
+    }
+}
