@@ -52,14 +52,15 @@ impl Release {
     };
 
     /// The release the renderer plays with: the grip keeps 2 % of its control from 6 ms
-    /// before the impact (let go over 4 ms before that) to 15 ms after it, firm again 25 ms
-    /// later. With 2 % the grip's loop runs at 14 % of its frequency (17 Hz for the
-    /// 120 Hz stick), slow beside a 5–9 ms contact: the stick rebounds as a free mallet.
+    /// before the impact (let go over 4 ms before that) to 25 ms after it, firm again 25 ms
+    /// later. With 2 % the grip's loop runs at 14 % of its frequency (25 Hz for the
+    /// 180 Hz stick), slow beside a 5–10 ms contact: the stick rebounds as a free mallet.
+    /// Closing at 15 ms left the 32-inch head, swinging back, to catch 2 of 30 ff strokes.
     pub const DEFAULT: Release = Release {
         held: 0.02,
         ramp_in_s: 0.004,
         before_s: 0.006,
-        after_s: 0.015,
+        after_s: 0.025,
         ramp_out_s: 0.025,
     };
 
@@ -431,13 +432,13 @@ mod tests {
         let r = Release::DEFAULT;
         assert_eq!(r.held_at(-0.1), 1.0);
         assert_eq!(r.held_at(0.1), 1.0);
-        for x in [-0.006, -0.003, 0.0, 0.008, 0.015] {
+        for x in [-0.006, -0.003, 0.0, 0.008, 0.025] {
             assert!((r.held_at(x) - r.held).abs() < 1e-12, "{x}");
         }
         // Halfway down each ramp, halfway between firm and relaxed.
         let mid = 0.5 * (1.0 + r.held);
         assert!((r.held_at(-0.008) - mid).abs() < 1e-9);
-        assert!((r.held_at(0.0275) - mid).abs() < 1e-9);
+        assert!((r.held_at(0.0375) - mid).abs() < 1e-9);
         assert_eq!(Release::FIRM.held_at(0.0), 1.0);
     }
 
