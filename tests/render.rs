@@ -35,7 +35,7 @@ fn render_file(path: &Path, db: &MotionDb) -> Rendering {
 /// Every scored stroke of every demo score yields a contact; over all of them the median
 /// |contact − scheduled| is under 1 ms and the worst under 3 ms; peak forces are in the
 /// range of real strikes; the audio is finite and never clips. The sticks rebound: at
-/// most 4 of the 291 strokes (1.4 %; 3 measured) are followed by the stick falling back
+/// most 1 % of the strokes (none measured of 291) are followed by the stick falling back
 /// on the head with 5 N or more. Force follows the dynamic (see [`forces_follow_dynamics`]).
 #[test]
 fn demo_scores_strike_every_beat_on_time() {
@@ -82,7 +82,11 @@ fn demo_scores_strike_every_beat_on_time() {
         median < 0.001 && worst < 0.003,
         "median {median} s, worst {worst} s"
     );
-    assert!(recontacts <= 4, "{recontacts} of {} strokes", all.len());
+    assert!(
+        recontacts * 100 <= all.len(),
+        "{recontacts} of {} strokes",
+        all.len()
+    );
 }
 
 /// The ladder moved to the outer drums (the right hand on the 23-inch, the left on the
