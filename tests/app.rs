@@ -26,16 +26,6 @@ fn demo() -> PathBuf {
     root().join("scores/etude-modes.ron")
 }
 
-/// Click at `pos` (press and release without moving).
-fn click(h: &mut Harness<'static, EditorApp>, pos: egui::Pos2) {
-    h.hover_at(pos);
-    settle(h);
-    h.drag_at(pos);
-    settle(h);
-    h.drop_at(pos);
-    settle(h);
-}
-
 /// The editor opens the bundled demo score, shows its title, the kit and every panel.
 #[test]
 fn opens_demo_score_with_every_panel() {
@@ -98,7 +88,7 @@ fn add_beat_set_mode_undo_redo() {
     let tick = 960 * 4 * 2 + 480;
     assert!(before.iter().all(|b| b.tick != tick));
     let at = common::steady_timeline_point(&mut h, tick, Hand::Left);
-    click(&mut h, at);
+    common::click(&mut h, at);
     let app = h.state();
     let beats = &app.loaded().unwrap().score.beats;
     assert_eq!(beats.len(), before.len() + 1, "{}", app.status());
@@ -226,7 +216,7 @@ fn save_and_reopen() {
     let dir = tempfile::tempdir().unwrap();
     let mut h = harness(Some(demo()), dir.path());
     let at = common::steady_timeline_point(&mut h, 960 * 3, Hand::Right);
-    click(&mut h, at);
+    common::click(&mut h, at);
     let edited = h.state().loaded().unwrap().score.clone();
     let target = dir.path().join("saved.ron");
     h.state_mut().save_to(&target);
@@ -247,7 +237,7 @@ fn quit_with_unsaved_changes_asks() {
     let mut h = harness(Some(demo()), dir.path());
     assert!(h.state_mut().request_quit(), "nothing to lose yet");
     let at = common::steady_timeline_point(&mut h, 960 * 3, Hand::Right);
-    click(&mut h, at);
+    common::click(&mut h, at);
     assert!(!h.state_mut().request_quit());
     settle(&mut h);
     h.get_by_label("Unsaved changes");
@@ -373,7 +363,7 @@ fn a_new_beat_goes_on_a_drum_of_its_hand() {
         assert!(h.state().selection().beats.is_empty());
         let before = h.state().loaded().unwrap().score.beats.clone();
         let at = common::steady_timeline_point(&mut h, tick, hand);
-        click(&mut h, at);
+        common::click(&mut h, at);
         let beats = &h.state().loaded().unwrap().score.beats;
         let added: Vec<_> = beats.iter().filter(|b| !before.contains(b)).collect();
         assert_eq!(added.len(), 1, "{hand:?} at {at:?}");

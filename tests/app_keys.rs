@@ -48,12 +48,7 @@ fn keyboard_editing() {
     let mut h = harness(dir.path());
     let original = ticks(&h);
     let at = h.state().timeline_point(960, Hand::Auto).unwrap();
-    h.hover_at(at);
-    settle(&mut h);
-    h.drag_at(at);
-    settle(&mut h);
-    h.drop_at(at);
-    settle(&mut h);
+    common::click(&mut h, at);
     assert_eq!(h.state().selection().beats.len(), 1);
     let none = egui::Modifiers::NONE;
     press(&mut h, egui::Modifiers::COMMAND, egui::Key::D);

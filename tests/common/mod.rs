@@ -45,6 +45,19 @@ pub fn settle(h: &mut Harness<'static, EditorApp>) {
     h.run();
 }
 
+/// Click at `pos`: hover, then press and release one frame apart. The harness advances
+/// 0.25 s a frame and egui takes a press held over 0.8 s for a long press, not a click:
+/// settling between press and release (as many frames as the workers keep the UI busy,
+/// more under load) once made a click add no beat.
+pub fn click(h: &mut Harness<'static, EditorApp>, pos: egui::Pos2) {
+    h.hover_at(pos);
+    settle(h);
+    h.drag_at(pos);
+    h.step();
+    h.drop_at(pos);
+    settle(h);
+}
+
 /// Where `tick` lies in `hand`'s lane once the layout has stopped moving (a panel that
 /// opens or closes animates over a few frames, and a click aimed at the first frame's
 /// geometry can land beside its lane): the point two settled frames agree on.
