@@ -60,11 +60,7 @@ impl BodyModel {
             let l = axis.length();
             let axial = 0.5 * m * radius * radius;
             let transverse = m * (3.0 * radius * radius + l * l) / 12.0;
-            // Cylinder inertia in a frame whose z is the axis, turned onto the segment axis.
-            let dir = axis.try_normalize().unwrap_or(DVec3::Z);
-            let r = DMat3::from_quat(glam::DQuat::from_rotation_arc(DVec3::Z, dir));
-            let inertia =
-                r * DMat3::from_diagonal(DVec3::new(transverse, transverse, axial)) * r.transpose();
+            let inertia = inertia_along(axis, transverse, axial);
             Segment {
                 mass_kg: m,
                 com_m: axis * 0.5,
@@ -92,12 +88,9 @@ impl BodyModel {
             let l = axis.length();
             let axial = 0.5 * mass_kg * segment.radius_m * segment.radius_m;
             let transverse = mass_kg * l * l / 9.0;
-            let dir = axis.try_normalize().unwrap_or(DVec3::Z);
-            let r = DMat3::from_quat(glam::DQuat::from_rotation_arc(DVec3::Z, dir));
             segment.mass_kg = mass_kg;
             segment.com_m = axis * (2.0 / 3.0);
-            segment.inertia =
-                r * DMat3::from_diagonal(DVec3::new(transverse, transverse, axial)) * r.transpose();
+            segment.inertia = inertia_along(axis, transverse, axial);
         }
         self
     }
@@ -113,6 +106,15 @@ impl Default for BodyModel {
     fn default() -> Self {
         BodyModel::new(Skeleton::default(), 70.0)
     }
+}
+
+/// The inertia (kg·m²) of a body symmetric about `axis` (segment frame): `transverse`
+/// about any line across it through its centre of mass, `axial` about the axis itself.
+fn inertia_along(axis: DVec3, transverse: f64, axial: f64) -> DMat3 {
+    // Diagonal in a frame whose z is the axis, turned onto the segment axis.
+    let dir = axis.try_normalize().unwrap_or(DVec3::Z);
+    let r = DMat3::from_quat(glam::DQuat::from_rotation_arc(DVec3::Z, dir));
+    r * DMat3::from_diagonal(DVec3::new(transverse, transverse, axial)) * r.transpose()
 }
 
 /// The segment's extent from its joint (segment frame): to its child joint, or for the
@@ -137,9 +139,6 @@ fn segment_axis(skeleton: &Skeleton, joint: Joint) -> DVec3 {
 mod tests {
     use super::*;
 
-    /// The simulated segments carry 61.5 % of the body mass (Table 1 without pelvis and
-    /// legs); inertias are symmetric positive definite; a stick spins about its own axis
-    /// with an inertia near 1e-5 kg·m² (guide §5).
     /// A mallet pivoting freely about the grip presents 5/9 of its mass at the tip,
     /// as the drum contact assumes.
     #[test]
@@ -157,6 +156,9 @@ mod tests {
         assert_eq!(stick.mass_kg, 0.045);
     }
 
+    /// The simulated segments carry 61.5 % of the body mass (Table 1 without pelvis and
+    /// legs); inertias are symmetric positive definite; a stick spins about its own axis
+    /// with an inertia near 1e-5 kg·m² (guide §5).
     #[test]
     fn mass_properties() {
         let body = BodyModel::default();

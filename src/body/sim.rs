@@ -210,7 +210,7 @@ pub fn ik_targets(
 /// there is one; else toward the previous pose for the arms and toward `posture` (the
 /// initial pose, upright) for the trunk, which would otherwise drift through the null
 /// space stroke after stroke (53° in 10 s of fast strokes over four drums).
-fn ik_target(
+pub fn ik_target(
     model: &BodyModel,
     reference: &Reference,
     params: &SimParams,

@@ -24,7 +24,7 @@ use crate::base::rng::Rng;
 use crate::body::ik::posture_reaching;
 use crate::body::model::BodyModel;
 use crate::body::sim::{
-    Motion, Pipeline, Reference, SimError, SimParams, ik_targets, rms_error, simulate,
+    Motion, Pipeline, Reference, SimError, SimParams, ik_target, ik_targets, rms_error, simulate,
 };
 use crate::body::skeleton::{JOINT_COUNT, Pose, Skeleton};
 use crate::kit::Side;
@@ -443,7 +443,7 @@ pub fn trial(
     // the tip some 18 mm off, a start no controller of tips would be given); ID replays
     // the captured joints from the captured posture.
     let tip_start = match &reference.poses {
-        Some(_) => ik_targets(model, &truncated(reference, 1), &params.sim, &start)[0],
+        Some(_) => ik_target(model, reference, &params.sim, 0, &start, &start),
         _ => start,
     };
     let run = |p: Pipeline| {
@@ -461,24 +461,6 @@ pub fn trial(
         })
     };
     Ok([run(Pipeline::Ik)?, run(Pipeline::Id)?, run(Pipeline::Himc)?])
-}
-
-/// The first `n` samples of `reference`.
-fn truncated(reference: &Reference, n: usize) -> Reference {
-    Reference {
-        rate_hz: reference.rate_hz,
-        tips: reference
-            .tips
-            .each_ref()
-            .map(|t| t[..n.min(t.len())].to_vec()),
-        poses: reference
-            .poses
-            .as_ref()
-            .map(|p| p[..n.min(p.len())].to_vec()),
-        beats: Vec::new(),
-        gaze: None,
-        grip: None,
-    }
 }
 
 /// Evaluate every playing mode `db` has units of; the others are reported as skipped.
