@@ -108,7 +108,9 @@ fn centre_and_playing_spot_differ() {
 }
 
 /// Contacts of single free strokes last 2–8 ms, end with the stick rebounding, and peak
-/// force rises monotonically from pp to ff, with mf–ff within 55–120 N (seed 000: 62–107 N).
+/// force rises monotonically from pp to ff, with mf–ff within 45–115 N (seed 000: 62–107 N;
+/// the felt's loss takes about a tenth off the elastic felt's peaks at these speeds, and
+/// the renderer adapts each stroke to its force aim).
 #[test]
 fn contact_duration_and_force_by_dynamic() {
     let mut last = 0.0;
@@ -123,7 +125,7 @@ fn contact_duration_and_force_by_dynamic() {
         assert!(c.peak_force_n > last, "{table:?}");
         assert!((c.impact_speed_mps - speed).abs() < 0.01 * speed);
         if matches!(dynamic, Dynamic::Mf | Dynamic::F | Dynamic::Ff) {
-            assert!((55.0..=115.0).contains(&c.peak_force_n), "{table:?}");
+            assert!((45.0..=115.0).contains(&c.peak_force_n), "{table:?}");
         }
         last = c.peak_force_n;
     }

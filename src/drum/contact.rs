@@ -1,7 +1,11 @@
-//! The Hertz law of the felt mallet on the head (seed 000 eq. 6): F = k·c^α for a
-//! compression c > 0 between the felt ball and the (displaced) head surface, 0 otherwise.
-//! The compression is capped at the felt ball's radius (beyond it the stick's core would
-//! meet the head), so a tip driven far below the head gets a large but finite force.
+//! The Hertz law of the felt mallet on the head (seed 000 eq. 6) with the felt's
+//! hysteresis: F = k·c^α·(1 + λ·ċ) for a compression c > 0 between the felt ball and the
+//! (displaced) head surface, 0 otherwise (Hunt & Crossley 1975: the loss λ, s/m, makes the
+//! felt push harder while it is compressed than while it recovers, and the force still
+//! starts and ends at zero; never negative, the felt does not pull). Felt is a stiffening,
+//! lossy spring (guide §5; Stulov's hereditary model for piano hammers behaves so over a
+//! stroke). The compression is capped at the felt ball's radius (beyond it the stick's core
+//! would meet the head), so a tip driven far below the head gets a large but finite force.
 //!
 //! Effective mass at the tip ([`effective_mass_kg`]): the mallet pivots about the grip; with
 //! a third of its mass in the felt head at the tip and two thirds in a uniform shaft
@@ -24,6 +28,8 @@ pub struct HertzContact {
     pub exponent: f64,
     /// Felt ball radius, m (the stick tip is the ball's centre).
     pub ball_radius_m: f64,
+    /// Hunt–Crossley loss λ of the felt, s/m (0: elastic).
+    pub loss_s_per_m: f64,
 }
 
 impl HertzContact {
@@ -33,7 +39,8 @@ impl HertzContact {
             && mallet.felt_stiffness > 0.0
             && mallet.head_radius_m > 0.0
             && mallet.mass_kg > 0.0
-            && (1.0..=4.0).contains(&mallet.contact_exponent);
+            && (1.0..=4.0).contains(&mallet.contact_exponent)
+            && (0.0..=10.0).contains(&mallet.felt_loss_s_per_m);
         if !ok {
             return Err(DrumError::InvalidMallet(mallet.name.clone()));
         }
@@ -41,6 +48,7 @@ impl HertzContact {
             stiffness: mallet.felt_stiffness,
             exponent: mallet.contact_exponent,
             ball_radius_m: mallet.head_radius_m,
+            loss_s_per_m: mallet.felt_loss_s_per_m,
         })
     }
 
@@ -55,15 +63,37 @@ impl HertzContact {
 }
 
 impl HertzContact {
-    /// The force F ≥ 0 that satisfies F = k·c^α with c = c0 − compliance·F (m, m/N): the
-    /// contact force when the compression itself yields under it. 0 when c0 ≤ 0.
-    pub fn solve(&self, c0: f64, compliance: f64) -> f64 {
+    /// The force F ≥ 0 held over one step of `dt_s` that satisfies
+    /// F = k·c^α·max(0, 1 + λ·ċ) with the mid-step compression c = c0 − compliance·F and
+    /// its rate ċ = 2·(c − c_start)/dt (the compression at the step's start `c_start`, m):
+    /// the contact force when the compression itself yields under it (m, m/N). 0 when
+    /// c0 ≤ 0. With λ = 0 it is the elastic F = k·c^α.
+    pub fn solve(&self, c0: f64, compliance: f64, c_start: f64, dt_s: f64) -> f64 {
         if c0.is_nan() || c0 <= 0.0 {
             return 0.0;
         }
-        let residual = |f: f64| f - self.force(c0 - compliance * f);
+        let rate_gain = 2.0 * self.loss_s_per_m / dt_s;
+        // The force for a mid-step compression c, and its slope dF/dc.
+        let law = |c: f64| -> (f64, f64) {
+            if c <= 0.0 {
+                return (0.0, 0.0);
+            }
+            let capped = c.min(self.ball_radius_m);
+            let elastic = self.stiffness * capped.powf(self.exponent);
+            let loss = 1.0 + rate_gain * (c - c_start);
+            if loss <= 0.0 {
+                return (0.0, 0.0);
+            }
+            let elastic_slope = if c < self.ball_radius_m {
+                self.exponent * elastic / c
+            } else {
+                0.0
+            };
+            (elastic * loss, elastic_slope * loss + elastic * rate_gain)
+        };
+        let residual = |f: f64| f - law(c0 - compliance * f).0;
         // The compression cannot go below 0, so F ≤ c0/compliance.
-        let (mut lo, mut hi) = (0.0, self.force(c0));
+        let (mut lo, mut hi) = (0.0, law(c0).0);
         if compliance.is_nan() || compliance <= 0.0 || hi <= 0.0 {
             return hi.max(0.0);
         }
@@ -78,12 +108,7 @@ impl HertzContact {
             } else {
                 lo = f;
             }
-            let c = c0 - compliance * f;
-            let slope = if c > 0.0 && c < self.ball_radius_m {
-                1.0 + compliance * self.exponent * self.stiffness * c.powf(self.exponent - 1.0)
-            } else {
-                1.0
-            };
+            let slope = 1.0 + compliance * law(c0 - compliance * f).1;
             let mut next = f - r / slope;
             if !(next > lo && next < hi) {
                 next = 0.5 * (lo + hi);
@@ -114,11 +139,28 @@ mod tests {
         assert_eq!(law.force(10.0), law.force(law.ball_radius_m));
         assert!(law.force(2.0 * c) > law.force(c));
         // The yielding solution satisfies its equation and is below the rigid force.
-        let (c0, s) = (0.004, 2e-5);
-        let f = law.solve(c0, s);
+        let elastic = HertzContact {
+            loss_s_per_m: 0.0,
+            ..law
+        };
+        let (c0, s, dt) = (0.004, 2e-5, 1e-4);
+        let f = elastic.solve(c0, s, c0, dt);
         assert!((f - law.force(c0 - s * f)).abs() < 1e-6 * f, "{f}");
         assert!(f > 0.0 && f < law.force(c0));
-        assert_eq!(law.solve(-1e-3, s), 0.0);
-        assert_eq!(law.solve(f64::NAN, s), 0.0);
+        assert_eq!(law.solve(-1e-3, s, 0.0, dt), 0.0);
+        assert_eq!(law.solve(f64::NAN, s, 0.0, dt), 0.0);
+        // Hysteresis: compressing (the step started 0.1 mm shallower) pushes harder than
+        // the elastic law, recovering (0.1 mm deeper) less, and the equation holds.
+        let s = 1e-8;
+        let f = elastic.solve(c0, s, c0, dt);
+        let loading = law.solve(c0, s, c0 - 1e-4, dt);
+        let unloading = law.solve(c0, s, c0 + 1e-4, dt);
+        assert!(loading > f && unloading < f, "{loading} {f} {unloading}");
+        let c = c0 - s * loading;
+        let rate = 2.0 * (c - (c0 - 1e-4)) / dt;
+        let want = law.force(c) * (1.0 + law.loss_s_per_m * rate);
+        assert!((loading - want).abs() < 1e-6 * want, "{loading} {want}");
+        // A felt recovering faster than λ allows pushes not at all (it never pulls).
+        assert_eq!(law.solve(c0, s, c0 + 0.1, dt), 0.0);
     }
 }

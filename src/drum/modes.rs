@@ -9,15 +9,43 @@
 //!
 //! Modes the kit does not list (e.g. (0,1), (1,2), (6,1)) take the in-vacuo membrane
 //! frequency j_mn/(2πa)·√(T/σ) (air loading mostly lowers the lowest modes; this puts
-//! (0,2) and (1,2) within 3 % of Fletcher & Rossing's 65-cm kettledrum), a T60 and gain
+//! (0,2) and (1,2) within 5 % of Fletcher & Rossing's 65-cm kettledrum), a T60 and gain
 //! scaled from the kit's highest listed mode by f_last/f (higher modes die faster and
 //! radiate less), and axisymmetric (m = 0) modes a quarter of that T60 (they die fast, guide §5).
+//!
+//! **The kettle** ([`kettle_loading`]): an axisymmetric mode moves air. Outside, it carries
+//! the radiation mass of a baffled piston of the same volume velocity, ρ·S²·8/(3π²a)
+//! (S = ∫Φ dA, m²; the piston's (8/3)ρa³ at low frequency); below, the kettle's air
+//! (volume V) is a spring ρc²·S²/V. The mode rings at √((K_vac + ρc²S²/V)/(M_vac + M_air)):
+//! the 26-inch drum's (0,1) at 0.85 of its (1,1), as Rossing measured on a 65-cm
+//! kettledrum (127 against 150 Hz), where the head without its kettle puts it near 0.55.
+//! The sound it radiates damps it ([`radiation_t60_s`]): the (0,1) rings about 0.1 s, the
+//! short low thump of a timpani stroke.
+//! Modes with nodal diameters move no net air and keep the kit's uniform air loading.
 
 use super::bessel::{EXACT_ZERO_LIMIT, Radial, bessel_zeros_below, debye_zero};
 use super::{DrumError, FrequencySource, ModeConfig};
 use crate::kit::Drum;
 use glam::{DVec2, DVec3};
 use std::f64::consts::{PI, TAU};
+
+/// Density of air, kg/m³ (20 °C).
+pub const AIR_DENSITY_KG_PER_M3: f64 = 1.204;
+/// Speed of sound in air, m/s (20 °C).
+pub const SOUND_SPEED_MPS: f64 = 343.0;
+
+/// The air an axisymmetric mode moves: its added radiation mass outside (kg) and the
+/// kettle's spring below (N/m, 0 without a kettle), for a head of radius `a_m` and a mode
+/// whose shape J0(j·r/a) (1 at the centre) has zero `zero` and J1(zero)² `j1_squared`.
+pub fn kettle_loading(a_m: f64, zero: f64, j1_squared: f64, kettle_m3: Option<f64>) -> (f64, f64) {
+    // S² = (2πa²·J1(j)/j)², the volume swept per unit modal displacement, squared.
+    let swept_squared = (TAU * a_m * a_m).powi(2) * j1_squared / (zero * zero);
+    let mass = AIR_DENSITY_KG_PER_M3 * swept_squared * 8.0 / (3.0 * PI * PI * a_m);
+    let spring = kettle_m3.map_or(0.0, |v| {
+        AIR_DENSITY_KG_PER_M3 * SOUND_SPEED_MPS * SOUND_SPEED_MPS * swept_squared / v
+    });
+    (mass, spring)
+}
 
 /// Which of a degenerate pair: the shape's angular factor cos(mθ) or sin(mθ) (m = 0 modes
 /// have only `Cos`, whose factor is 1).
@@ -99,6 +127,19 @@ fn unlisted_zeros(x_max: f64, is_listed: &dyn Fn(u32, u32) -> bool) -> Vec<(f64,
     }
     found.retain(|&(_, m, n)| !is_listed(m, n));
     found
+}
+
+/// Time for an axisymmetric mode of modal mass `mass_kg` ringing at `freq_hz` to lose
+/// 60 dB to the sound it radiates from one face of a baffled head of radius `a_m`, s:
+/// R = ρc·S²/(πa²)·(1 − 2J1(2ka)/(2ka)) (a baffled piston of the same volume velocity,
+/// ρω²S²/(2πc) at low ka), T60 = ln(1000)·2M/R. The 26-inch drum's (0,1): about 0.09 s.
+pub fn radiation_t60_s(a_m: f64, zero: f64, j1_squared: f64, freq_hz: f64, mass_kg: f64) -> f64 {
+    let swept_squared = (TAU * a_m * a_m).powi(2) * j1_squared / (zero * zero);
+    let two_ka = 2.0 * TAU * freq_hz / SOUND_SPEED_MPS * a_m;
+    let piston = 1.0 - 2.0 * super::bessel::bessel_j(1, two_ka) / two_ka;
+    let resistance =
+        AIR_DENSITY_KG_PER_M3 * SOUND_SPEED_MPS * swept_squared / (PI * a_m * a_m) * piston;
+    1000f64.ln() * 2.0 * mass_kg / resistance
 }
 
 /// The modes of one head and where it is.
@@ -207,6 +248,22 @@ impl HeadModes {
             // ∫ Φ² dA = π a² J1(j)² for m = 0, π a²/2 · J_{m+1}(j)² otherwise.
             let angular = if m == 0 { PI } else { PI / 2.0 };
             let norm = angular * a * a * radial.j_next_squared();
+            // An unlisted axisymmetric mode moves air: the membrane's own mass and
+            // stiffness (in vacuo), the radiation mass and the kettle's spring; what it
+            // radiates damps it.
+            let (freq_hz, t60_s, modal_mass_kg) = if m == 0 && listed.is_none() {
+                let membrane_mass = mem.areal_density_kg_per_m2 * norm;
+                let stiffness = membrane_mass * (TAU * membrane_hz).powi(2);
+                let j1_squared = radial.j_next_squared();
+                let (air_mass, air_spring) =
+                    kettle_loading(a, zero, j1_squared, drum.kettle_volume_m3);
+                let mass = membrane_mass + air_mass;
+                let f = ((stiffness + air_spring) / mass).sqrt() / TAU;
+                let radiated = radiation_t60_s(a, zero, j1_squared, f, mass);
+                (f, t60_s.min(radiated), mass)
+            } else {
+                (freq_hz, t60_s, sigma_eff * norm)
+            };
             for &orientation in orientations(m) {
                 if !room(modes) {
                     return;
@@ -223,7 +280,7 @@ impl HeadModes {
                     freq_hz,
                     t60_s,
                     gain,
-                    modal_mass_kg: sigma_eff * norm,
+                    modal_mass_kg,
                     listed: listed.is_some(),
                     radial: radial.clone(),
                 });
@@ -343,7 +400,8 @@ mod tests {
         assert!((ratio(1, 2) / 2.09 - 1.0).abs() < 0.05, "{}", ratio(1, 2));
     }
 
-    /// With 200 modes the unlisted ones come in rising frequency, all finite and positive.
+    /// With 200 modes the unlisted ones with nodal diameters come in rising frequency (the
+    /// kettle moves the axisymmetric ones), all finite and positive.
     #[test]
     fn two_hundred_modes_are_sorted_and_sane() {
         let d = standard_26();
@@ -356,7 +414,7 @@ mod tests {
         let unlisted: Vec<f64> = h
             .modes()
             .iter()
-            .filter(|k| !k.listed)
+            .filter(|k| !k.listed && k.m > 0)
             .map(|k| k.freq_hz)
             .collect();
         assert!(unlisted.windows(2).all(|w| w[0] <= w[1]));
@@ -366,6 +424,45 @@ mod tests {
             && k.gain.is_finite()));
         assert!(ModeConfig { count: 0, ..cfg }.check().is_err());
         assert!(ModeConfig { count: 201, ..cfg }.check().is_err());
+    }
+
+    /// The kettle's air spring raises the (0,1) of the 26-inch drum from about 0.54 of the
+    /// (1,1) (head open below, radiation mass only) to Rossing's 0.85, a smaller kettle
+    /// raises it more, and modes with nodal diameters do not feel it.
+    #[test]
+    fn the_kettle_raises_the_axisymmetric_modes() {
+        let ratio_01 = |volume: Option<f64>| {
+            let mut d = standard_26();
+            d.kettle_volume_m3 = volume;
+            let h = HeadModes::new(&d, &ModeConfig::default()).unwrap();
+            let of = |m, n| {
+                h.modes()
+                    .iter()
+                    .find(|k| (k.m, k.n) == (m, n))
+                    .unwrap()
+                    .freq_hz
+            };
+            (of(0, 1) / d.tuning.hz(), of(1, 2))
+        };
+        let (open, open_12) = ratio_01(None);
+        let (kettle, kettle_12) = ratio_01(standard_26().kettle_volume_m3);
+        let (small, _) = ratio_01(Some(0.1));
+        assert!((open - 0.54).abs() < 0.03, "{open}");
+        assert!((kettle - 0.85).abs() < 0.02, "{kettle}");
+        assert!(small > kettle + 0.1, "{small}");
+        assert_eq!(open_12, kettle_12);
+        // Its radiation damps the (0,1) within about 0.1 s; at low ka the piston law is
+        // ρω²S²/(2πc).
+        let h = HeadModes::new(&standard_26(), &ModeConfig::default()).unwrap();
+        let mode = h.modes().iter().find(|k| (k.m, k.n) == (0, 1)).unwrap();
+        assert!((0.05..0.15).contains(&mode.t60_s), "{}", mode.t60_s);
+        let (a, z, j1s) = (0.01, mode.bessel_zero(), mode.radial.j_next_squared());
+        let s2 = (TAU * a * a).powi(2) * j1s / (z * z);
+        let omega = TAU * 100.0;
+        let r = AIR_DENSITY_KG_PER_M3 * omega * omega * s2 / (TAU * SOUND_SPEED_MPS);
+        let want = 1000f64.ln() * 2.0 * 1e-3 / r;
+        let t60 = radiation_t60_s(a, z, j1s, 100.0, 1e-3);
+        assert!((t60 / want - 1.0).abs() < 1e-3, "{t60} {want}");
     }
 
     /// The membrane source reproduces the ideal-membrane ratios j_mn/j_11 and the kit's
@@ -383,8 +480,9 @@ mod tests {
         assert!((h.modes()[2].freq_hz / f11 - 5.135_622 / 3.831_706).abs() < 1e-5);
     }
 
-    /// Modal mass equals σ_eff ∫Φ² dA by numerical quadrature (1e-3), and shapes are 0 at
-    /// the rim, J_m(0) at the centre, and cos/sin in angle.
+    /// Modal mass equals σ_eff ∫Φ² dA by numerical quadrature (1e-3) (σ ∫Φ² dA plus the
+    /// air's radiation mass for the axisymmetric modes), and shapes are 0 at the rim,
+    /// J_m(0) at the centre, and cos/sin in angle.
     #[test]
     fn modal_mass_and_shapes() {
         let d = standard_26();
@@ -411,7 +509,14 @@ mod tests {
             }
         }
         for (k, mode) in h.modes().iter().enumerate() {
-            let m = sigma_eff * integral[k];
+            let m = if mode.m == 0 {
+                let zero = mode.bessel_zero();
+                let j1_squared = integral[k] / (PI * a * a);
+                let air = kettle_loading(a, zero, j1_squared, None).0;
+                d.membrane.areal_density_kg_per_m2 * integral[k] + air
+            } else {
+                sigma_eff * integral[k]
+            };
             assert!(
                 (m / mode.modal_mass_kg - 1.0).abs() < 1e-3,
                 "mode {k}: {m} vs {}",

@@ -262,7 +262,9 @@ impl DrumSet {
             }
             let c_end = surface + d_free - bottom_end;
             let c0 = 0.5 * (c_now + c_end);
-            let f = self.law.solve(c0, 0.5 * (compliance + tip_compliance));
+            let f = self
+                .law
+                .solve(c0, 0.5 * (compliance + tip_compliance), c_now, dt);
             if f > 0.0 {
                 force[i] = f;
                 touching[i] = Some((j, local));

@@ -27,6 +27,17 @@ pub const PLAYING_SPOT_FRACTION: f64 = 0.6;
 /// players' 1.5–3.7 m/s for those forces, see README "Strokes").
 pub const FULL_SPEED_MPS: f64 = 8.0;
 
+/// Peak contact force a stroke of MIDI velocity 0 aims at, N, and the increase to
+/// velocity 127 (seed 000 measured 62–107 N strikes): pp 33 … ff 99 N. The renderer's
+/// compensation adapts each stroke toward it, and the sound's reference strokes meet it.
+pub const FORCE_AT_SILENCE_N: f64 = 5.0;
+pub const FORCE_RANGE_N: f64 = 107.0;
+
+/// The peak contact force aimed at for a stroke of `dynamic`, N.
+pub fn aimed_force_n(dynamic: Dynamic) -> f64 {
+    FORCE_AT_SILENCE_N + FORCE_RANGE_N * dynamic.velocity().clamp(0.0, 1.0)
+}
+
 /// Downward impact speed for a dynamic, m/s (linear in MIDI velocity, see [`FULL_SPEED_MPS`]).
 pub fn impact_speed_mps(dynamic: Dynamic) -> f64 {
     FULL_SPEED_MPS * dynamic.velocity().clamp(0.0, 1.0)
@@ -109,6 +120,36 @@ pub fn run(
         }
     }
     history
+}
+
+/// The downward impact speed (m/s) at which a free stroke of `mallet` at `point` on the
+/// single drum of `kit` peaks at `force_n` (within 0.5 %, secant on the speed from
+/// [`FULL_SPEED_MPS`]-scaled guesses; each trial a fresh head at rest). Deterministic.
+pub fn speed_for_force(kit: &crate::kit::Kit, config: &super::ModeConfig, force_n: f64) -> f64 {
+    let (drum, mallet) = (&kit.drums[0], &kit.mallets[0]);
+    let point = drum.point_on_head(PLAYING_SPOT_FRACTION, 0.0);
+    let peak = |speed: f64| {
+        let mut drums = DrumSet::new(kit, mallet, config, 1.0 / SIM_RATE_HZ)
+            .expect("a kit that plays is valid");
+        scripted(&mut drums, drum, mallet, Side::Right, point, speed, 0.02);
+        drums
+            .contacts()
+            .iter()
+            .map(|c| c.peak_force_n)
+            .fold(0.0, f64::max)
+    };
+    let (mut v0, mut v1) = (0.04 * force_n, 0.06 * force_n);
+    let (mut f0, mut f1) = (peak(v0), peak(v1));
+    for _ in 0..20 {
+        if (f1 / force_n - 1.0).abs() < 0.005 || (f1 - f0).abs() < 1e-9 {
+            break;
+        }
+        let next = (v1 + (force_n - f1) * (v1 - v0) / (f1 - f0)).clamp(0.1, 30.0);
+        (v0, f0) = (v1, f1);
+        v1 = next;
+        f1 = peak(v1);
+    }
+    v1
 }
 
 /// One free stroke by `side` at `point` on drum `drum` of the set, starting 1 mm above

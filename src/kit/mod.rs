@@ -63,6 +63,10 @@ pub struct Drum {
     /// Shortest comfortable time between two strokes of one hand on this drum, s
     /// (`minTimeGap` of seed 003 Alg. 3.1).
     pub min_same_hand_gap_s: f64,
+    /// Volume of air the kettle encloses under the head, m³: its spring raises the
+    /// axisymmetric modes (none: a head open below, as kits written before it read).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kettle_volume_m3: Option<f64>,
 }
 
 /// The drum head as a membrane.
@@ -122,6 +126,10 @@ pub struct Mallet {
     pub contact_exponent: f64,
     /// Radius of the felt head, m.
     pub head_radius_m: f64,
+    /// Hunt–Crossley loss λ of the felt in F = k·c^α·(1 + λ·ċ), s/m (0: elastic; kits
+    /// written before it existed read as elastic).
+    #[serde(default)]
+    pub felt_loss_s_per_m: f64,
 }
 
 /// Zero j11 of the Bessel function J1: the (1,1) mode of an ideal circular membrane.

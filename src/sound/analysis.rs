@@ -103,6 +103,22 @@ pub fn profile(samples: &[f32], rate_hz: u32) -> Option<Profile> {
     })
 }
 
+/// Share (dB of the total) of the first second after the onset that lies between `lo_hz`
+/// and `hi_hz`, e.g. the low thump below the (1,1). None for a silent signal.
+pub fn share_between_db(samples: &[f32], rate_hz: u32, lo_hz: f64, hi_hz: f64) -> Option<f64> {
+    let start = onset(samples, rate_hz)?;
+    let len = ((ANALYSIS_SPAN_S * f64::from(rate_hz)) as usize).min(samples.len() - start);
+    let (bin_hz, power) = power_spectrum(&samples[start..start + len], rate_hz);
+    let total: f64 = power.iter().skip(1).sum::<f64>().max(1e-300);
+    let inside: f64 = power
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| (lo_hz..hi_hz).contains(&(*k as f64 * bin_hz)))
+        .map(|(_, p)| p)
+        .sum();
+    Some(10.0 * (inside / total).max(1e-30).log10())
+}
+
 /// The frequency of the partial near `near_hz` (searched within ±4 %) in a Hann window of
 /// `window_s` seconds starting `at_s` after the signal's start, by the peak of a zero-padded
 /// spectrum (×16) refined by parabolic interpolation. None when the window runs off the end.

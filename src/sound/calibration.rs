@@ -42,6 +42,10 @@ pub struct Calibration {
     pub t60_s: [f64; 7],
     /// T60 of axisymmetric (m = 0) modes as a share of the others' (radiation damps them).
     pub axisymmetric_t60_share: f64,
+    /// Correction of the unlisted axisymmetric modes' radiation (the (0,1)'s low thump
+    /// below the (1,1)), dB (calibrations written before it read 0).
+    #[serde(default)]
+    pub axisymmetric_db: f64,
     /// T60 of the listed partials.
     pub partials: Vec<PartialDecay>,
     /// The fit's residuals.
@@ -66,6 +70,11 @@ impl Calibration {
         ron_file::write_atomic(path, text.as_bytes())
     }
 
+    /// Radiation correction of the unlisted axisymmetric modes, linear gain.
+    pub fn axisymmetric_gain(&self) -> f64 {
+        10f64.powf(self.axisymmetric_db / 20.0)
+    }
+
     /// Radiation correction at `hz`, linear gain.
     pub fn radiation_gain(&self, hz: f64) -> f64 {
         10f64.powf(interpolate(&self.radiation_db, hz) / 20.0)
@@ -81,6 +90,7 @@ impl Calibration {
             radiation_db: [0.0; 7],
             t60_s: [2.0; 7],
             axisymmetric_t60_share: 0.1,
+            axisymmetric_db: 0.0,
             partials: Vec::new(),
             residuals: Vec::new(),
         }

@@ -13,7 +13,9 @@ use super::calibration::{Calibration, PartialDecay, Residual};
 use super::{SoundError, SoundModel};
 use crate::base::gesture::Dynamic;
 use crate::base::pitch::Pitch;
-use crate::drum::strike::{PLAYING_SPOT_FRACTION, SIM_RATE_HZ, scripted};
+use crate::drum::strike::{
+    PLAYING_SPOT_FRACTION, SIM_RATE_HZ, aimed_force_n, scripted, speed_for_force,
+};
 use crate::drum::{DrumSet, ModeConfig};
 use crate::kit::{Kit, Side};
 
@@ -43,22 +45,36 @@ pub struct Note {
     pub rate_hz: u32,
 }
 
-/// What a note measures: pitch (Hz), band shares (dB), band T60s (s).
+/// The span below the (1,1) where the (0,1) thumps, as fractions of the (1,1): the (0,1)
+/// with its kettle near 0.85, clear of the (1,1)'s own line.
+pub const THUMP_SPAN: (f64, f64) = (0.3, 0.92);
+
+/// What a note measures: pitch (Hz), band shares (dB), band T60s (s), the share of the
+/// thump span (dB).
 #[derive(Clone, Debug)]
 struct Measured {
     pitch_hz: f64,
     bands_db: [f64; 7],
     band_t60_s: [Option<f64>; 7],
+    thump_db: f64,
 }
 
 fn measure(samples: &[f32], rate_hz: u32) -> Option<Measured> {
     let p = analysis::profile(samples, rate_hz)?;
     let band_t60_s = OCTAVE_CENTRES_HZ
         .map(|c| analysis::band_t60(samples, rate_hz, c, DECAY_SPAN_S, DECAY_WINDOW_S));
+    let pitch_hz = p.principal_hz?;
+    let thump_db = analysis::share_between_db(
+        samples,
+        rate_hz,
+        THUMP_SPAN.0 * pitch_hz,
+        THUMP_SPAN.1 * pitch_hz,
+    )?;
     Some(Measured {
-        pitch_hz: p.principal_hz?,
+        pitch_hz,
         bands_db: p.bands_db,
         band_t60_s,
+        thump_db,
     })
 }
 
@@ -89,19 +105,10 @@ pub fn kit_for(hz: f64) -> Kit {
     kit
 }
 
-/// The head the shipped calibration's reference strokes were struck on: 24 mechanical
-/// modes (the default until the strokes' re-contacts asked for 100, which made contacts
-/// longer and the fit of the recordings worse: to be refitted with the sound's own work).
-pub const FITTED_HEAD: ModeConfig = ModeConfig {
-    count: 24,
-    source: crate::drum::FrequencySource::Measured,
-};
-/// The reference strokes' impact speed at velocity 1, m/s (pp 1.46 … ff 4.94 m/s).
-pub const FITTED_FULL_SPEED_MPS: f64 = 5.6;
-
 /// One scripted stroke at `dynamic` (legato, playing spot, general mallet, right hand) on
-/// the first drum of `kit`, rendered with the modal model under `calibration`: mono,
-/// 48 kHz, `duration_s` long.
+/// the first drum of `kit` (the renderer's head, [`ModeConfig::default`]), struck at the
+/// speed that meets the renderer's force aim for the dynamic ([`aimed_force_n`]),
+/// rendered with the modal model under `calibration`: mono, 48 kHz, `duration_s` long.
 pub fn stroke(
     kit: &Kit,
     dynamic: Dynamic,
@@ -109,10 +116,11 @@ pub fn stroke(
     duration_s: f64,
 ) -> Result<Vec<f32>, SoundError> {
     let (drum, mallet) = (&kit.drums[0], &kit.mallets[0]);
-    let mut drums = DrumSet::new(kit, mallet, &FITTED_HEAD, 1.0 / SIM_RATE_HZ)
-        .expect("the standard kit is valid");
+    let config = ModeConfig::default();
+    let mut drums =
+        DrumSet::new(kit, mallet, &config, 1.0 / SIM_RATE_HZ).expect("the standard kit is valid");
     let point = drum.point_on_head(PLAYING_SPOT_FRACTION, 0.0);
-    let speed = FITTED_FULL_SPEED_MPS * dynamic.velocity().clamp(0.0, 1.0);
+    let speed = speed_for_force(kit, &config, aimed_force_n(dynamic));
     scripted(
         &mut drums,
         drum,
@@ -217,12 +225,14 @@ pub fn fit(
         let mut residuals = Vec::new();
         let mut band_steps: [Vec<f64>; 7] = Default::default();
         let mut t60_ratios: [Vec<f64>; 7] = Default::default();
+        let mut thump_steps = Vec::new();
 
         for ((note, target), kit) in notes.iter().zip(&measured).zip(&kits) {
             let audio = stroke(kit, Dynamic::Mf, &cal, NOTE_S)?;
             let model = measure(&audio, super::SAMPLE_RATE_HZ)
                 .ok_or_else(|| FitError::NoPitch(format!("the model's {}", note.name)))?;
 
+            thump_steps.push(target.thump_db - model.thump_db);
             let mut bands_db = [0.0; 7];
             for b in 0..7 {
                 bands_db[b] = model.bands_db[b] - target.bands_db[b];
@@ -253,10 +263,13 @@ pub fn fit(
             let step = geometric_mean(&t60_ratios[b]).clamp(0.7, 1.4);
             cal.t60_s[b] = (cal.t60_s[b] * step).clamp(MIN_T60_S, MAX_T60_S);
         }
-        // Bands below every note's fitted ones hold the lowest fitted band's value.
+        let step = thump_steps.iter().sum::<f64>() / thump_steps.len() as f64;
+        cal.axisymmetric_db += step.clamp(-MAX_STEP_DB, MAX_STEP_DB);
+        // Bands below every note's fitted ones (there the listed partials rule the band
+        // shares and a correction of the others is not measurable) keep the physical
+        // Rayleigh radiation: the (0,1) with its kettle, the (1,2), the (0,2).
         if let Some(first) = band_steps.iter().position(|s| !s.is_empty()) {
-            let held = cal.radiation_db[first];
-            cal.radiation_db[..first].fill(held);
+            cal.radiation_db[..first].fill(0.0);
         }
     }
     Ok(cal)

@@ -114,12 +114,24 @@ impl SoundHead {
                 let mode = &modes.modes()[k];
                 Voice {
                     freq_hz: mode.freq_hz,
-                    t60_s: calibration.t60_s(mode.m, mode.n, mode.freq_hz),
+                    // An axisymmetric mode dies at least as fast as its own radiation
+                    // damps it.
+                    t60_s: if mode.m == 0 && !mode.listed {
+                        calibration
+                            .t60_s(mode.m, mode.n, mode.freq_hz)
+                            .min(mode.t60_s)
+                    } else {
+                        calibration.t60_s(mode.m, mode.n, mode.freq_hz)
+                    },
                     glide: glide_per_state * stretch(mode),
                     // Over ω_k: the mix differentiates (the head radiates its
                     // acceleration), giving w at the mode's own frequency.
                     gain: if mode.listed {
                         w
+                    } else if mode.m == 0 {
+                        w * scale
+                            * calibration.radiation_gain(mode.freq_hz)
+                            * calibration.axisymmetric_gain()
                     } else {
                         w * scale * calibration.radiation_gain(mode.freq_hz)
                     } / (std::f64::consts::TAU * mode.freq_hz),
