@@ -1,8 +1,12 @@
 //! The modal sound's calibration on recorded timpani (`kits/sound/modal.ron`, written by
-//! `timpanist sound fit`, see [`super::fit`]): per octave band a correction of the
-//! Rayleigh radiation weights (dB) and the T60 of the modes the kit does not list (s),
-//! the T60 of the listed (m, n) partials, and the fit's residuals. Values between band
-//! centres are interpolated linearly in log frequency and held flat beyond the ends.
+//! `timpanist sound fit`, see [`super::fit`]): a correction of the Rayleigh radiation
+//! weights (dB) per octave of a mode's *order*, its frequency over the head's (1,1)
+//! ([`ORDER_CENTRES`]: what the model misses in the excitation and radiation of a head's
+//! higher modes scales with their place in its spectrum, not with absolute frequency, so
+//! one correction serves the low and the high drums), the T60 of the modes the kit does
+//! not list per octave band (s), the T60 of the listed (m, n) partials, and the fit's
+//! residuals. Values between centres are interpolated linearly in log frequency and held
+//! flat beyond the ends.
 //! The shipped file is embedded in the program.
 
 use super::analysis::OCTAVE_CENTRES_HZ;
@@ -10,6 +14,9 @@ use crate::base::ron_file::{self, FileError};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::sync::OnceLock;
+
+/// Centres of the radiation correction's octaves of mode order f/f11.
+pub const ORDER_CENTRES: [f64; 7] = [0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0];
 
 /// The shipped calibration's text.
 pub const SHIPPED: &str = include_str!("../../kits/sound/modal.ron");
@@ -36,8 +43,9 @@ pub struct Calibration {
     pub version: u32,
     /// The recordings it was fitted to.
     pub fitted_from: Vec<String>,
-    /// Correction of the radiation weights per octave band, dB.
-    pub radiation_db: [f64; 7],
+    /// Correction of the radiation weights per octave of mode order f/f11
+    /// ([`ORDER_CENTRES`]), dB.
+    pub radiation_by_order_db: [f64; 7],
     /// T60 of unlisted modes per octave band, s.
     pub t60_s: [f64; 7],
     /// T60 of axisymmetric (m = 0) modes as a share of the others' (radiation damps them).
@@ -63,8 +71,9 @@ impl Calibration {
     pub fn save(&self, path: &Path) -> Result<(), FileError> {
         let text = format!(
             "// The modal sound's calibration on recorded timpani, written by `timpanist sound fit`\n\
-             // (README \"Sound calibration\"). Per octave band 63 Hz - 4 kHz: radiation correction (dB),\n\
-             // T60 of unlisted modes (s); listed partials' T60; residual = model - recording (dB).\n{}",
+             // (README \"Sound calibration\"). Radiation correction (dB) per octave of mode order f/f11\n\
+             // (0.5 ... 32); per octave band 63 Hz - 4 kHz the T60 of unlisted modes (s); listed\n\
+             // partials' T60; residual = model - recording per octave band (dB).\n{}",
             ron_file::to_pretty(self)
         );
         ron_file::write_atomic(path, text.as_bytes())
@@ -75,9 +84,11 @@ impl Calibration {
         10f64.powf(self.axisymmetric_db / 20.0)
     }
 
-    /// Radiation correction at `hz`, linear gain.
-    pub fn radiation_gain(&self, hz: f64) -> f64 {
-        10f64.powf(interpolate(&self.radiation_db, hz) / 20.0)
+    /// Radiation correction of a mode of order `f_over_f11` (its frequency over the
+    /// head's (1,1)), linear gain.
+    pub fn radiation_gain(&self, f_over_f11: f64) -> f64 {
+        let at = f_over_f11 / ORDER_CENTRES[0] * OCTAVE_CENTRES_HZ[0];
+        10f64.powf(interpolate(&self.radiation_by_order_db, at) / 20.0)
     }
 
     /// Where a fit starts: no radiation correction, the guide's recorded decay (−20 dB in
@@ -87,7 +98,7 @@ impl Calibration {
         Calibration {
             version: 1,
             fitted_from: Vec::new(),
-            radiation_db: [0.0; 7],
+            radiation_by_order_db: [0.0; 7],
             t60_s: [2.0; 7],
             axisymmetric_t60_share: 0.1,
             axisymmetric_db: 0.0,

@@ -2,14 +2,15 @@
 //! measured with [`super::analysis`] — its (1,1) pitch, octave-band shares and band T60s
 //! over the first second, and the T60 of the kit's listed partials — and the same note is
 //! played by a scripted mf stroke (legato, playing spot) on the standard-kit drum whose
-//! range is nearest, tuned to the recording. Then, a few rounds: each band's radiation
-//! correction moves by the mean (recording − model) band share, and each band's T60 by
+//! range is nearest, tuned to the recording. Then, a few rounds: each octave of mode order
+//! (f/f11) moves its radiation correction by the mean (recording − model) share of the
+//! notes' bands that fall in it, and each band's T60 by
 //! the geometric-mean ratio of the recordings' band T60 to the model's. The listed
 //! partials take the recordings' measured T60s directly. Deterministic: the same
 //! recordings give the same calibration.
 
 use super::analysis::{self, OCTAVE_CENTRES_HZ};
-use super::calibration::{Calibration, PartialDecay, Residual};
+use super::calibration::{Calibration, ORDER_CENTRES, PartialDecay, Residual};
 use super::{SoundError, SoundModel};
 use crate::base::gesture::Dynamic;
 use crate::base::pitch::Pitch;
@@ -28,6 +29,10 @@ const DECAY_SPAN_S: (f64, f64) = (0.02, 1.0);
 /// A band's radiation correction is fitted on the notes whose pitch lies this many times
 /// below the band's centre (lower bands are the listed partials' business).
 const BAND_FIT_ABOVE_PITCH: f64 = 4.0;
+/// An octave of mode order is fitted only on the bands of at least this many notes (one
+/// note alone, e.g. the bright G2, would set it by its own quirks); the others keep the
+/// physical radiation.
+const MIN_NOTES_PER_ORDER: usize = 2;
 /// Largest change of a band's correction per round, dB.
 const MAX_STEP_DB: f64 = 6.0;
 /// Bounds of a fitted T60, s: the guide's recordings fall 20 dB in 0.55–1.1 s.
@@ -35,6 +40,12 @@ const MIN_T60_S: f64 = 0.1;
 const MAX_T60_S: f64 = 6.0;
 /// Window of the band-T60 measurement, s.
 const DECAY_WINDOW_S: f64 = 0.08;
+
+/// The octave of mode order ([`ORDER_CENTRES`]) nearest `f_over_f11` in log frequency.
+fn order_octave(f_over_f11: f64) -> usize {
+    let x = (f_over_f11 / ORDER_CENTRES[0]).log2().round();
+    x.clamp(0.0, (ORDER_CENTRES.len() - 1) as f64) as usize
+}
 
 /// A recorded note.
 #[derive(Clone, Debug)]
@@ -223,7 +234,8 @@ pub fn fit(
         .collect();
     for round in 0..=ROUNDS {
         let mut residuals = Vec::new();
-        let mut band_steps: [Vec<f64>; 7] = Default::default();
+        // Radiation steps per octave of mode order (ORDER_CENTRES), from each note's bands.
+        let mut order_steps: [Vec<f64>; 7] = Default::default();
         let mut t60_ratios: [Vec<f64>; 7] = Default::default();
         let mut thump_steps = Vec::new();
 
@@ -237,7 +249,8 @@ pub fn fit(
             for b in 0..7 {
                 bands_db[b] = model.bands_db[b] - target.bands_db[b];
                 if OCTAVE_CENTRES_HZ[b] >= BAND_FIT_ABOVE_PITCH * target.pitch_hz {
-                    band_steps[b].push(-bands_db[b]);
+                    order_steps[order_octave(OCTAVE_CENTRES_HZ[b] / target.pitch_hz)]
+                        .push(-bands_db[b]);
                 }
                 if let (Some(r), Some(m)) = (target.band_t60_s[b], model.band_t60_s[b]) {
                     t60_ratios[b].push(r / m);
@@ -254,10 +267,10 @@ pub fn fit(
             break;
         }
         for b in 0..7 {
-            let steps = &band_steps[b];
-            if !steps.is_empty() {
+            let steps = &order_steps[b];
+            if steps.len() >= MIN_NOTES_PER_ORDER {
                 let step = steps.iter().sum::<f64>() / steps.len() as f64;
-                cal.radiation_db[b] += step.clamp(-MAX_STEP_DB, MAX_STEP_DB);
+                cal.radiation_by_order_db[b] += step.clamp(-MAX_STEP_DB, MAX_STEP_DB);
             }
             // Bands the listed partials rule barely answer: small steps, bounded decays.
             let step = geometric_mean(&t60_ratios[b]).clamp(0.7, 1.4);
@@ -265,11 +278,14 @@ pub fn fit(
         }
         let step = thump_steps.iter().sum::<f64>() / thump_steps.len() as f64;
         cal.axisymmetric_db += step.clamp(-MAX_STEP_DB, MAX_STEP_DB);
-        // Bands below every note's fitted ones (there the listed partials rule the band
+        // Orders below every note's fitted ones (there the listed partials rule the band
         // shares and a correction of the others is not measurable) keep the physical
         // Rayleigh radiation: the (0,1) with its kettle, the (1,2), the (0,2).
-        if let Some(first) = band_steps.iter().position(|s| !s.is_empty()) {
-            cal.radiation_db[..first].fill(0.0);
+        if let Some(first) = order_steps
+            .iter()
+            .position(|s| s.len() >= MIN_NOTES_PER_ORDER)
+        {
+            cal.radiation_by_order_db[..first].fill(0.0);
         }
     }
     Ok(cal)

@@ -108,6 +108,7 @@ impl SoundHead {
             let omega = std::f64::consts::TAU * mode.freq_hz;
             (mode.bessel_zero() / a).powi(2) * mode.modal_mass_kg / (2.0 * omega * omega)
         };
+        let f11 = drum.tuning.hz();
         let voices = chosen
             .iter()
             .map(|&(k, w, scale)| {
@@ -130,10 +131,10 @@ impl SoundHead {
                         w
                     } else if mode.m == 0 {
                         w * scale
-                            * calibration.radiation_gain(mode.freq_hz)
+                            * calibration.radiation_gain(mode.freq_hz / f11)
                             * calibration.axisymmetric_gain()
                     } else {
-                        w * scale * calibration.radiation_gain(mode.freq_hz)
+                        w * scale * calibration.radiation_gain(mode.freq_hz / f11)
                     } / (std::f64::consts::TAU * mode.freq_hz),
                 }
             })
