@@ -234,6 +234,36 @@ impl EditorApp {
         }
     }
 
+    /// The offer to restore what the last session left unsaved.
+    pub(super) fn restore_dialog(&mut self, ctx: &egui::Context) {
+        let Some(offer) = &self.restore_offer else {
+            return;
+        };
+        let from = offer
+            .original
+            .as_ref()
+            .map_or("an untitled score".to_string(), |p| p.display().to_string());
+        let mut choice = None;
+        egui::Modal::new(egui::Id::unique("restore-autosave")).show(ctx, |ui| {
+            ui.heading("Restore unsaved changes?");
+            ui.label(format!(
+                "timpanist did not close cleanly last time. Its autosave holds changes to \
+                 {from} that were not saved."
+            ));
+            ui.horizontal(|ui| {
+                if ui.button("Restore").clicked() {
+                    choice = Some(true);
+                }
+                if ui.button("Discard").clicked() {
+                    choice = Some(false);
+                }
+            });
+        });
+        if let Some(restore) = choice {
+            self.answer_restore(restore);
+        }
+    }
+
     pub(super) fn central(&mut self, ui: &mut egui::Ui) {
         if let Some(err) = self.messages.error.clone() {
             ui.horizontal(|ui| {

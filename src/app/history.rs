@@ -131,6 +131,12 @@ impl History {
         self.record.set_saved();
     }
 
+    /// Mark the score as not saved (e.g. restored from the autosave).
+    pub fn mark_unsaved(&mut self) {
+        self.begin_gesture();
+        self.record.clear_saved();
+    }
+
     /// What Undo would undo, e.g. "move handle".
     pub fn undo_text(&self) -> Option<String> {
         self.record

@@ -26,6 +26,7 @@ pub mod playback;
 mod plots;
 mod pose;
 mod recent;
+mod recovery;
 mod renderer;
 mod selection;
 mod session;
@@ -70,6 +71,8 @@ pub struct EditorOptions {
     pub score: Option<PathBuf>,
     /// Where the recent-files list is kept; `None` keeps it in memory only.
     pub recent_store: Option<PathBuf>,
+    /// The autosave file (see `recovery`); `None` autosaves nowhere.
+    pub recovery_file: Option<PathBuf>,
     /// Try to open the sound device (otherwise the silent clock is used).
     pub audio_device: bool,
     /// Render each version of the score (simulation and sound) on a worker thread for
@@ -82,6 +85,7 @@ impl Default for EditorOptions {
         EditorOptions {
             score: None,
             recent_store: recent::default_store(),
+            recovery_file: recovery::default_file(),
             audio_device: true,
             render: true,
         }
@@ -124,6 +128,9 @@ pub struct EditorApp {
     views: Views,
     jobs: Jobs,
     recent: RecentFiles,
+    recovery: recovery::Recovery,
+    /// A score the last session left unsaved, offered back until the user answers.
+    restore_offer: Option<recovery::Recovered>,
     clipboard: Clipboard,
     messages: Messages,
     /// The question asked before losing unsaved changes, while it shows.
@@ -169,6 +176,8 @@ impl EditorApp {
             },
             jobs: Jobs::default(),
             recent: RecentFiles::load(options.recent_store),
+            recovery: recovery::Recovery::new(options.recovery_file),
+            restore_offer: None,
             clipboard: Clipboard::default(),
             messages: Messages::default(),
             confirm: None,
@@ -182,6 +191,7 @@ impl EditorApp {
             Some(p) => app.open_path(p),
             None => app.open_demo(),
         }
+        app.find_left_behind();
         app
     }
 
@@ -212,7 +222,10 @@ impl EditorApp {
         if self.quitting && !self.jobs.is_busy() {
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         }
-        if self.confirm.is_none() {
+        if self.restore_offer.is_none() && !self.quitting {
+            self.autosave(ctx);
+        }
+        if self.confirm.is_none() && self.restore_offer.is_none() {
             for a in keys::take_actions(ctx) {
                 self.pending.push(Command::Do(a));
             }
@@ -258,7 +271,13 @@ impl eframe::App for EditorApp {
         egui::CentralPanel::default_margins().show(ui, |ui| self.central(ui));
         self.drain();
         self.confirm_dialog(&ctx);
+        self.restore_dialog(&ctx);
         keys::help_window(&ctx, &mut self.views.show_help);
+    }
+
+    /// A clean quit: nothing is left to recover.
+    fn on_exit(&mut self) {
+        let _ = self.recovery.remove();
     }
 }
 

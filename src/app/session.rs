@@ -31,6 +31,7 @@ impl EditorApp {
 
     fn set_document(&mut self, loaded: LoadedScore, path: Option<PathBuf>) {
         self.doc = Some(Document::new(loaded, path));
+        self.recovery.restart();
         self.transport.reset();
         self.views.timeline.fit();
         self.views.simulated = None;
@@ -214,7 +215,76 @@ impl EditorApp {
             self.confirm = Some(AfterConfirm::Quit);
             false
         } else {
+            self.forget_autosave();
             true
+        }
+    }
+
+    /// Nothing is left to recover (a clean quit): remove the autosave.
+    fn forget_autosave(&mut self) {
+        if let Err(e) = self.recovery.remove() {
+            self.messages.status = format!("autosave: {e}");
+        }
+    }
+
+    /// At start: offer back a score the last session left unsaved (a crash, a kill, a
+    /// power cut). An autosave that cannot be read is reported and kept.
+    pub(super) fn find_left_behind(&mut self) {
+        match self.recovery.left_behind() {
+            Some(Ok(recovered)) => {
+                let from = recovered
+                    .original
+                    .as_ref()
+                    .map_or("an untitled score".to_string(), |p| p.display().to_string());
+                eprintln!("timpanist: the autosave holds unsaved changes to {from}: offered back");
+                self.restore_offer = Some(recovered);
+            }
+            Some(Err(e)) => {
+                self.messages.error = Some(format!("the autosave could not be read: {e}"))
+            }
+            None => {}
+        }
+    }
+
+    /// Write the score to the autosave once it has been left alone a moment after a
+    /// change, and wake the window to do it.
+    pub(super) fn autosave(&mut self, ctx: &egui::Context) {
+        let now = ctx.input(|i| i.time);
+        match self.recovery.tick(self.doc.as_ref(), now) {
+            Ok(true) => self.messages.status = "changes autosaved".into(),
+            Ok(false) => {}
+            Err(e) => self.messages.status = format!("autosave failed: {e}"),
+        }
+        if self.recovery.waiting(self.doc.as_ref()) {
+            ctx.request_repaint_after(std::time::Duration::from_millis(500));
+        }
+    }
+
+    /// Whether a score left unsaved by the last session is being offered back.
+    pub fn restore_offered(&self) -> bool {
+        self.restore_offer.is_some()
+    }
+
+    /// Answer the offer: restore the score the last session left (it opens with its
+    /// changes unsaved, under its own file name), or discard it.
+    pub fn answer_restore(&mut self, restore: bool) {
+        let Some(recovered) = self.restore_offer.take() else {
+            return;
+        };
+        if restore {
+            let from = recovered
+                .original
+                .as_ref()
+                .map_or("an untitled score".to_string(), |p| p.display().to_string());
+            self.set_document(recovered.loaded, recovered.original);
+            self.recovery.adopt();
+            if let Some(doc) = &mut self.doc {
+                doc.history.mark_unsaved();
+            }
+            self.messages.status = format!("restored the unsaved changes to {from}");
+        } else {
+            self.forget_autosave();
+            self.messages.status = "discarded the autosaved changes".into();
         }
     }
 
@@ -231,6 +301,7 @@ impl EditorApp {
         match what {
             AfterConfirm::Quit => {
                 self.quitting = true;
+                self.forget_autosave();
                 if let Some(ctx) = &self.ctx
                     && !self.jobs.is_busy()
                 {

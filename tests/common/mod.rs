@@ -13,13 +13,14 @@ pub fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// The editor's options for `score`, its recent list in `dir`, no sound device,
+/// The editor's options for `score`, its recent list and autosave in `dir`, no sound device,
 /// rendering if `render`; moves into the repository.
 pub fn options(score: Option<PathBuf>, dir: &Path, render: bool) -> EditorOptions {
     std::env::set_current_dir(root()).unwrap();
     EditorOptions {
         score,
         recent_store: Some(dir.join("recent.txt")),
+        recovery_file: Some(dir.join("recovery.ron")),
         audio_device: false,
         render,
     }
