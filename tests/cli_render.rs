@@ -139,6 +139,27 @@ fn cli_render_refuses_bad_scores_cleanly() {
         stderr.contains("far.ron: beat 0 is out of the right hand's reach"),
         "{stderr}"
     );
+
+    // Past the limits: a file larger than a score may be (refused unread), and a score
+    // longer than 30 minutes.
+    let huge = dir.path().join("huge.ron");
+    let mut text = std::fs::read_to_string(&far).unwrap();
+    text.push_str(&" ".repeat(33 << 20));
+    std::fs::write(&huge, text).unwrap();
+    let stderr = refused(&huge);
+    assert!(
+        stderr.contains("huge.ron: 33.0 MB is larger than the 32.0 MB a text file may be"),
+        "{stderr}"
+    );
+    let mut score = Score::new("long");
+    score.beats = vec![Beat::plain(0, 1), Beat::plain(960 * 4000, 1)];
+    let long = dir.path().join("long.ron");
+    score.save(&long).unwrap();
+    let stderr = refused(&long);
+    assert!(
+        stderr.contains("long.ron: length:") && stderr.contains("split it into movements"),
+        "{stderr}"
+    );
 }
 
 /// Without the `editor` feature, `timpanist edit` fails at once and says how to get the

@@ -78,9 +78,19 @@ pub fn unsupported_version(path: &Path, found: u32, supported: u32) -> FileError
     }
 }
 
-/// Read a whole text file.
+/// Read a whole text file (at most [`MAX_TEXT_FILE_BYTES`](super::limits::MAX_TEXT_FILE_BYTES)).
 pub fn read_text(path: &Path) -> Result<String, FileError> {
-    std::fs::read_to_string(path).map_err(|e| FileError::io(path, e))
+    let bytes = super::limits::read_at_most(path, super::limits::MAX_TEXT_FILE_BYTES, "text file")
+        .map_err(|e| FileError::io(path, e))?;
+    String::from_utf8(bytes).map_err(|e| {
+        FileError::io(
+            path,
+            std::io::Error::new(
+                std::io::ErrorKind::InvalidData,
+                format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+            ),
+        )
+    })
 }
 
 /// Parse RON text strictly into `T`, naming `path` and the line and column on error.

@@ -154,7 +154,12 @@ pub fn import_file(
     kit: &Kit,
     options: &ImportOptions,
 ) -> Result<(Score, ImportReport), MidiError> {
-    let bytes = std::fs::read(path).map_err(|source| MidiError::Io {
+    let bytes = crate::base::limits::read_at_most(
+        path,
+        crate::base::limits::MAX_MIDI_FILE_BYTES,
+        "MIDI file",
+    )
+    .map_err(|source| MidiError::Io {
         path: path.to_path_buf(),
         source,
     })?;

@@ -23,13 +23,40 @@ pub fn problems(score: &Score, kit: &Kit) -> Vec<Problem> {
         ));
         return out; // Every position below depends on it.
     }
-    for (i, m) in tempo::validate_points(&score.tempo) {
+    let tempo_problems = tempo::validate_points(&score.tempo);
+    let tempo_ok = tempo_problems.is_empty();
+    for (i, m) in tempo_problems {
         out.push(Problem::new(format!("tempo point {i}"), m));
     }
     let meter_problems = meter::validate_changes(&score.meter, score.ticks_per_quarter);
     let meter_ok = meter_problems.is_empty();
     for (i, m) in meter_problems {
         out.push(Problem::new(format!("time signature {i}"), m));
+    }
+    if score.beats.len() > crate::base::limits::MAX_BEATS {
+        out.push(Problem::new(
+            "beats",
+            format!(
+                "{} beats are more than the {} a score may hold; split it into movements",
+                score.beats.len(),
+                crate::base::limits::MAX_BEATS
+            ),
+        ));
+        return out;
+    }
+    if tempo_ok {
+        let length_s = score.duration_s();
+        if length_s > crate::base::limits::MAX_SCORE_S {
+            out.push(Problem::new(
+                "length",
+                format!(
+                    "{:.0} minutes is longer than the {:.0} minutes a score may last (a render \
+                     holds the whole performance in memory); split it into movements",
+                    length_s / 60.0,
+                    crate::base::limits::MAX_SCORE_S / 60.0
+                ),
+            ));
+        }
     }
     let bars = meter_ok.then(|| score.meter_map());
     let place = |i: usize| match &bars {
@@ -202,5 +229,30 @@ mod tests {
         s.beats = vec![beat(0, 0)];
         s.tempo[0].bpm = 2000.0;
         assert!(first_problem(&s).contains("tempo point 0: tempo 2000 bpm is impossible"));
+    }
+
+    /// A score past the limits is refused with what they are: too many beats, too long.
+    #[test]
+    fn limits_hold() {
+        use crate::base::limits::{MAX_BEATS, MAX_SCORE_S};
+        let mut s = Score::new("t");
+        s.beats = (0..=MAX_BEATS as u64).map(|k| beat(k * 480, 0)).collect();
+        let p = first_problem(&s);
+        assert!(
+            p.contains("beats: 50001 beats are more than the 50000"),
+            "{p}"
+        );
+        // One beat 31 minutes in, then one just inside the limit.
+        let tick_at = |t: f64| s.tempo_map().tick_at(t) as u64;
+        let (late, last) = (tick_at(31.0 * 60.0), tick_at(MAX_SCORE_S - 10.0));
+        s.beats = vec![beat(0, 0), beat(late, 1)];
+        let p = first_problem(&s);
+        assert!(
+            p.contains("length: 31 minutes is longer than the 30 minutes"),
+            "{p}"
+        );
+        s.beats = vec![beat(0, 0), beat(last, 1)];
+        let p = first_problem(&s);
+        assert!(p.is_empty(), "{p}");
     }
 }

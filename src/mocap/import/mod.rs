@@ -244,7 +244,12 @@ fn read_file(
     unit: Option<&str>,
 ) -> Result<(Vec<u8>, Option<LengthUnit>), ImportError> {
     let unit = parse_unit_override(path, unit)?;
-    let bytes = std::fs::read(path).map_err(|source| ImportError::Io {
+    let bytes = crate::base::limits::read_at_most(
+        path,
+        crate::base::limits::MAX_CAPTURE_FILE_BYTES,
+        "capture file",
+    )
+    .map_err(|source| ImportError::Io {
         path: path.to_path_buf(),
         source,
     })?;
