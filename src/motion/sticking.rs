@@ -870,7 +870,12 @@ mod tests {
         let mut rng = Lcg(11);
         let kit = Kit::standard();
         let s = varied(&mut rng, 20_000, true);
-        let sides = run(&s, &kit, Method::Optimal);
+        // 95 minutes: past the length a score may have to be rendered (the only problem),
+        // on purpose — the sticking itself scales further.
+        let problems = s.problems(&kit);
+        assert!(problems.iter().all(|p| p.place == "length"), "{problems:?}");
+        let sides = assign(&s, &kit, Method::Optimal, &Params::default());
+        assert_eq!(sides.len(), s.beats.len());
         assert_rules(&s, &sides);
     }
 
