@@ -285,6 +285,7 @@ impl Performer {
             target,
             Some(reference),
             &params,
+            &crate::body::limits::NO_LIMITS,
         )
         .pose
     }

@@ -471,8 +471,11 @@ impl Run<'_> {
                 let model =
                     BodyModel::new(skeleton, params.mass_kg).holding_mallets(self.mallet.mass_kg);
                 let first = targets.reference(&Warp::default());
-                let initial =
-                    ik::posture_reaching(&model.skeleton, [first.tips[0][0], first.tips[1][0]]);
+                let initial = ik::posture_reaching(
+                    &model.skeleton,
+                    [first.tips[0][0], first.tips[1][0]],
+                    &params.sim.ik_limits(),
+                );
                 let sim = Simulator::new(
                     &model,
                     &first,
