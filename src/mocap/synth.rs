@@ -504,7 +504,11 @@ impl Performer {
                 }
             }
         }
-        MotionDb { index, takes }
+        MotionDb {
+            index,
+            takes,
+            limits: Default::default(),
+        }
     }
 }
 
