@@ -139,6 +139,7 @@ impl IkPose {
                     tips[h],
                     Some(&ready),
                     &self.params,
+                    &crate::body::limits::NO_LIMITS,
                 );
                 self.pose = r.pose;
             }

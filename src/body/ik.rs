@@ -8,6 +8,7 @@
 //! A step ω (world frame) is applied to a joint's local rotation as
 //! q ← (R_parent⁻¹·exp(ω)·R_parent)·q.
 
+use super::limits::JointLimits;
 use super::skeleton::{Frames, JOINT_COUNT, Joint, Pose, Skeleton};
 pub use crate::base::choices::IkMethod;
 use crate::kit::Side;
@@ -58,8 +59,9 @@ pub struct IkResult {
 }
 
 /// Move the `side` stick tip of `start` toward `target` (performer frame, m), pulling the
-/// redundant degrees of freedom toward `reference` if given. Never produces NaN: an
-/// unreachable target leaves the arm stretched toward it with the remaining error reported.
+/// redundant degrees of freedom toward `reference` if given and holding every chain joint
+/// within its ellipsoid of `limits` (see [`iterate`]). Never produces NaN: an unreachable
+/// target leaves the arm stretched toward it with the remaining error reported.
 pub fn solve(
     skeleton: &Skeleton,
     start: &Pose,
@@ -67,6 +69,7 @@ pub fn solve(
     target: DVec3,
     reference: Option<&Pose>,
     params: &IkParams,
+    limits: &JointLimits,
 ) -> IkResult {
     let mut pose = *start;
     let mut iterations = 0;
@@ -78,7 +81,7 @@ pub fn solve(
             break;
         }
         iterations += 1;
-        iterate(&frames, &mut pose, side, target, reference, params);
+        iterate(&frames, &mut pose, side, target, reference, params, limits);
     }
     if iterations == params.max_iterations {
         error = (target - skeleton.tip(&pose, side)).length();
@@ -93,9 +96,10 @@ pub fn solve(
 
 /// A posture with both stick tips on `tips` ([left, right], m, performer frame): each arm
 /// solved in turn from the rest pose (trunk upright, 500 iterations of the default
-/// solver), so a simulation started in it has its tips on their first targets instead of
-/// hanging at rest ~0.8 m away. A tip out of reach leaves that arm stretched toward it.
-pub fn posture_reaching(skeleton: &Skeleton, tips: [DVec3; 2]) -> Pose {
+/// solver, every joint within `limits`), so a simulation started in it has its tips on
+/// their first targets instead of hanging at rest ~0.8 m away. A tip out of reach leaves
+/// that arm stretched toward it.
+pub fn posture_reaching(skeleton: &Skeleton, tips: [DVec3; 2], limits: &JointLimits) -> Pose {
     let params = IkParams {
         max_iterations: 500,
         use_trunk: false,
@@ -103,15 +107,29 @@ pub fn posture_reaching(skeleton: &Skeleton, tips: [DVec3; 2]) -> Pose {
     };
     let mut pose = super::skeleton::REST;
     for (side, tip) in [Side::Left, Side::Right].into_iter().zip(tips) {
-        pose = solve(skeleton, &pose, side, tip, None, &params).pose;
+        pose = solve(skeleton, &pose, side, tip, None, &params, limits).pose;
     }
     pose
 }
+
+/// One column of the chain's Jacobian: the joint, the world axis of rotation a, the tip's
+/// velocity a × (tip − joint) per unit rotation about it, and the joint's weight.
+type Column = (usize, DVec3, DVec3, f64);
 
 /// One iteration of the solver: the joint steps that move the `side` tip toward `target`,
 /// computed from `frames` (the forward kinematics of the pose the steps are applied to) and
 /// applied to `pose`. HIMC runs exactly this once per arm every simulation step, both arms
 /// from one forward-kinematics pass (the arms' chains share at most the trunk).
+///
+/// **Joint limits.** A chain joint with a limit in `limits` that is on (or beyond) its
+/// ellipsoid and whose step would take it further out is clamped: its rotations are
+/// restricted to the ellipsoid's tangent plane (its outward normal,
+/// [`JointLimit::outward`](super::limits::JointLimit::outward), removed from its three
+/// axes and from its null-space pull) and the step solved again, so the other joints of
+/// the redundant chain take over what it cannot do (at most once per joint). A joint
+/// that a step takes across its ellipsoid is put back on it
+/// ([`JointLimit::boundary`](super::limits::JointLimit::boundary)); one already outside
+/// is moved onto it. The pose leaves every limited chain joint within its ellipsoid.
 pub fn iterate(
     frames: &Frames,
     pose: &mut Pose,
@@ -119,6 +137,7 @@ pub fn iterate(
     target: DVec3,
     reference: Option<&Pose>,
     params: &IkParams,
+    limits: &JointLimits,
 ) {
     // Fixed-size buffers: the solver runs every simulation step and must not allocate.
     let mut chain = [(Joint::Trunk, 0.0); 5];
@@ -132,13 +151,74 @@ pub fn iterate(
         len += 1;
     }
     let chain = &chain[..len];
+    // Outward normals (world) of the limited joints on or beyond their ellipsoids.
+    let mut at_limit = [None; 5];
+    for (normal, &(j, _)) in at_limit.iter_mut().zip(chain) {
+        if let Some(limit) = &limits[j.index()]
+            && limit.radius(pose[j.index()]) >= 1.0 - 1e-9
+        {
+            let n =
+                (frames.parent_rotation(j) * limit.outward(pose[j.index()])).normalize_or_zero();
+            *normal = (n != DVec3::ZERO).then_some(n);
+        }
+    }
+    let mut clamped = [None; 5];
+    let mut step = chain_step(
+        frames, pose, chain, &clamped, side, target, reference, params,
+    );
+    for _ in 0..chain.len() {
+        let mut more = false;
+        for slot in 0..chain.len() {
+            if let (None, Some(n)) = (clamped[slot], at_limit[slot])
+                && step[chain[slot].0.index()].dot(n) > 0.0
+            {
+                clamped[slot] = Some(n);
+                more = true;
+            }
+        }
+        if !more {
+            break;
+        }
+        step = chain_step(
+            frames, pose, chain, &clamped, side, target, reference, params,
+        );
+    }
+    for &(j, _) in chain {
+        let i = j.index();
+        let mut w = step[i];
+        if w.length() > params.max_step_rad {
+            w = w.normalize() * params.max_step_rad;
+        }
+        let parent = frames.parent_rotation(j);
+        pose[i] = (parent.inverse() * DQuat::from_scaled_axis(w) * parent * pose[i]).normalize();
+        if let Some(limit) = &limits[i] {
+            pose[i] = limit.boundary(pose[i]);
+        }
+    }
+}
+
+/// The joint steps (world rotation vectors, rad) of one iteration over `chain`, each
+/// clamped joint's (`clamped[slot]`: its outward normal) kept out of that normal.
+#[allow(clippy::too_many_arguments)]
+fn chain_step(
+    frames: &Frames,
+    pose: &Pose,
+    chain: &[(Joint, f64)],
+    clamped: &[Option<DVec3>; 5],
+    side: Side,
+    target: DVec3,
+    reference: Option<&Pose>,
+    params: &IkParams,
+) -> [DVec3; JOINT_COUNT] {
     let tip = frames.tip(side);
     let e = target - tip;
-    // Columns: three world axes per joint.
-    let mut buffer = [(0usize, DVec3::ZERO, DVec3::ZERO, 0.0); 15];
-    for (slot, &(j, w)) in buffer.chunks_mut(3).zip(chain) {
+    // Columns: three world axes per joint (a clamped joint's projected on its tangent
+    // plane: three vectors spanning it, whose outer products sum to the projector).
+    let mut buffer: [Column; 15] = [(0, DVec3::ZERO, DVec3::ZERO, 0.0); 15];
+    for ((slot, &(j, w)), normal) in buffer.chunks_mut(3).zip(chain).zip(clamped) {
         let r = tip - frames.position[j.index()];
         for (column, a) in slot.iter_mut().zip([DVec3::X, DVec3::Y, DVec3::Z]) {
+            let a = normal.map_or(a, |n| a - n * n.dot(a));
             *column = (j.index(), a, a.cross(r), w);
         }
     }
@@ -161,28 +241,29 @@ pub fn iterate(
         step[i] += a * (w * c.dot(y));
     }
     if let Some(reference) = reference {
-        add_null_space_pull(&mut step, columns, frames, pose, reference, jwjt, params);
-    }
-    for &(j, _) in chain {
-        let i = j.index();
-        let mut w = step[i];
-        if w.length() > params.max_step_rad {
-            w = w.normalize() * params.max_step_rad;
+        let mut normals = [None; JOINT_COUNT];
+        for (&(j, _), n) in chain.iter().zip(clamped) {
+            normals[j.index()] = *n;
         }
-        let parent = frames.parent_rotation(j);
-        pose[i] = (parent.inverse() * DQuat::from_scaled_axis(w) * parent * pose[i]).normalize();
+        add_null_space_pull(
+            &mut step, columns, frames, pose, reference, jwjt, params, &normals,
+        );
     }
+    step
 }
 
-/// Add z − W·Jᵀ(JWJᵀ + λ²I)⁻¹·J·z, where z turns each chain joint toward `reference`.
+/// Add z − W·Jᵀ(JWJᵀ + λ²I)⁻¹·J·z, where z turns each chain joint toward `reference`
+/// (a clamped joint's turn without its component along its outward normal `normals`).
+#[allow(clippy::too_many_arguments)]
 fn add_null_space_pull(
     step: &mut [DVec3],
-    columns: &[(usize, DVec3, DVec3, f64)],
+    columns: &[Column],
     frames: &Frames,
     pose: &Pose,
     reference: &Pose,
     jwjt: DMat3,
     params: &IkParams,
+    normals: &[Option<DVec3>; JOINT_COUNT],
 ) {
     let mut z = [DVec3::ZERO; JOINT_COUNT];
     for &(i, _, _, w) in columns.iter().step_by(3) {
@@ -192,6 +273,9 @@ fn add_null_space_pull(
         let local = reference[i] * pose[i].inverse();
         let toward = 2.0 * local.xyz() * local.w.signum();
         z[i] = frames.parent_rotation(joint) * toward * (params.reference_gain * w);
+        if let Some(n) = normals[i] {
+            z[i] -= n * n.dot(z[i]);
+        }
     }
     let jz = columns
         .iter()
@@ -222,6 +306,7 @@ fn safe_solve(m: DMat3, e: DVec3, min_det: f64) -> DVec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::body::limits::NO_LIMITS;
     use crate::body::skeleton::REST;
 
     fn bent_start() -> Pose {
@@ -251,7 +336,15 @@ mod tests {
                 tolerance_m: 1e-4,
                 ..IkParams::default()
             };
-            let r = solve(&s, &bent_start(), Side::Right, target, None, &params);
+            let r = solve(
+                &s,
+                &bent_start(),
+                Side::Right,
+                target,
+                None,
+                &params,
+                &NO_LIMITS,
+            );
             assert!(r.converged, "{method:?}: error {} m", r.error_m);
             assert!((s.tip(&r.pose, Side::Right) - target).length() < 1e-4);
         }
@@ -269,6 +362,7 @@ mod tests {
             target,
             None,
             &IkParams::default(),
+            &NO_LIMITS,
         );
         assert!(!r.converged);
         assert!(r.pose.iter().all(|q| q.is_finite()));
@@ -288,7 +382,7 @@ mod tests {
     fn posture_reaching_puts_both_tips_on_target() {
         let s = Skeleton::default();
         let tips = [DVec3::new(-0.3, 0.5, 0.85), DVec3::new(0.35, 0.55, 0.8)];
-        let pose = posture_reaching(&s, tips);
+        let pose = posture_reaching(&s, tips, &NO_LIMITS);
         for (side, tip) in [Side::Left, Side::Right].into_iter().zip(tips) {
             assert!(s.tip(&pose, side).distance(tip) < 1e-4, "{side:?}");
         }
@@ -306,6 +400,7 @@ mod tests {
             target,
             None,
             &IkParams::default(),
+            &NO_LIMITS,
         );
         let mut reference = REST;
         reference[Joint::WristR.index()] = DQuat::from_rotation_x(-0.6);
@@ -316,10 +411,55 @@ mod tests {
             target,
             Some(&reference),
             &IkParams::default(),
+            &NO_LIMITS,
         );
         assert!(pulled.error_m < 5e-4, "{}", pulled.error_m);
         let wrist = Joint::WristR.index();
         let dist = |p: &Pose| p[wrist].angle_between(reference[wrist]);
         assert!(dist(&pulled.pose) < dist(&free.pose));
+    }
+
+    /// A target the free solver reaches only by bending the elbow far outside a limit
+    /// about its starting rotation: with the limit the elbow ends inside its ellipsoid and
+    /// the other joints of the redundant arm still bring the tip onto the target; an
+    /// elbow starting outside its ellipsoid is brought onto it.
+    #[test]
+    fn limits_hold_and_the_arm_reaches_another_way() {
+        use crate::body::limits::JointLimit;
+        let s = Skeleton::default();
+        let elbow = Joint::ElbowR.index();
+        let start = bent_start();
+        let mut limits = NO_LIMITS;
+        limits[elbow] = Some(JointLimit {
+            mean: start[elbow],
+            axes: [DVec3::X, DVec3::Y, DVec3::Z],
+            semi_axes: [0.1; 3],
+            centre: DVec3::ZERO,
+        });
+        let limit = limits[elbow].unwrap();
+        let params = IkParams::default();
+        let target = DVec3::new(0.2, 0.3, 0.6);
+        let free = solve(&s, &start, Side::Right, target, None, &params, &NO_LIMITS);
+        assert!(free.converged, "free: {} m", free.error_m);
+        assert!(
+            limit.radius(free.pose[elbow]) > 1.5,
+            "the free solution should leave the limit (2.3 measured): {}",
+            limit.radius(free.pose[elbow])
+        );
+        let held = solve(&s, &start, Side::Right, target, None, &params, &limits);
+        assert!(
+            limit.contains(held.pose[elbow]),
+            "elbow at {} of its ellipsoid",
+            limit.radius(held.pose[elbow])
+        );
+        assert!(
+            held.error_m < 1e-3,
+            "limited arm {} m from the target",
+            held.error_m
+        );
+        let mut outside = start;
+        outside[elbow] = start[elbow] * DQuat::from_rotation_x(0.8);
+        let from_outside = solve(&s, &outside, Side::Right, target, None, &params, &limits);
+        assert!(limit.contains(from_outside.pose[elbow]));
     }
 }

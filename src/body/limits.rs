@@ -24,6 +24,9 @@ pub struct JointLimit {
 /// A limit per joint (`None`: that joint is free), in [`crate::body::Joint`] order.
 pub type JointLimits = [Option<JointLimit>; crate::body::skeleton::JOINT_COUNT];
 
+/// Every joint free.
+pub const NO_LIMITS: JointLimits = [None; crate::body::skeleton::JOINT_COUNT];
+
 /// The quaternion log map, half-angle rotation vector (rad), shortest arc.
 pub fn quat_log(q: DQuat) -> DVec3 {
     let q = if q.w < 0.0 { -q } else { q };
@@ -102,6 +105,15 @@ impl JointLimit {
         }
     }
 
+    /// This limit with its ellipsoid scaled by `factor` about its centre (every semi-axis
+    /// times `factor`).
+    pub fn scaled(&self, factor: f64) -> JointLimit {
+        JointLimit {
+            semi_axes: self.semi_axes.map(|a| a * factor),
+            ..*self
+        }
+    }
+
     /// The rotation on the ellipsoid's surface on the ray from its centre through `q`
     /// (`q` itself when it is inside).
     pub fn boundary(&self, q: DQuat) -> DQuat {
@@ -111,6 +123,34 @@ impl JointLimit {
         }
         let d = quat_log(self.mean.inverse() * q) - self.centre;
         (self.mean * quat_exp(self.centre + d / r)).normalize()
+    }
+
+    /// The gradient of radius² with respect to a small rotation δ of the joint,
+    /// q ← exp(δ)·q with δ a rotation vector (rad) in the frame `q` is expressed in (the
+    /// parent segment's): the direction in which turning the joint leaves its ellipsoid
+    /// fastest (the ellipsoid's outward normal, mapped from the tangent space at the mean
+    /// to rotations of the joint). With m = q̄*·q, φ = 2·log(m) and d = log(m) − centre,
+    /// δ moves the log by ½·J_l⁻¹(φ)·(q̄*·δ) (J_l the left Jacobian of SO(3)), so the
+    /// gradient is q̄·(½·J_l⁻ᵀ(φ)·g) with g = Σ_k 2·(d·e_k)/a_k²·e_k.
+    pub fn outward(&self, q: DQuat) -> DVec3 {
+        let v = quat_log(self.mean.inverse() * q);
+        let d = v - self.centre;
+        let g: DVec3 = (0..3)
+            .map(|k| {
+                let a = self.semi_axes[k].max(1e-12);
+                self.axes[k] * (2.0 * d.dot(self.axes[k]) / (a * a))
+            })
+            .sum();
+        let phi = 2.0 * v;
+        let theta = phi.length();
+        // J_l⁻¹(φ) = I − ½[φ]× + c·[φ]×², c = 1/θ² − (1 + cos θ)/(2θ·sin θ) (→ 1/12).
+        let c = if theta < 1e-4 || theta.sin() < 1e-9 {
+            1.0 / 12.0
+        } else {
+            1.0 / (theta * theta) - (1.0 + theta.cos()) / (2.0 * theta * theta.sin())
+        };
+        let jt_g = g + 0.5 * phi.cross(g) + c * phi.cross(phi.cross(g));
+        self.mean * (0.5 * jt_g)
     }
 
     /// Whether `q` lies within the limit.
@@ -211,5 +251,40 @@ mod tests {
         assert!(limit.semi_axes[0] > limit.semi_axes[1] && limit.semi_axes[1] > limit.semi_axes[2]);
         assert!(samples.iter().all(|q| limit.contains(*q)));
         assert!(!limit.contains(mean * quat_exp(axes[0] * 0.6)));
+    }
+
+    /// [`JointLimit::outward`] is the gradient of radius² under q ← exp(δ)·q (central
+    /// differences), near the mean and far from it.
+    #[test]
+    fn outward_is_the_gradient_of_the_radius() {
+        let limit = JointLimit {
+            mean: DQuat::from_rotation_y(0.8) * DQuat::from_rotation_x(0.3),
+            axes: [
+                DVec3::new(1.0, 1.0, 0.0).normalize(),
+                DVec3::new(-1.0, 1.0, 0.0).normalize(),
+                DVec3::Z,
+            ],
+            semi_axes: [0.5, 0.3, 0.2],
+            centre: DVec3::new(0.02, -0.01, 0.03),
+        };
+        let mut rng = Rng::new(5);
+        for spread in [0.1, 0.5, 1.2] {
+            for _ in 0..20 {
+                let v = DVec3::new(rng.normal(), rng.normal(), rng.normal()) * spread;
+                let q = limit.mean * quat_exp(v);
+                let r2 = |d: DVec3| limit.radius(DQuat::from_scaled_axis(d) * q).powi(2);
+                let h = 1e-6;
+                let numeric = DVec3::new(
+                    r2(DVec3::X * h) - r2(DVec3::X * -h),
+                    r2(DVec3::Y * h) - r2(DVec3::Y * -h),
+                    r2(DVec3::Z * h) - r2(DVec3::Z * -h),
+                ) / (2.0 * h);
+                let analytic = limit.outward(q);
+                assert!(
+                    (numeric - analytic).length() < 1e-5 * (1.0 + numeric.length()),
+                    "{numeric} vs {analytic} at {v}"
+                );
+            }
+        }
     }
 }

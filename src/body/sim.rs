@@ -48,10 +48,25 @@ pub struct SimParams {
     /// 0.16 m.
     pub max_tracking_error_m: f64,
     /// Joint limits the body cannot pass (seed 000 Alg. 1 ellipsoids, e.g. from the
-    /// motion database: `MotionDb::joint_limits`); none by default.
+    /// motion database: `MotionDb::joint_limits`); none by default. The IK (task rate
+    /// and nested) holds its postures within them; the simulator's stops hold the body.
     pub limits: JointLimits,
     /// How many times stiffer than a joint's PD loop its limit stop is.
     pub limit_stiffness: f64,
+    /// The IK holds each joint within this fraction of its limit ellipsoid (radius ≤
+    /// this), so the joint targets leave room for what the dynamics add — the tracking
+    /// error, a released stick's rebound — before the stops act: a stick aimed with its
+    /// grip on the ellipsoid meets the stop as soon as it rebounds.
+    pub ik_limit_fraction: f64,
+}
+
+impl SimParams {
+    /// The limits the IK holds its postures within: [`SimParams::limits`] scaled by
+    /// [`SimParams::ik_limit_fraction`].
+    pub fn ik_limits(&self) -> JointLimits {
+        self.limits
+            .map(|l| l.map(|l| l.scaled(self.ik_limit_fraction)))
+    }
 }
 
 impl Default for SimParams {
@@ -73,7 +88,8 @@ impl Default for SimParams {
             max_angular_speed: 500.0,
             max_tracking_error_m: 0.5,
             limits: [None; JOINT_COUNT],
-            limit_stiffness: 16.0,
+            limit_stiffness: 8.0,
+            ik_limit_fraction: 0.9,
         }
     }
 }
@@ -237,6 +253,7 @@ pub fn ik_target(
             reference.tips[h][k],
             Some(&pull),
             &params.ik,
+            &params.ik_limits(),
         )
         .pose;
     }
@@ -287,6 +304,8 @@ pub struct Simulator {
     pipeline: Pipeline,
     /// The nested IK of HIMC: pulled fully toward the task-rate posture.
     nested: IkParams,
+    /// The limits the IK holds (`SimParams::ik_limits`).
+    ik_limits: JointLimits,
     dynamics: Dynamics,
     gains: Gains,
     substeps: usize,
@@ -335,6 +354,7 @@ impl Simulator {
                 reference_gain: 1.0,
                 ..params.ik.clone()
             },
+            ik_limits: params.ik_limits(),
             dynamics,
             gains,
             substeps,
@@ -531,6 +551,7 @@ impl Simulator {
                             target,
                             Some(&reference_pose),
                             &self.nested,
+                            &self.ik_limits,
                         );
                     }
                 }
@@ -557,12 +578,19 @@ impl Simulator {
                 }
             }
             if self.params.limits.iter().any(Option::is_some) {
-                let stops = limit_torques(
+                let mut stops = limit_torques(
                     &self.gains,
                     &self.params.limits,
                     &self.state,
                     self.params.limit_stiffness,
                 );
+                if let Some(held) = held {
+                    // A released grip holds the stick loosely: its stop gives as its
+                    // PD does, so the stick rebounds freely about the fulcrum.
+                    for (side, fraction) in [Side::Left, Side::Right].into_iter().zip(held) {
+                        stops[Joint::arm(side)[3].index()] *= fraction;
+                    }
+                }
                 for (t, stop) in tau.iter_mut().zip(stops) {
                     if stop != DVec3::ZERO {
                         *t += stop;

@@ -142,6 +142,13 @@ pub enum Command {
         /// Seed of the choice among near-equal motion units.
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Hold the body within the database performer's ranges of motion (seed 000
+        /// Alg. 1 joint limits, each axis widened to a floor within published human
+        /// ranges): the IK keeps its postures inside them and the simulator's stops hold
+        /// the body. Strokes at the edge of the ranges (outer drums, across the body) may
+        /// then fail to render.
+        #[arg(long)]
+        joint_limits: bool,
     },
     /// Compare the IK, ID and HIMC control pipelines on captured strokes of each playing
     /// mode (seed 000 §3.3): tip RMS error per mode with its spread across trials.
@@ -435,6 +442,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             stats,
             db,
             seed,
+            joint_limits,
         }) => render::run(
             &score,
             &db_or_default(db),
@@ -451,6 +459,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 sound: sound.map(Into::into),
                 seed,
                 stats,
+                joint_limits,
             },
         )
         .map(|()| ExitCode::SUCCESS),

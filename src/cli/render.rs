@@ -40,6 +40,8 @@ pub struct Choices {
     pub seed: u64,
     /// Print where the time went and the force by dynamic.
     pub stats: bool,
+    /// Hold the body within the database performer's joint limits.
+    pub joint_limits: bool,
 }
 
 pub fn run(
@@ -53,6 +55,7 @@ pub fn run(
         sound,
         seed,
         stats,
+        joint_limits,
     } = *choices;
     let loaded = LoadedScore::load(score)?;
     for notice in &loaded.notices {
@@ -67,6 +70,7 @@ pub fn run(
             seed,
             ..PlanParams::default()
         },
+        joint_limits,
         ..settings
     };
     let started = std::time::Instant::now();
@@ -289,6 +293,13 @@ fn print_stats(r: &Rendering) {
         t.strokes,
         r.audio.gain
     );
+    match r.worst_joint_radius() {
+        Some((joint, radius, at_s)) => println!(
+            "joint limits: worst {} at {radius:.2} of its ellipsoid (1 = on it) at {at_s:.2} s",
+            joint.name()
+        ),
+        None => println!("joint limits: none held"),
+    }
     let forces = strikes::forces_by_dynamic(&r.events);
     let recontacts: usize = forces.iter().map(|f| f.recontacts).sum();
     println!("force by dynamic (peak force of each stroke's contact; re-contacts ≥ 5 N after it):");

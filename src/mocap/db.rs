@@ -23,6 +23,7 @@ use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 /// The database format this timpanist writes and the newest it reads.
 pub const DB_FORMAT_VERSION: u32 = 1;
@@ -117,6 +118,34 @@ pub struct MotionDb {
     pub index: Index,
     /// Samples of each take, in `index.takes` order.
     pub takes: Vec<TakeData>,
+    /// [`MotionDb::joint_limits`] per grip, estimated on first use (≈ 25 ms for the
+    /// shipped database, once, not at every composition). A clone estimates afresh;
+    /// change `index` or `takes` before asking for the limits, or in a clone.
+    pub limits: LimitsCache,
+}
+
+/// The joint limits of a database per grip (French, German), each estimated once.
+#[derive(Default)]
+pub struct LimitsCache([OnceLock<JointLimits>; 2]);
+
+impl Clone for LimitsCache {
+    /// Empty: the clone's index and takes may be changed before it is asked.
+    fn clone(&self) -> Self {
+        LimitsCache::default()
+    }
+}
+
+impl PartialEq for LimitsCache {
+    /// A cache of what the database holds: databases compare by their contents.
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for LimitsCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("LimitsCache")
+    }
 }
 
 /// Names of the joints, as written in `index.joints`.
@@ -124,16 +153,55 @@ pub fn joint_names() -> Vec<String> {
     Joint::ALL.iter().map(|j| j.name().to_string()).collect()
 }
 
-/// The narrowest range of rotation a joint limit allows about any axis, degrees.
-pub const MIN_LIMIT_ROTATION_DEG: f64 = 20.0;
+/// The narrowest range of rotation a joint limit allows about any axis (each semi-axis of
+/// its ellipsoid at least this, as a rotation either way from the centre), degrees, per
+/// joint in [`Joint::ALL`] order. The synthetic performer plays only the two middle drums,
+/// each hand on its own side, moving each arm in a plane and keeping trunk, neck and head
+/// still, so its estimated ellipsoids pin whole axes that a performer on the whole kit
+/// moves (an outer drum, the head turning to the drum about to be struck). The floors
+/// stay inside published normal active ranges of motion (AAOS, *Joint Motion: Method of
+/// Measuring and Recording*, 1965; Greene & Heckman, *The Clinical Measurement of Joint
+/// Motion*, AAOS 1994; Soucie et al., Haemophilia 17:500–507, 2011):
+///
+/// - trunk 20°: thoracolumbar axial rotation and lateral flexion are 30–45° either way;
+///   the IK keeps the trunk within ≈ 6° of upright;
+/// - neck 32°, head 48°: cervical axial rotation is 70–80° either way in young adults
+///   (Youdas et al., Phys. Ther. 72:770–780, 1992), and the gaze (`body::gaze`)
+///   turns 40 % of it in the neck and 60 % in the head: 40 and 60 % of 80°;
+/// - shoulder 30°: half the shoulder's least active range (extension ≈ 60°; flexion and
+///   abduction 180°, internal and external rotation 70° and 90°);
+/// - elbow 20°: the elbow is a hinge with forearm rotation; its estimate moves about both
+///   (14–28°), the floor only keeps a ball joint's third axis from being pinned;
+/// - wrist 25°: half the radio-ulnar deviation arc (radial ≈ 20°, ulnar ≈ 30°), its
+///   least-ranging motion (flexion 80°, extension 70°);
+/// - grip 20°: the stick in the fingers, no anatomical joint; its estimate spans
+///   60–150° in the stroke's plane.
+///
+/// Measured on the demo scores (README "Physics (HIMC)"): with 20° everywhere the left
+/// hand could not reach the 32-inch drum within its ranges (the task-rate IK, holding
+/// 0.9 of each ellipsoid, ended up to 0.3 m short on the one-minute study); the shoulder's 30° brought the worst to
+/// 19 mm, the wrist's 25° to 14 mm (8 mm with no limits at all); the neck's and head's
+/// floors hold the gaze's turns within 0.99 of their ellipsoids.
+pub const MIN_LIMIT_ROTATION_DEG: [f64; JOINT_COUNT] = [
+    20.0, 32.0, 48.0, 30.0, 20.0, 25.0, 20.0, 30.0, 20.0, 25.0, 20.0,
+];
 
 impl MotionDb {
     /// The joint limits the simulation holds a player of `grip` to: the
     /// [estimates](MotionDb::estimated_joint_limits), each axis at least
     /// [`MIN_LIMIT_ROTATION_DEG`] wide.
     pub fn joint_limits(&self, grip: Grip) -> JointLimits {
-        self.estimated_joint_limits(grip)
-            .map(|l| l.map(|l| l.at_least(MIN_LIMIT_ROTATION_DEG.to_radians())))
+        let slot = match grip {
+            Grip::French => 0,
+            Grip::German => 1,
+        };
+        *self.limits.0[slot].get_or_init(|| {
+            let mut limits = self.estimated_joint_limits(grip);
+            for (limit, floor) in limits.iter_mut().zip(MIN_LIMIT_ROTATION_DEG) {
+                *limit = limit.map(|l| l.at_least(floor.to_radians()));
+            }
+            limits
+        })
     }
 
     /// The joint limits of `grip` estimated from the captured joint rotations of its
@@ -174,6 +242,7 @@ impl MotionDb {
                 units: Vec::new(),
             },
             takes: Vec::new(),
+            limits: LimitsCache::default(),
         }
     }
 
@@ -219,7 +288,11 @@ impl MotionDb {
                 ));
             }
         }
-        Ok(MotionDb { index, takes })
+        Ok(MotionDb {
+            index,
+            takes,
+            limits: LimitsCache::default(),
+        })
     }
 
     /// Write every sample file and then the index, each atomically.

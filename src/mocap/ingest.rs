@@ -772,6 +772,7 @@ mod tests {
                 units: Vec::new(),
             },
             takes: Vec::new(),
+            limits: Default::default(),
         };
         let options = IngestOptions {
             tips: [Some("TipL".into()), Some("TipR".into())],

@@ -285,6 +285,7 @@ impl Performer {
             target,
             Some(reference),
             &params,
+            &crate::body::limits::NO_LIMITS,
         )
         .pose
     }
@@ -503,7 +504,11 @@ impl Performer {
                 }
             }
         }
-        MotionDb { index, takes }
+        MotionDb {
+            index,
+            takes,
+            limits: Default::default(),
+        }
     }
 }
 

@@ -20,6 +20,7 @@
 //! point between the strokes.
 
 use super::plan::PlannedStroke;
+use crate::body::limits::{JointLimits, NO_LIMITS};
 use crate::kit::Side;
 use crate::mocap::db::{MotionDb, UnitEntry, side_index};
 use glam::{DQuat, DVec3};
@@ -99,6 +100,10 @@ pub struct Composition {
     pub strokes: Vec<PlannedStroke>,
     /// Sample index of each stroke's impact.
     pub impact_samples: Vec<usize>,
+    /// The ranges of motion of the performer whose units these are (from the motion
+    /// database, `MotionDb::joint_limits` of the score's grip; none when composed without
+    /// a score): a rendering holds the body within them.
+    pub limits: JointLimits,
 }
 
 impl Composition {
@@ -310,6 +315,7 @@ pub fn compose(strokes: &[PlannedStroke], db: &MotionDb, params: &ComposeParams)
         tags,
         strokes: strokes.to_vec(),
         impact_samples,
+        limits: NO_LIMITS,
     }
 }
 

@@ -1,5 +1,6 @@
 //! The whole path from a score to its two stick-tip trajectories: plan (sticking and
-//! motion units), compose, then apply the user's handles.
+//! motion units), compose, then apply the user's handles; the composition carries the
+//! database performer's joint limits for the score's grip.
 
 use super::compose::{ComposeParams, Composition, compose};
 use super::handles;
@@ -19,5 +20,6 @@ pub fn trajectories(
     let strokes = plan(score, kit, db, plan_params)?;
     let mut comp = compose(&strokes, db, compose_params);
     handles::apply(&mut comp, score);
+    comp.limits = db.joint_limits(score.grip);
     Ok(comp)
 }

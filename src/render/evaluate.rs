@@ -22,6 +22,7 @@
 
 use crate::base::rng::Rng;
 use crate::body::ik::posture_reaching;
+use crate::body::limits::NO_LIMITS;
 use crate::body::model::BodyModel;
 use crate::body::sim::{
     Motion, Pipeline, Reference, SimError, SimParams, ik_target, ik_targets, rms_error, simulate,
@@ -313,7 +314,7 @@ fn longest_gap(track: &[Option<DVec3>]) -> usize {
 /// posture reaching the first tips), as a capture's solver would give them.
 fn solved_joints(tips: &[Vec<DVec3>; 2], rate_hz: f64) -> Vec<Pose> {
     let skeleton = capture_skeleton();
-    let start = posture_reaching(&skeleton, [tips[0][0], tips[1][0]]);
+    let start = posture_reaching(&skeleton, [tips[0][0], tips[1][0]], &NO_LIMITS);
     let reference = Reference {
         rate_hz,
         tips: tips.clone(),
@@ -429,7 +430,13 @@ pub fn trial(
     rng: &mut Rng,
 ) -> Result<[Motion; 3], PipelineFailed> {
     let start = reference.poses.as_ref().map_or_else(
-        || posture_reaching(&model.skeleton, reference.tips.each_ref().map(|t| t[0])),
+        || {
+            posture_reaching(
+                &model.skeleton,
+                reference.tips.each_ref().map(|t| t[0]),
+                &params.sim.ik_limits(),
+            )
+        },
         |p| p[0],
     );
     let turns: [DQuat; JOINT_COUNT] = std::array::from_fn(|_| {

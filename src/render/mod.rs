@@ -18,7 +18,9 @@ pub mod reach;
 pub mod reference;
 pub mod strikes;
 
+use crate::body::Joint;
 use crate::body::ik::{self, IkParams};
+use crate::body::limits::JointLimits;
 use crate::body::model::BodyModel;
 use crate::body::sim::{Motion, Pipeline, Reference, SimError, SimParams, Simulator};
 use crate::body::skeleton::Skeleton;
@@ -43,6 +45,14 @@ pub struct RenderParams {
     pub sound: SoundModel,
     pub modes: ModeConfig,
     pub sim: SimParams,
+    /// Hold the body within its performer's ranges of motion, the composition's joint
+    /// limits (`Composition::limits`: the motion database's for the score's grip), in
+    /// the IK and with the simulator's stops; `false` (the default) leaves `sim.limits`
+    /// as given (none by default). Off by default: all six demo scores render within
+    /// them, but strokes at the edge of the ranges (outer drums, across the body: the
+    /// ladder moved to the outer drums, four-drum eighth notes, random scores) can make
+    /// the body diverge against its stops or lose a stick (README "Physics (HIMC)").
+    pub joint_limits: bool,
     pub plan: PlanParams,
     pub compose: ComposeParams,
     /// Index of the kit mallet to play with.
@@ -115,6 +125,7 @@ impl Default for RenderParams {
             sound: SoundModel::Modal,
             modes: ModeConfig::default(),
             sim: SimParams::default(),
+            joint_limits: false,
             plan: PlanParams::default(),
             compose: ComposeParams::default(),
             mallet: 0,
@@ -276,6 +287,7 @@ pub struct Resume {
     strokes: Vec<PlannedStroke>,
     tips: [Vec<DVec3>; 2],
     gaze: Vec<DVec3>,
+    limits: JointLimits,
     start_s: f64,
     rate_hz: f64,
     params: RenderParams,
@@ -440,6 +452,20 @@ struct Started {
 }
 
 impl Run<'_> {
+    /// The simulation settings: the parameters', holding the composition's joint limits
+    /// when they say so.
+    fn sim_params(&self) -> SimParams {
+        let params = self.params;
+        if params.joint_limits {
+            SimParams {
+                limits: self.composition.limits,
+                ..params.sim.clone()
+            }
+        } else {
+            params.sim.clone()
+        }
+    }
+
     /// Resume `previous` at its latest saved state before the change, when it is of the
     /// same kit and parameters, else start a new performance (keeping the sound's state
     /// when the heads are the same: the sound compares each drum's record itself).
@@ -471,13 +497,17 @@ impl Run<'_> {
                 let model =
                     BodyModel::new(skeleton, params.mass_kg).holding_mallets(self.mallet.mass_kg);
                 let first = targets.reference(&Warp::default());
-                let initial =
-                    ik::posture_reaching(&model.skeleton, [first.tips[0][0], first.tips[1][0]]);
+                let sim_params = self.sim_params();
+                let initial = ik::posture_reaching(
+                    &model.skeleton,
+                    [first.tips[0][0], first.tips[1][0]],
+                    &sim_params.ik_limits(),
+                );
                 let sim = Simulator::new(
                     &model,
                     &first,
                     params.control,
-                    &params.sim,
+                    &sim_params,
                     &initial,
                     &[params.gain_scale; crate::body::skeleton::JOINT_COUNT],
                 )
@@ -499,6 +529,7 @@ impl Run<'_> {
                 strokes: comp.strokes.clone(),
                 tips: comp.tips.clone(),
                 gaze,
+                limits: comp.limits,
                 start_s,
                 rate_hz: rate,
                 params: params.clone(),
@@ -517,6 +548,7 @@ impl Run<'_> {
         let comp = self.composition;
         let same = previous.params == *self.params
             && previous.kit == *self.kit
+            && previous.limits == comp.limits
             && previous.start_s == comp.start_s
             && previous.rate_hz == comp.rate_hz;
         if !same {
@@ -638,6 +670,36 @@ pub fn touches(score: &crate::score::Score) -> Vec<Touch> {
 }
 
 impl Rendering {
+    /// The joint limits the body was held within (none when it was not).
+    pub fn limits(&self) -> JointLimits {
+        if self.params.joint_limits {
+            self.composition.limits
+        } else {
+            self.params.sim.limits
+        }
+    }
+
+    /// The farthest any limited joint went outside its ellipsoid over the performance:
+    /// the joint, its largest ellipsoid radius ([`JointLimit::radius`]: 1 on the
+    /// ellipsoid) and the score time, s. `None` when no joint is limited.
+    ///
+    /// [`JointLimit::radius`]: crate::body::limits::JointLimit::radius
+    pub fn worst_joint_radius(&self) -> Option<(Joint, f64, f64)> {
+        let limits = self.limits();
+        let mut worst: Option<(Joint, f64, f64)> = None;
+        for (k, pose) in self.motion.poses.iter().enumerate() {
+            for (j, limit) in limits.iter().enumerate() {
+                let Some(limit) = limit else { continue };
+                let r = limit.radius(pose[j]);
+                if worst.is_none_or(|w| r > w.1) {
+                    let t = self.start_s + k as f64 / self.motion.rate_hz;
+                    worst = Some((Joint::ALL[j], r, t));
+                }
+            }
+        }
+        worst
+    }
+
     /// The body that played it (the player's height and the mallet's length).
     pub fn skeleton(&self) -> Skeleton {
         let mallet = self.kit.mallets.get(self.params.mallet);
