@@ -7,5 +7,7 @@ pub mod midi_export;
 pub mod midi_import;
 pub mod motion_c3d;
 pub mod motion_csv;
+pub mod musicxml;
+pub mod open;
 pub mod plot;
 pub mod tips_csv;
