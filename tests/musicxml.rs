@@ -357,13 +357,10 @@ fn tempo_marks() {
     };
     let xml = doc(&[
         &format!(
-            "{}{}{}",
+            "{}{}<direction><direction-type>{}</direction-type><sound tempo=\"60\"/></direction>",
             attrs(1),
             note("D3", 2, ""),
-            format!(
-                "<direction><direction-type>{}</direction-type><sound tempo=\"60\"/></direction>",
-                metro("quarter", 0, "66")
-            )
+            metro("quarter", 0, "66")
         ),
         &format!("{}{}", note("D3", 2, ""), rest(2)),
         &format!(

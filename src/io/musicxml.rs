@@ -663,6 +663,9 @@ fn timpani_name(name: &str) -> bool {
             .any(|w| w == "pk" || w == "pkn")
 }
 
+/// A way to recognise the timpani part: (the instrument id if one matched, why).
+type Rule = dyn Fn(&PartInfo) -> Option<(String, String)>;
+
 /// Choose the part and say which and why.
 fn choose(
     path: &Path,
@@ -708,7 +711,7 @@ fn choose(
             .find(|n| timpani_name(n))?;
         Some((String::new(), format!("named \"{named}\"")))
     };
-    let rules: [&dyn Fn(&PartInfo) -> Option<(String, String)>; 2] = [&by_sound, &by_name];
+    let rules: [&Rule; 2] = [&by_sound, &by_name];
     for rule in rules {
         let candidates: Vec<(usize, String, String)> = parts
             .iter()
@@ -1747,7 +1750,7 @@ fn tempo_points(tempos: &[(u64, f64, bool)], notices: &mut Notices) -> Vec<Tempo
         change: TempoChange::Step,
     };
     let mut sorted = tempos.to_vec();
-    sorted.sort_by(|a, b| (a.0, a.2).cmp(&(b.0, b.2)));
+    sorted.sort_by_key(|a| (a.0, a.2));
     let mut points = vec![step(0, DEFAULT_BPM)];
     for (tick, bpm, _) in sorted {
         let clamped = bpm.clamp(*BPM_RANGE.start(), *BPM_RANGE.end());
@@ -1779,7 +1782,7 @@ fn signature_of(length: u64, tpq: u64, den: u32) -> Option<(u32, u32)> {
         .find_map(|d| {
             let whole = 4 * tpq;
             let num = length * u64::from(d);
-            (num % whole == 0)
+            num.is_multiple_of(whole)
                 .then(|| num / whole)
                 .filter(|n| (1..=64).contains(n))
                 .map(|n| (n as u32, d))
