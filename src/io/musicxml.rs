@@ -927,6 +927,17 @@ impl<'a, 'd> PartReader<'a, 'd> {
                 )
             })?;
         let exact = value * self.tpq as f64 / self.divisions;
+        if exact > 1e12 {
+            return Err(self.invalid(
+                node,
+                measure,
+                format!(
+                    "<{}> {text} at {} divisions per quarter is longer than a score can hold",
+                    node.tag_name().name(),
+                    self.divisions
+                ),
+            ));
+        }
         let ticks = exact.round();
         if (ticks - exact).abs() > 1e-6 && !self.rounded {
             self.rounded = true;
