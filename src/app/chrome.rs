@@ -42,6 +42,13 @@ impl EditorApp {
                 {
                     self.after_confirm(AfterConfirm::Open(p));
                 }
+                if ui.button("Import MusicXML...").clicked()
+                    && let Some(p) = rfd::FileDialog::new()
+                        .add_filter("MusicXML", &["musicxml", "xml", "mxl"])
+                        .pick_file()
+                {
+                    self.after_confirm(AfterConfirm::Open(p));
+                }
                 ui.separator();
                 let mut item = |ui: &mut egui::Ui, label: &str, action: Action| {
                     if ui.button(label).clicked() {

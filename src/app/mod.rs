@@ -154,14 +154,34 @@ impl EditorApp {
         })
     }
 
+    /// Start the editor with `options` on a document read already (`timpanist FILE`
+    /// imports before the window opens); `options.score` is not read.
+    pub fn with_document(options: EditorOptions, opened: files::Opened) -> EditorApp {
+        let mut app = EditorApp::start(&options);
+        app.open_document(opened);
+        app.find_left_behind();
+        app
+    }
+
     /// Start the editor with `options`. Errors are shown in the window.
     pub fn with_options(options: EditorOptions) -> EditorApp {
+        let mut app = EditorApp::start(&options);
+        match &options.score {
+            Some(p) => app.open_path(p),
+            None => app.open_demo(),
+        }
+        app.find_left_behind();
+        app
+    }
+
+    /// The editor with no document yet.
+    fn start(options: &EditorOptions) -> EditorApp {
         let playback = if options.audio_device {
             Playback::new()
         } else {
             Playback::silent()
         };
-        let mut app = EditorApp {
+        EditorApp {
             doc: None,
             pipeline: Pipeline::new(options.render),
             transport: Transport::new(playback),
@@ -175,8 +195,8 @@ impl EditorApp {
                 show_help: false,
             },
             jobs: Jobs::default(),
-            recent: RecentFiles::load(options.recent_store),
-            recovery: recovery::Recovery::new(options.recovery_file),
+            recent: RecentFiles::load(options.recent_store.clone()),
+            recovery: recovery::Recovery::new(options.recovery_file.clone()),
             restore_offer: None,
             clipboard: Clipboard::default(),
             messages: Messages::default(),
@@ -186,13 +206,7 @@ impl EditorApp {
             pending: Vec::new(),
             ctx: None,
             shown_title: String::new(),
-        };
-        match &options.score {
-            Some(p) => app.open_path(p),
-            None => app.open_demo(),
         }
-        app.find_left_behind();
-        app
     }
 
     /// Once per frame, before the panels: take the workers' results, dropped files, the
@@ -294,6 +308,28 @@ pub fn run(score: Option<PathBuf>) -> anyhow::Result<()> {
         "timpanist",
         options,
         Box::new(move |_cc| Ok(Box::new(EditorApp::new(score.as_deref())))),
+    )
+    .map_err(|e| anyhow::anyhow!("could not open the editor window: {e}"))
+}
+
+/// Open the editor window on a document read or imported already (`timpanist FILE.mid`).
+pub fn run_document(opened: files::Opened) -> anyhow::Result<()> {
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_inner_size([1400.0, 900.0])
+            .with_title("timpanist")
+            .with_drag_and_drop(true),
+        ..Default::default()
+    };
+    eframe::run_native(
+        "timpanist",
+        options,
+        Box::new(move |_cc| {
+            Ok(Box::new(EditorApp::with_document(
+                EditorOptions::default(),
+                opened,
+            )))
+        }),
     )
     .map_err(|e| anyhow::anyhow!("could not open the editor window: {e}"))
 }

@@ -92,20 +92,24 @@ impl EditorApp {
         }
     }
 
-    /// Open a score (`.ron`) or import a MIDI file (`.mid`); errors go to the window.
+    /// Open a score (`.ron`) or import a MIDI (`.mid`) or MusicXML file; errors go to the
+    /// window.
     /// Unsaved changes are dropped (the UI asks first).
     pub fn open_path(&mut self, path: &Path) {
         match files::read(path) {
-            Ok(opened) => {
-                self.set_document(opened.loaded, opened.path.clone());
-                self.messages.status = opened.message;
-                if let Some(p) = &opened.path
-                    && let Err(e) = self.recent.add(p)
-                {
-                    self.messages.status = e.to_string();
-                }
-            }
+            Ok(opened) => self.open_document(opened),
             Err(e) => self.messages.error = Some(e.to_string()),
+        }
+    }
+
+    /// Show a document read (or imported) already.
+    pub fn open_document(&mut self, opened: files::Opened) {
+        self.set_document(opened.loaded, opened.path.clone());
+        self.messages.status = opened.message;
+        if let Some(p) = &opened.path
+            && let Err(e) = self.recent.add(p)
+        {
+            self.messages.status = e.to_string();
         }
     }
 
@@ -115,7 +119,7 @@ impl EditorApp {
         match kind_of(path) {
             FileKind::Other => {
                 self.messages.error = Some(format!(
-                    "{}: drop a score (.ron) or a MIDI file (.mid)",
+                    "{}: drop a score (.ron), a MIDI file (.mid) or a MusicXML file (.musicxml, .xml, .mxl)",
                     path.display()
                 ))
             }

@@ -10,6 +10,9 @@ use std::path::Path;
 pub const MAX_TEXT_FILE_BYTES: u64 = 32 << 20;
 /// Largest MIDI file imported, bytes (orchestral files are well under 1 MB).
 pub const MAX_MIDI_FILE_BYTES: u64 = 16 << 20;
+/// Largest MusicXML file imported (plain or `.mxl`), bytes (a whole orchestral score in
+/// plain MusicXML is tens of MB).
+pub const MAX_MUSICXML_FILE_BYTES: u64 = 256 << 20;
 /// Largest motion-capture file imported, bytes (an hour of 250 Hz C3D markers is a few
 /// hundred MB).
 pub const MAX_CAPTURE_FILE_BYTES: u64 = 1 << 30;

@@ -70,7 +70,7 @@ pub fn export(input: &Path, output: &Path) -> anyhow::Result<()> {
 
 /// How a score saved at `score` should name the kit file `kit`: relative to the score's
 /// folder when both are on the same tree.
-fn kit_reference(kit: &Path, score: &Path) -> anyhow::Result<String> {
+pub(super) fn kit_reference(kit: &Path, score: &Path) -> anyhow::Result<String> {
     let kit = kit
         .canonicalize()
         .with_context(|| format!("{}: cannot resolve the kit path", kit.display()))?;

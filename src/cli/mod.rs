@@ -8,22 +8,28 @@ mod compose;
 mod evaluate;
 mod midi;
 mod mocap;
+mod musicxml;
 mod render;
 mod sound;
 mod sticking;
 
+use crate::io::open::OpenAction;
 use args::{
     ControlArg, DynamicArg, GripArg, LocationArg, ModeArg, SideArg, SoundArg, UpArg, parse_format,
     parse_tips, parse_vec3,
 };
 use clap::{Parser, Subcommand};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Compose timpani gesture scores; hear and see them played by a simulated timpanist.
 #[derive(Debug, Parser)]
 #[command(name = "timpanist", version, about, long_about = None)]
+#[command(args_conflicts_with_subcommands = true)]
 pub struct Cli {
+    /// A file to open in the editor: a score (.ron) opens as it is; a MIDI (.mid) or
+    /// MusicXML (.musicxml, .xml, .mxl) file is imported into a new, unsaved score.
+    pub file: Option<PathBuf>,
     #[command(subcommand)]
     pub command: Option<Command>,
 }
@@ -62,6 +68,25 @@ pub enum Command {
         /// Turn runs of fast, evenly spaced repeated notes into rolls.
         #[arg(long)]
         detect_rolls: bool,
+    },
+    /// Import the timpani part of a MusicXML score (.musicxml, .xml or compressed .mxl).
+    ImportMusicxml {
+        /// The MusicXML file.
+        input: PathBuf,
+        /// The score to write (.ron).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// The part to read, by id ("P4") or by (part of) its name; default: the part
+        /// whose instrument sound is drum.timpani or MIDI program 48, else a part named
+        /// like "Timpani", "Pk.", "Pauken" or "Timbales".
+        #[arg(long)]
+        part: Option<String>,
+        /// The kit to map pitches onto (default: the bundled standard kit).
+        #[arg(long)]
+        kit: Option<PathBuf>,
+        /// Title of the score (default: the movement or work title, else the file name).
+        #[arg(long)]
+        title: Option<String>,
     },
     /// Export a score as a type 1 Standard MIDI File (tempo map, GM Timpani, velocities).
     ExportMidi {
@@ -392,6 +417,34 @@ fn edit(score: Option<PathBuf>) -> anyhow::Result<ExitCode> {
     crate::app::run(score).map(|()| ExitCode::SUCCESS)
 }
 
+/// `timpanist FILE`: open a score, or import a MIDI or MusicXML file (errors and what the
+/// import reports go to the terminal, before any window opens) and open the result.
+fn open_file(path: &Path) -> anyhow::Result<ExitCode> {
+    match crate::io::open::action_for(path)? {
+        OpenAction::Edit(score) => edit(Some(score)),
+        OpenAction::Import(file, _) => {
+            let opened = crate::io::open::read(&file)?;
+            eprintln!("{}", opened.message.split("; ").next().unwrap_or_default());
+            for n in &opened.notices {
+                eprintln!("note: {n}");
+            }
+            edit_document(opened)
+        }
+    }
+}
+
+/// Open the editor on an imported document.
+#[cfg(feature = "editor")]
+fn edit_document(opened: crate::io::open::Opened) -> anyhow::Result<ExitCode> {
+    crate::app::run_document(opened).map(|()| ExitCode::SUCCESS)
+}
+
+/// A headless build has no editor: say how to get one.
+#[cfg(not(feature = "editor"))]
+fn edit_document(_opened: crate::io::open::Opened) -> anyhow::Result<ExitCode> {
+    edit(None)
+}
+
 /// A headless build has no editor: say how to get one.
 #[cfg(not(feature = "editor"))]
 fn edit(_score: Option<PathBuf>) -> anyhow::Result<ExitCode> {
@@ -404,7 +457,10 @@ fn edit(_score: Option<PathBuf>) -> anyhow::Result<ExitCode> {
 
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
-        None => edit(None),
+        None => match cli.file {
+            Some(file) => open_file(&file),
+            None => edit(None),
+        },
         Some(Command::Edit { score }) => edit(score),
         Some(Command::Check { files }) => Ok(check::run(&files)),
         Some(Command::ImportMidi {
@@ -415,6 +471,14 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             title,
             detect_rolls,
         }) => midi::import(&input, &output, track, kit.as_deref(), title, detect_rolls)
+            .map(|()| ExitCode::SUCCESS),
+        Some(Command::ImportMusicxml {
+            input,
+            output,
+            part,
+            kit,
+            title,
+        }) => musicxml::import(&input, &output, part, kit.as_deref(), title)
             .map(|()| ExitCode::SUCCESS),
         Some(Command::Sticking {
             score,

@@ -33,7 +33,7 @@ const DEFAULT_BPM: f64 = 120.0;
 /// The General MIDI percussion channel (10, counted from 1).
 const PERCUSSION_CHANNEL: u8 = 9;
 /// Drum index in timpanist data that lets the import choose the drum.
-const ANY_DRUM: usize = usize::MAX;
+pub(super) const ANY_DRUM: usize = usize::MAX;
 /// Fewest evenly spaced repeated notes taken as a roll by `detect_rolls`.
 const MIN_ROLL_NOTES: usize = 6;
 
@@ -288,13 +288,13 @@ impl Clock {
 
 /// A note-on, in score ticks.
 #[derive(Clone, Debug, PartialEq)]
-struct Note {
-    tick: u64,
-    channel: u8,
-    key: u8,
-    vel: u8,
+pub(super) struct Note {
+    pub(super) tick: u64,
+    pub(super) channel: u8,
+    pub(super) key: u8,
+    pub(super) vel: u8,
     /// timpanist data written just before this note (roll length in score ticks).
-    data: Option<BeatData>,
+    pub(super) data: Option<BeatData>,
 }
 
 /// What a track holds.
@@ -330,7 +330,7 @@ fn read_file(smf: &Smf<'_>, clock: &Clock) -> FileInfo {
             let tick = clock.tick(file_tick);
             match event.kind {
                 TrackEventKind::Meta(MetaMessage::TrackName(name)) if info.name.is_empty() => {
-                    info.name = String::from_utf8_lossy(name).trim().to_string();
+                    info.name = decode_text(name).trim().to_string();
                 }
                 TrackEventKind::Meta(MetaMessage::Tempo(us)) => {
                     file.tempos.push((tick, us.as_int()));
@@ -364,6 +364,39 @@ fn read_file(smf: &Smf<'_>, clock: &Clock) -> FileInfo {
         file.tracks.push(info);
     }
     file
+}
+
+/// MIDI text (a track name, the title) as a string: valid UTF-8 as it is, else Shift-JIS
+/// if it decodes without errors and has Japanese letters (kana or kanji), else Latin-1
+/// (Windows-1252); text with control characters in it is taken as undecodable and read as
+/// empty (the title then falls back to the file name).
+pub fn decode_text(bytes: &[u8]) -> String {
+    let readable = |s: &str| !s.chars().any(|c| c.is_control() && c != '\t');
+    if let Ok(s) = std::str::from_utf8(bytes) {
+        return if readable(s) {
+            s.to_string()
+        } else {
+            String::new()
+        };
+    }
+    let japanese = |c: char| {
+        // Hiragana, katakana, kanji; not the half-width katakana alone, which Latin-1
+        // capitals and accented letters also decode to.
+        matches!(c, '\u{3040}'..='\u{30ff}' | '\u{4e00}'..='\u{9fff}')
+    };
+    if let Some(s) =
+        encoding_rs::SHIFT_JIS.decode_without_bom_handling_and_without_replacement(bytes)
+        && s.chars().any(japanese)
+        && readable(&s)
+    {
+        return s.into_owned();
+    }
+    let (latin, _) = encoding_rs::WINDOWS_1252.decode_without_bom_handling(bytes);
+    if readable(&latin) {
+        latin.into_owned()
+    } else {
+        String::new()
+    }
 }
 
 /// Timpani data made fit for a score: roll length in score ticks, and a roll or location
@@ -559,7 +592,7 @@ fn skip_roll_strokes(notes: Vec<Note>) -> Vec<Note> {
 /// Drop duplicate notes (same channel, tick and key; notes carrying timpanist data for
 /// different drums are not duplicates), keeping the loudest; sort the rest by time.
 /// Returns how many were dropped.
-fn drop_duplicates(notes: &mut Vec<Note>) -> usize {
+pub(super) fn drop_duplicates(notes: &mut Vec<Note>) -> usize {
     let before = notes.len();
     let drum = |n: &Note| n.data.map(|d| d.2);
     notes.sort_by_key(|n| (n.tick, n.channel, n.key, drum(n), Reverse(n.vel)));
@@ -657,7 +690,7 @@ fn detect_rolls(notes: &mut Vec<Note>, tpq: u32) {
 
 /// Keep at most the two loudest notes at each tick (a timpanist has two hands), and give
 /// two simultaneous strokes different hands if their data names the same one.
-fn limit_to_two_hands(notes: &mut Vec<Note>, warnings: &mut Vec<String>) {
+pub(super) fn limit_to_two_hands(notes: &mut Vec<Note>, warnings: &mut Vec<String>) {
     let mut kept = Vec::with_capacity(notes.len());
     let mut crowded = Vec::new();
     for group in notes.chunk_by(|a, b| a.tick == b.tick) {
@@ -705,7 +738,7 @@ fn reachable(pitch: Pitch, kit: &Kit) -> Pitch {
 
 /// Move notes no drum can reach by octaves into a drum's range; one warning sums them up.
 /// Returns how many moved.
-fn move_into_range(notes: &mut [Note], kit: &Kit, warnings: &mut Vec<String>) -> usize {
+pub(super) fn move_into_range(notes: &mut [Note], kit: &Kit, warnings: &mut Vec<String>) -> usize {
     let mut moves: BTreeMap<(Pitch, Pitch), usize> = BTreeMap::new();
     for n in notes.iter_mut() {
         let pitch = Pitch(n.key);
@@ -734,7 +767,7 @@ fn move_into_range(notes: &mut [Note], kit: &Kit, warnings: &mut Vec<String>) ->
 /// reaches it, else, among the drums that reach it (not already struck at this tick if
 /// possible), to one tuned to it, else to the one idle longest (it is retuned), ties to the
 /// nearest kit tuning.
-fn assign_drums(notes: &[Note], kit: &Kit) -> Vec<Beat> {
+pub(super) fn assign_drums(notes: &[Note], kit: &Kit) -> Vec<Beat> {
     let mut tuning: Vec<Pitch> = kit.drums.iter().map(|d| d.tuning).collect();
     let mut last_used: Vec<Option<u64>> = vec![None; kit.drums.len()];
     let mut taken: Vec<usize> = Vec::new();
@@ -787,7 +820,7 @@ fn assign_drums(notes: &[Note], kit: &Kit) -> Vec<Beat> {
 }
 
 /// Shorten rolls that another beat starts inside (a roll takes both hands).
-fn trim_rolls(beats: &mut [Beat]) {
+pub(super) fn trim_rolls(beats: &mut [Beat]) {
     for i in 0..beats.len() {
         let tick = beats[i].tick;
         let next = beats[i + 1..].iter().map(|b| b.tick).find(|&t| t > tick);

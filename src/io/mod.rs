@@ -1,5 +1,6 @@
-//! File adapters over what the layers below make: Standard MIDI Files in and out, composed
-//! and simulated motion as CSV and C3D, and PNG figures. (Strict RON reading and atomic
+//! File adapters over what the layers below make: Standard MIDI Files in and out, MusicXML
+//! in, opening any score-bearing file (`open`), composed and simulated motion as CSV and
+//! C3D, and PNG figures. (Strict RON reading and atomic
 //! writing are on the ground floor, `base::ron_file`, since kits and scores use them.)
 
 pub mod c3d_write;
@@ -7,5 +8,7 @@ pub mod midi_export;
 pub mod midi_import;
 pub mod motion_c3d;
 pub mod motion_csv;
+pub mod musicxml;
+pub mod open;
 pub mod plot;
 pub mod tips_csv;

@@ -1,0 +1,844 @@
+//! MusicXML import: the real Bach chorale movement checked note by note, hand-written
+//! snippets for each element read, malformed input, the whole MusicXML test suite (no
+//! file may crash the importer), `import-musicxml` through the binary, `timpanist FILE`
+//! dispatch, and MIDI text in Shift-JIS and Latin-1.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use timpanist::base::pitch::Pitch;
+use timpanist::io::musicxml::{ImportOptions, ImportReport, MusicXmlError, import, import_file};
+use timpanist::io::open::{self, FileKind, OpenAction, OpenError};
+use timpanist::kit::Kit;
+use timpanist::score::{Dynamic, PlayingMode, Roll, Score};
+
+const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data");
+const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures");
+
+fn p(name: &str) -> Pitch {
+    name.parse().unwrap()
+}
+
+/// A one-part partwise score named "Timpani" holding `measures` (the inner XML of each
+/// `<measure>`, numbered from 1).
+fn doc(measures: &[&str]) -> String {
+    let body: String = measures
+        .iter()
+        .enumerate()
+        .map(|(i, m)| format!("<measure number=\"{}\">{m}</measure>\n", i + 1))
+        .collect();
+    format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?>
+<!DOCTYPE score-partwise PUBLIC "-//Recordare//DTD MusicXML 4.0 Partwise//EN" "http://www.musicxml.org/dtds/partwise.dtd">
+<score-partwise version="4.0">
+<part-list><score-part id="P1"><part-name>Timpani</part-name></score-part></part-list>
+<part id="P1">
+{body}</part>
+</score-partwise>"#
+    )
+}
+
+/// `<attributes>` with divisions and 4/4.
+fn attrs(divisions: u32) -> String {
+    format!(
+        "<attributes><divisions>{divisions}</divisions><time><beats>4</beats><beat-type>4</beat-type></time></attributes>"
+    )
+}
+
+/// A note: step+octave like "D3" or "Bb2", a duration in divisions, extra inner XML.
+fn note(pitch: &str, duration: u32, extra: &str) -> String {
+    let (step, rest) = pitch.split_at(1);
+    let (alter, octave) = match rest.strip_prefix('b') {
+        Some(o) => ("<alter>-1</alter>", o),
+        None => match rest.strip_prefix('#') {
+            Some(o) => ("<alter>1</alter>", o),
+            None => ("", rest),
+        },
+    };
+    format!(
+        "<note><pitch><step>{step}</step>{alter}<octave>{octave}</octave></pitch><duration>{duration}</duration>{extra}</note>"
+    )
+}
+
+fn rest(duration: u32) -> String {
+    format!("<note><rest/><duration>{duration}</duration></note>")
+}
+
+fn run(xml: &str) -> (Score, ImportReport) {
+    let kit = Kit::standard();
+    let (score, report) = import(
+        Path::new("snippet.musicxml"),
+        xml.as_bytes(),
+        &kit,
+        &ImportOptions::default(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        score.problems(&kit).is_empty(),
+        "{:?}",
+        score.problems(&kit)
+    );
+    (score, report)
+}
+
+/// (tick, sounding pitch) of every beat.
+fn timeline(score: &Score) -> Vec<(u64, Pitch)> {
+    let kit = Kit::standard();
+    score
+        .beats
+        .iter()
+        .map(|b| (b.tick, b.sounding_pitch(&kit)))
+        .collect()
+}
+
+// ---- the Bach movement ----
+
+/// Every timpani note of BWV 248/64 (the .mxl of the music21 corpus) at its time and
+/// pitch: the 112 notes music21 reads (tests/fixtures), here from the MusicXML itself.
+/// By hand from the XML: divisions 4; measure 0 is a one-quarter pickup (forward 2, rest
+/// 2), measure 1 a whole rest, measure 2 starts at quarter 5 with an eighth rest, then
+/// D3 A2 D3 A2 A2 in eighths: quarters 5.5, 6, 6.5, 7, 7.5. A2 goes to the 29-inch drum
+/// (tuned Bb2, retuned to A2 and kept), D3 to the 26-inch drum (tuned D3).
+#[test]
+fn bach_timpani_part_note_by_note() {
+    let kit = Kit::standard();
+    let (score, report) = import_file(
+        &Path::new(DATA).join("bwv248.64-6.mxl"),
+        &kit,
+        &ImportOptions::default(),
+    )
+    .unwrap();
+    assert!(score.problems(&kit).is_empty());
+    assert!(
+        report.source.starts_with("part P4 \"Timpani\""),
+        "{}",
+        report.source
+    );
+    assert_eq!(report.notes, 112);
+    assert_eq!((report.duplicates_dropped, report.octave_moves), (0, 0));
+    assert_eq!(score.title, "bwv248.64-6");
+    assert_eq!(score.ticks_per_quarter, 960);
+    let tempo: Vec<(u64, f64)> = score.tempo.iter().map(|t| (t.tick, t.bpm)).collect();
+    assert_eq!(tempo, vec![(0, 72.0)]);
+    let meter: Vec<(u32, u32, u32)> = score
+        .meter
+        .iter()
+        .map(|m| (m.bar, m.numerator, m.denominator))
+        .collect();
+    assert_eq!(meter, vec![(1, 1, 4), (2, 4, 4)], "the pickup is a 1/4 bar");
+    assert!(
+        report.notices.iter().any(|n| n.contains("pickup")),
+        "{:?}",
+        report.notices
+    );
+    let expected: Vec<(f64, u8)> =
+        std::fs::read_to_string(Path::new(FIXTURES).join("bwv248-64-6.timpani.txt"))
+            .unwrap()
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .map(|l| {
+                let (o, m) = l.split_once(' ').unwrap();
+                (o.parse().unwrap(), m.parse().unwrap())
+            })
+            .collect();
+    assert_eq!(score.beats.len(), 112);
+    for (b, &(offset, midi)) in score.beats.iter().zip(&expected) {
+        assert_eq!(b.tick as f64, offset * 960.0, "{b:?}");
+        assert_eq!(b.sounding_pitch(&kit), Pitch(midi), "{b:?}");
+        let (drum, pitch) = if midi == 45 {
+            (1, Some(p("A2")))
+        } else {
+            (2, None)
+        };
+        assert_eq!((b.drum, b.pitch), (drum, pitch), "{b:?}");
+        assert_eq!(b.dynamic, Dynamic::Mf);
+        assert_eq!(b.mode, PlayingMode::Legato);
+        assert!(b.roll.is_none());
+    }
+    let first: Vec<(u64, Pitch)> = timeline(&score).into_iter().take(5).collect();
+    assert_eq!(
+        first,
+        vec![
+            (5280, p("D3")),
+            (5760, p("A2")),
+            (6240, p("D3")),
+            (6720, p("A2")),
+            (7200, p("A2"))
+        ]
+    );
+}
+
+// ---- snippets ----
+
+/// A chord is two drums at once; a tie's later notes are no new strokes (across a bar
+/// line too); the same pitch after the tie is.
+#[test]
+fn chords_and_ties() {
+    let xml = doc(&[
+        &format!(
+            "{}{}{}{}{}",
+            attrs(2),
+            note("A2", 2, ""),
+            note("D3", 2, "<chord/>"),
+            note(
+                "F3",
+                4,
+                "<tie type=\"start\"/><notations><tied type=\"start\"/></notations>"
+            ),
+            rest(2)
+        ),
+        &format!(
+            "{}{}{}",
+            note(
+                "F3",
+                2,
+                "<tie type=\"stop\"/><notations><tied type=\"stop\"/></notations>"
+            ),
+            note("F3", 2, ""),
+            rest(4)
+        ),
+    ]);
+    let (score, report) = run(&xml);
+    assert_eq!(
+        timeline(&score),
+        vec![(0, p("A2")), (0, p("D3")), (960, p("F3")), (4800, p("F3"))]
+    );
+    assert_ne!(score.beats[0].drum, score.beats[1].drum);
+    assert_eq!(report.notes, 4);
+}
+
+/// Single-note tremolos roll with their stroke count (2 marks: 16ths, 3 marks: 32nds)
+/// for the note's length; an unmeasured tremolo is a roll of 32nds, tied notes lengthen it.
+#[test]
+fn tremolos_are_rolls() {
+    let trem = |t: &str, marks: u32| {
+        format!(
+            "<notations><ornaments><tremolo type=\"{t}\">{marks}</tremolo></ornaments></notations>"
+        )
+    };
+    let xml = doc(&[
+        &format!(
+            "{}{}{}{}",
+            attrs(1),
+            note("D3", 2, &trem("single", 3)),
+            note("D3", 1, &trem("single", 2)),
+            rest(1)
+        ),
+        &note(
+            "A2",
+            4,
+            &format!(
+                "<tie type=\"start\"/>{}",
+                trem("unmeasured", 0).replace("<notations>", "<notations><tied type=\"start\"/>")
+            ),
+        ),
+        &note("A2", 2, "<tie type=\"stop\"/>"),
+    ]);
+    let (score, _) = run(&xml);
+    let rolls: Vec<(u64, Option<Roll>)> = score.beats.iter().map(|b| (b.tick, b.roll)).collect();
+    let roll = |length_ticks, strokes_per_quarter| {
+        Some(Roll {
+            length_ticks,
+            strokes_per_quarter,
+        })
+    };
+    assert_eq!(
+        rolls,
+        vec![
+            (0, roll(1920, 8)),
+            (1920, roll(960, 4)),
+            (3840, roll(5760, 8))
+        ]
+    );
+}
+
+/// Dynamics are levels from where they stand; a crescendo hairpin rises linearly (in MIDI
+/// velocity) to the marking that closes it; a diminuendo without one falls a step; sfz
+/// accents one stroke and the level comes back.
+#[test]
+fn dynamics_and_hairpins() {
+    let dir =
+        |inner: &str| format!("<direction><direction-type>{inner}</direction-type></direction>");
+    let xml = doc(&[
+        &format!(
+            "{}{}{}{}{}{}{}{}",
+            attrs(1),
+            dir("<dynamics><p/></dynamics>"),
+            note("D3", 1, ""),
+            dir("<wedge type=\"crescendo\"/>"),
+            note("D3", 1, ""),
+            note("D3", 1, ""),
+            note("D3", 1, ""),
+            dir("<wedge type=\"stop\"/>"),
+        ),
+        &format!(
+            "{}{}{}{}{}{}{}",
+            dir("<dynamics><f/></dynamics>"),
+            note("D3", 1, ""),
+            note(
+                "D3",
+                1,
+                "<notations><dynamics><sfz/></dynamics></notations>"
+            ),
+            dir("<wedge type=\"diminuendo\"/>"),
+            note("D3", 1, ""),
+            dir("<wedge type=\"stop\"/>"),
+            note("D3", 1, ""),
+        ),
+    ]);
+    let (score, _) = run(&xml);
+    let dynamics: Vec<Dynamic> = score.beats.iter().map(|b| b.dynamic).collect();
+    let v = |x: f64| Dynamic::Velocity(x / 127.0);
+    assert_eq!(
+        dynamics,
+        vec![
+            Dynamic::P,
+            Dynamic::P,
+            v(49.0 + 47.0 / 3.0),
+            v(49.0 + 2.0 * 47.0 / 3.0),
+            Dynamic::F,
+            Dynamic::F,  // sfz
+            Dynamic::F,  // the diminuendo's start
+            Dynamic::Mf  // a step down from f where it stops
+        ]
+    );
+    assert_eq!(score.beats[5].mode, PlayingMode::Accent);
+    assert_eq!(score.beats[4].mode, PlayingMode::Legato);
+}
+
+/// Accent, marcato (strong accent), staccato, tenuto; none is legato; the strongest of
+/// several wins.
+#[test]
+fn articulations_are_modes() {
+    let art = |a: &str| format!("<notations><articulations>{a}</articulations></notations>");
+    let xml = doc(&[&format!(
+        "{}{}{}{}{}{}{}{}{}",
+        attrs(2),
+        note("D3", 1, &art("<accent/>")),
+        note("D3", 1, &art("<strong-accent type=\"up\"/>")),
+        note("D3", 1, &art("<staccato/>")),
+        note("D3", 1, &art("<tenuto/>")),
+        note("D3", 1, ""),
+        note("D3", 1, &art("<staccato/><accent/>")),
+        note("D3", 1, &art("<staccatissimo/>")),
+        note("D3", 1, &art("<breath-mark/>")),
+    )]);
+    let (score, report) = run(&xml);
+    let modes: Vec<PlayingMode> = score.beats.iter().map(|b| b.mode).collect();
+    use PlayingMode::*;
+    assert_eq!(
+        modes,
+        vec![
+            Accent,
+            VerticalAccent,
+            Staccato,
+            Tenuto,
+            Legato,
+            Accent,
+            Staccato,
+            Legato
+        ]
+    );
+    assert!(
+        report.notices.iter().any(|n| n.contains("breath-mark")),
+        "{:?}",
+        report.notices
+    );
+}
+
+/// `<sound tempo>` wins over the metronome mark beside it; a metronome alone counts in
+/// its beat unit (dotted half = 40 is 120 quarters a minute); 120 bpm before any mark.
+#[test]
+fn tempo_marks() {
+    let metro = |unit: &str, dots: usize, pm: &str| {
+        format!(
+            "<metronome><beat-unit>{unit}</beat-unit>{}<per-minute>{pm}</per-minute></metronome>",
+            "<beat-unit-dot/>".repeat(dots)
+        )
+    };
+    let xml = doc(&[
+        &format!(
+            "{}{}<direction><direction-type>{}</direction-type><sound tempo=\"60\"/></direction>",
+            attrs(1),
+            note("D3", 2, ""),
+            metro("quarter", 0, "66")
+        ),
+        &format!("{}{}", note("D3", 2, ""), rest(2)),
+        &format!(
+            "<direction><direction-type>{}</direction-type></direction>{}",
+            metro("half", 1, "c. 40"),
+            rest(4)
+        ),
+        &format!("<sound tempo=\"90\"/>{}", rest(4)),
+    ]);
+    let (score, _) = run(&xml);
+    let tempo: Vec<(u64, f64)> = score.tempo.iter().map(|t| (t.tick, t.bpm)).collect();
+    // Measure 1 holds a half note (a 2/4 bar), measures 2 and 3 a whole bar each.
+    assert_eq!(
+        tempo,
+        vec![(0, 120.0), (1920, 60.0), (5760, 120.0), (9600, 90.0)]
+    );
+}
+
+/// Divisions may change between measures: 1, then 4 (eighths), then 3 (triplet eighths);
+/// a part in 7 divisions gets 960 × 7 ticks per quarter, exactly.
+#[test]
+fn divisions_change() {
+    let xml = doc(&[
+        &format!("{}{}{}", attrs(1), note("D3", 2, ""), note("D3", 2, "")),
+        &format!(
+            "<attributes><divisions>4</divisions></attributes>{}{}{}",
+            note("D3", 2, ""),
+            note("D3", 2, ""),
+            rest(12)
+        ),
+        &format!(
+            "<attributes><divisions>3</divisions></attributes>{}{}{}{}",
+            note("D3", 1, ""),
+            note("D3", 1, ""),
+            note("D3", 1, ""),
+            rest(9)
+        ),
+    ]);
+    let (score, _) = run(&xml);
+    let ticks: Vec<u64> = score.beats.iter().map(|b| b.tick).collect();
+    assert_eq!(ticks, vec![0, 1920, 3840, 4320, 7680, 8000, 8320]);
+    let xml = doc(&[&format!(
+        "{}{}{}",
+        attrs(7),
+        note("D3", 3, ""),
+        note("D3", 25, "")
+    )]);
+    let (score, _) = run(&xml);
+    assert_eq!(score.ticks_per_quarter, 6720);
+    assert_eq!(score.beats[1].tick, 3 * 960);
+}
+
+/// Two voices through `<backup>` and `<forward>`: both are read; a unison written in
+/// both voices is one stroke.
+#[test]
+fn backup_forward_and_voices() {
+    let v = |n: u32| format!("<voice>{n}</voice>");
+    let xml = doc(&[&format!(
+        "{}{}{}<backup><duration>8</duration></backup><forward><duration>2</duration></forward>{}{}<forward><duration>2</duration></forward>",
+        attrs(2),
+        note("D3", 4, &v(1)),
+        note("D3", 4, &v(1)),
+        note("A2", 2, &v(2)),
+        note("D3", 2, &v(2)),
+    )]);
+    let (score, report) = run(&xml);
+    assert_eq!(
+        timeline(&score),
+        vec![(0, p("D3")), (960, p("A2")), (1920, p("D3"))]
+    );
+    assert_eq!(report.duplicates_dropped, 1);
+}
+
+/// Grace notes are skipped, repeats and fermatas reported, each with its measure.
+#[test]
+fn reported_not_performed() {
+    let xml = doc(&[
+        &format!(
+            "{}<barline location=\"left\"><repeat direction=\"forward\"/></barline>{}{}{}",
+            attrs(1),
+            "<note><grace/><pitch><step>A</step><octave>2</octave></pitch></note>",
+            note("D3", 2, "<notations><fermata/></notations>"),
+            rest(2)
+        ),
+        &format!(
+            "{}<barline location=\"right\"><repeat direction=\"backward\"/></barline>",
+            rest(4)
+        ),
+    ]);
+    let (score, report) = run(&xml);
+    assert_eq!(timeline(&score), vec![(0, p("D3"))]);
+    let all = report.notices.join("\n");
+    assert!(
+        all.contains("grace note: skipped (grace notes take no time) (measure 1)"),
+        "{all}"
+    );
+    assert!(all.contains("fermata"), "{all}");
+    assert!(
+        all.contains("repeat sign: not expanded") && all.contains("×2"),
+        "{all}"
+    );
+}
+
+// ---- choosing the part ----
+
+fn two_parts(first: &str, second: &str) -> String {
+    let m = format!(
+        "<measure number=\"1\">{}{}</measure>",
+        attrs(1),
+        note("D3", 4, "")
+    );
+    format!(
+        r#"<score-partwise><part-list>
+<score-part id="P1">{first}</score-part><score-part id="P2">{second}</score-part>
+</part-list><part id="P1">{m}</part><part id="P2">{m}</part></score-partwise>"#
+    )
+}
+
+/// The timpani part by its instrument sound, by MIDI program 48, by a name ("Pk."); else
+/// the error lists the parts; `--part` by id or name.
+#[test]
+fn choosing_the_part() {
+    let kit = Kit::standard();
+    let go = |xml: &str, part: Option<&str>| {
+        import(
+            Path::new("parts.musicxml"),
+            xml.as_bytes(),
+            &kit,
+            &ImportOptions {
+                part: part.map(str::to_string),
+                ..ImportOptions::default()
+            },
+        )
+    };
+    let violin = "<part-name>Violin</part-name>";
+    let sound = "<part-name>Percussion 1</part-name><score-instrument id=\"I1\"><instrument-name>Kettledrums</instrument-name><instrument-sound>drum.timpani</instrument-sound></score-instrument>";
+    let (_, r) = go(&two_parts(violin, sound), None).unwrap();
+    assert!(
+        r.source
+            .starts_with("part P2 \"Percussion 1\": instrument sound drum.timpani"),
+        "{}",
+        r.source
+    );
+    let program = "<part-name>Kettle</part-name><midi-instrument id=\"I2\"><midi-program>48</midi-program></midi-instrument>";
+    let (_, r) = go(&two_parts(program, violin), None).unwrap();
+    assert!(
+        r.source.contains("P1") && r.source.contains("program 48"),
+        "{}",
+        r.source
+    );
+    let (_, r) = go(&two_parts(violin, "<part-name>Pk.</part-name>"), None).unwrap();
+    assert!(r.source.starts_with("part P2 \"Pk.\""), "{}", r.source);
+    let err = go(&two_parts(violin, "<part-name>Viola</part-name>"), None).unwrap_err();
+    assert!(matches!(err, MusicXmlError::NoTimpani { .. }));
+    let text = err.to_string();
+    assert!(
+        text.starts_with("parts.musicxml: no timpani part found"),
+        "{text}"
+    );
+    assert!(
+        text.contains("part P1 \"Violin\": 1 notes") && text.contains("part P2 \"Viola\""),
+        "{text}"
+    );
+    let (_, r) = go(
+        &two_parts(violin, "<part-name>Viola</part-name>"),
+        Some("P2"),
+    )
+    .unwrap();
+    assert!(r.source.contains("--part \"P2\""), "{}", r.source);
+    let (_, r) = go(
+        &two_parts(violin, "<part-name>Viola</part-name>"),
+        Some("viol"),
+    )
+    .unwrap();
+    assert!(r.source.starts_with("part P1"), "{}", r.source);
+    let err = go(&two_parts(violin, violin), Some("Tuba")).unwrap_err();
+    assert!(err.to_string().contains("\"Tuba\""), "{err}");
+}
+
+// ---- bad input ----
+
+/// Malformed XML names the file, line and column; a bad value names the line and
+/// measure; an .mxl that is no zip, a corrupt zip and a missing file name the file.
+#[test]
+fn malformed_input_errors() {
+    let kit = Kit::standard();
+    let opts = ImportOptions::default();
+    let err = |name: &str, bytes: &[u8]| {
+        import(Path::new(name), bytes, &kit, &opts)
+            .unwrap_err()
+            .to_string()
+    };
+    let truncated = doc(&[&note("D3", 1, "")]);
+    let truncated = &truncated[..truncated.len() - 30];
+    let e = err("cut.musicxml", truncated.as_bytes());
+    assert!(
+        e.starts_with("cut.musicxml:6:") && e.contains("malformed XML"),
+        "{e}"
+    );
+    let bad_duration = doc(&[&format!(
+        "{}{}",
+        attrs(1),
+        note("D3", 1, "").replace(">1<", ">one<")
+    )]);
+    let e = err("dur.musicxml", bad_duration.as_bytes());
+    assert!(
+        e.starts_with("dur.musicxml:6: measure 1: <duration> \"one\""),
+        "{e}"
+    );
+    let e = err("x.musicxml", b"<html><body/></html>");
+    assert!(
+        e.contains("not a MusicXML score") && e.contains("<html>"),
+        "{e}"
+    );
+    let e = err("not-zip.mxl", b"<score-partwise/>");
+    assert!(
+        e.starts_with("not-zip.mxl: not a readable compressed MusicXML"),
+        "{e}"
+    );
+    let mxl = std::fs::read(Path::new(DATA).join("bwv248.64-6.mxl")).unwrap();
+    let e = err("cut.mxl", &mxl[..mxl.len() / 2]);
+    assert!(
+        e.starts_with("cut.mxl: not a readable compressed MusicXML"),
+        "{e}"
+    );
+    let e = import_file(Path::new("/nonexistent/score.mxl"), &kit, &opts)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("/nonexistent/score.mxl: cannot read the file"),
+        "{e}"
+    );
+}
+
+/// Every file of the MusicXML test suite either imports into a playable score or fails
+/// with an error naming it; none panics. Files without a timpani part are read with
+/// `--part` set to their first part.
+#[test]
+fn whole_test_suite_never_crashes() {
+    let kit = Kit::standard();
+    let dir = Path::new(DATA).join("musicxml-testsuite/xmlFiles");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 150);
+    let (mut imported, mut errors) = (Vec::new(), Vec::new());
+    for f in &files {
+        let mut result = import_file(f, &kit, &ImportOptions::default());
+        if let Err(MusicXmlError::NoTimpani { parts, .. }) = &result {
+            let first = parts.lines().next().unwrap().trim();
+            let id = first
+                .strip_prefix("part ")
+                .unwrap()
+                .split([' ', ':'])
+                .next()
+                .unwrap();
+            let opts = ImportOptions {
+                part: Some(id.to_string()),
+                ..ImportOptions::default()
+            };
+            result = import_file(f, &kit, &opts);
+        }
+        match result {
+            Ok((score, _)) => {
+                assert!(
+                    score.problems(&kit).is_empty(),
+                    "{}: {:?}",
+                    f.display(),
+                    score.problems(&kit)
+                );
+                imported.push(f);
+            }
+            Err(e) => {
+                let name = f.file_name().unwrap().to_string_lossy();
+                assert!(e.to_string().contains(&*name), "{e}");
+                errors.push(e.to_string());
+            }
+        }
+    }
+    println!(
+        "{} imported, {} clean errors: {errors:#?}",
+        imported.len(),
+        errors.len()
+    );
+    // The one malformed file of the suite (a </part> closes an open <measure>).
+    assert_eq!(errors.len(), 1, "{errors:#?}");
+    assert!(errors[0].contains("32ad-Notations5.musicxml:141:3: malformed XML"));
+}
+
+/// Snippets of the test suite read as a timpanist would: 21a (a chord of three notes:
+/// the two loudest — here the first two — kept), 03c (divisions changes), 90a (.mxl).
+#[test]
+fn test_suite_files() {
+    let kit = Kit::standard();
+    let dir = Path::new(DATA).join("musicxml-testsuite/xmlFiles");
+    let read = |name: &str, part: &str| {
+        let opts = ImportOptions {
+            part: Some(part.into()),
+            ..ImportOptions::default()
+        };
+        import_file(&dir.join(name), &kit, &opts).unwrap()
+    };
+    let (score, report) = read("90a-Compressed-MusicXML.mxl", "P1");
+    assert_eq!(score.beats.len(), 4, "{report:?}");
+    let (score, _) = read("03c-Rhythm-DivisionChange.xml", "P1");
+    assert!(score.beats.windows(2).all(|w| w[0].tick < w[1].tick));
+}
+
+// ---- the binary ----
+
+fn timpanist(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_timpanist"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// `import-musicxml` writes a score that checks; a file without a timpani part fails
+/// with the parts listed and writes nothing.
+#[test]
+fn cli_import_musicxml() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("bach.ron");
+    let bach = Path::new(DATA).join("bwv248.64-6.mxl");
+    let o = timpanist(&[
+        "import-musicxml",
+        bach.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("112 beats from part P4"), "{stdout}");
+    assert!(String::from_utf8_lossy(&o.stderr).contains("note: pickup measure"));
+    let loaded = timpanist::score::LoadedScore::load(&out).unwrap();
+    assert_eq!(loaded.score.beats.len(), 112);
+    let no_timp = Path::new(DATA).join("musicxml-testsuite/xmlFiles/21a-Chord-Basic.xml");
+    let out2 = tmp.path().join("none.ron");
+    let o = timpanist(&[
+        "import-musicxml",
+        no_timp.to_str().unwrap(),
+        "-o",
+        out2.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("no timpani part found") && stderr.contains("part P0"),
+        "{stderr}"
+    );
+    assert!(!out2.exists());
+    let o = timpanist(&[
+        "import-musicxml",
+        no_timp.to_str().unwrap(),
+        "-o",
+        out2.to_str().unwrap(),
+        "--part",
+        "P0",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+// ---- timpanist FILE ----
+
+/// `timpanist FILE`: a score is edited, MIDI and MusicXML files are imported; a missing
+/// or unknown file is refused naming it. Reading an import gives an unsaved document.
+#[test]
+fn file_dispatch() {
+    let mid = Path::new(FIXTURES).join("bwv248-64-6.mid");
+    let mxl = Path::new(DATA).join("bwv248.64-6.mxl");
+    let ron = Path::new(env!("CARGO_MANIFEST_DIR")).join("scores/etude-modes.ron");
+    assert_eq!(
+        open::action_for(&ron).unwrap(),
+        OpenAction::Edit(ron.clone())
+    );
+    assert_eq!(
+        open::action_for(&mid).unwrap(),
+        OpenAction::Import(mid.clone(), FileKind::Midi)
+    );
+    assert_eq!(
+        open::action_for(&mxl).unwrap(),
+        OpenAction::Import(mxl.clone(), FileKind::MusicXml)
+    );
+    assert!(matches!(
+        open::action_for(Path::new("/nope/a.mid")),
+        Err(OpenError::Missing(_))
+    ));
+    assert!(matches!(
+        open::action_for(&Path::new(DATA).join("LICENSE-music21-corpus.txt")),
+        Err(OpenError::NotAScore(_))
+    ));
+    for file in [&mid, &mxl] {
+        let opened = open::read(file).unwrap();
+        assert_eq!(opened.path, None, "an import is unsaved");
+        assert_eq!(opened.loaded.score.beats.len(), 112);
+    }
+    let o = timpanist(&["/nope/a.mid"]);
+    assert!(!o.status.success());
+    assert_eq!(
+        String::from_utf8_lossy(&o.stderr).trim(),
+        "error: /nope/a.mid: no such file"
+    );
+    let tmp = tempfile::tempdir().unwrap();
+    let bad = tmp.path().join("bad.musicxml");
+    std::fs::write(&bad, "<score-partwise><part-list>").unwrap();
+    let o = timpanist(&[bad.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("bad.musicxml:1:"));
+}
+
+// ---- MIDI text encodings ----
+
+fn midi_titled(title: &[u8]) -> Vec<u8> {
+    use midly::num::{u4, u7, u15, u28};
+    use midly::{
+        Format, Header, MetaMessage, MidiMessage, Smf, Timing, TrackEvent, TrackEventKind,
+    };
+    let ev = |kind| TrackEvent {
+        delta: u28::new(0),
+        kind,
+    };
+    let end = ev(TrackEventKind::Meta(MetaMessage::EndOfTrack));
+    let smf = Smf {
+        header: Header::new(Format::Parallel, Timing::Metrical(u15::new(480))),
+        tracks: vec![
+            vec![ev(TrackEventKind::Meta(MetaMessage::TrackName(title))), end],
+            vec![
+                ev(TrackEventKind::Midi {
+                    channel: u4::new(0),
+                    message: MidiMessage::ProgramChange {
+                        program: u7::new(47),
+                    },
+                }),
+                ev(TrackEventKind::Midi {
+                    channel: u4::new(0),
+                    message: MidiMessage::NoteOn {
+                        key: u7::new(50),
+                        vel: u7::new(80),
+                    },
+                }),
+                end,
+            ],
+        ],
+    };
+    let mut out = Vec::new();
+    smf.write_std(&mut out).unwrap();
+    out
+}
+
+/// Titles in UTF-8, Shift-JIS and Latin-1 read as written; undecodable text gives the
+/// file name.
+#[test]
+fn midi_titles_in_legacy_encodings() {
+    use timpanist::io::midi_import;
+    let kit = Kit::standard();
+    let title = |bytes: &[u8]| {
+        let midi = midi_titled(bytes);
+        let (score, _) = midi_import::import(
+            Path::new("dir/song.mid"),
+            &midi,
+            &kit,
+            &midi_import::ImportOptions::default(),
+        )
+        .unwrap();
+        score.title
+    };
+    let (sjis, _, bad) = encoding_rs::SHIFT_JIS.encode("ティンパニ協奏曲 第1番");
+    assert!(!bad && std::str::from_utf8(&sjis).is_err());
+    assert_eq!(title(&sjis), "ティンパニ協奏曲 第1番");
+    assert_eq!(
+        title(b"Pi\xe8ce pour timbales \xe0 Fran\xe7ois"),
+        "Pièce pour timbales à François"
+    );
+    assert_eq!(title("Ouvertüre".as_bytes()), "Ouvertüre");
+    // Bytes that are Shift-JIS without any Japanese letter are Latin-1: "Åbo".
+    assert_eq!(title(b"\xc5bo"), "Åbo");
+    assert_eq!(title(b"\x01\x02\x03"), "song");
+    assert_eq!(midi_import::decode_text(b"caf\xe9"), "café");
+}
