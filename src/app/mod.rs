@@ -297,23 +297,16 @@ impl eframe::App for EditorApp {
 
 /// Open the editor window on `score` (or the demo score) and run until it closes.
 pub fn run(score: Option<PathBuf>) -> anyhow::Result<()> {
-    let options = eframe::NativeOptions {
-        viewport: egui::ViewportBuilder::default()
-            .with_inner_size([1400.0, 900.0])
-            .with_title("timpanist")
-            .with_drag_and_drop(true),
-        ..Default::default()
-    };
-    eframe::run_native(
-        "timpanist",
-        options,
-        Box::new(move |_cc| Ok(Box::new(EditorApp::new(score.as_deref())))),
-    )
-    .map_err(|e| anyhow::anyhow!("could not open the editor window: {e}"))
+    open_window(move || EditorApp::new(score.as_deref()))
 }
 
 /// Open the editor window on a document read or imported already (`timpanist FILE.mid`).
 pub fn run_document(opened: files::Opened) -> anyhow::Result<()> {
+    open_window(move || EditorApp::with_document(EditorOptions::default(), opened))
+}
+
+/// Open the editor window on the editor `make` builds and run until it closes.
+fn open_window(make: impl FnOnce() -> EditorApp + 'static) -> anyhow::Result<()> {
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_inner_size([1400.0, 900.0])
@@ -324,12 +317,7 @@ pub fn run_document(opened: files::Opened) -> anyhow::Result<()> {
     eframe::run_native(
         "timpanist",
         options,
-        Box::new(move |_cc| {
-            Ok(Box::new(EditorApp::with_document(
-                EditorOptions::default(),
-                opened,
-            )))
-        }),
+        Box::new(move |_cc| Ok(Box::new(make()))),
     )
     .map_err(|e| anyhow::anyhow!("could not open the editor window: {e}"))
 }
