@@ -17,10 +17,7 @@ pub fn import(
     title: Option<String>,
     detect_rolls: bool,
 ) -> anyhow::Result<()> {
-    let (kit, kit_ref) = match kit_path {
-        Some(p) => (Kit::load(p)?, kit_reference(p, output)?),
-        None => (Kit::standard(), "standard".to_string()),
-    };
+    let (kit, kit_ref) = import_kit(kit_path, output)?;
     let options = ImportOptions {
         track: track.map(|t| t.parse::<TrackChoice>().unwrap_or(TrackChoice::Name(t))),
         kit_ref,
@@ -28,7 +25,47 @@ pub fn import(
         detect_rolls,
     };
     let (score, report) = midi_import::import_file(input, &kit, &options)?;
-    if let Some(p) = score.problems(&kit).first() {
+    save_imported(
+        (input, output),
+        &score,
+        &kit,
+        &Imported {
+            source: &report.source,
+            duplicates_dropped: report.duplicates_dropped,
+            octave_moves: report.octave_moves,
+        },
+    )?;
+    for w in &report.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(())
+}
+
+/// The kit an import plays on (`kit_path`, else the bundled standard kit) and how the
+/// score written to `output` names it.
+pub(super) fn import_kit(kit_path: Option<&Path>, output: &Path) -> anyhow::Result<(Kit, String)> {
+    Ok(match kit_path {
+        Some(p) => (Kit::load(p)?, kit_reference(p, output)?),
+        None => (Kit::standard(), "standard".to_string()),
+    })
+}
+
+/// What an import says about itself on its summary line.
+pub(super) struct Imported<'a> {
+    pub source: &'a str,
+    pub duplicates_dropped: usize,
+    pub octave_moves: usize,
+}
+
+/// Save an imported `score` from `input` to `output` once it is playable on `kit`
+/// (else nothing is written), and print the summary line.
+pub(super) fn save_imported(
+    (input, output): (&Path, &Path),
+    score: &crate::score::Score,
+    kit: &Kit,
+    imported: &Imported,
+) -> anyhow::Result<()> {
+    if let Some(p) = score.problems(kit).first() {
         anyhow::bail!(
             "{}: the imported score is not playable: {p}",
             input.display()
@@ -40,13 +77,10 @@ pub fn import(
         input.display(),
         output.display(),
         score.beats.len(),
-        report.source,
-        report.duplicates_dropped,
-        report.octave_moves
+        imported.source,
+        imported.duplicates_dropped,
+        imported.octave_moves
     );
-    for w in &report.warnings {
-        eprintln!("warning: {w}");
-    }
     Ok(())
 }
 

@@ -1,9 +1,8 @@
 //! `timpanist import-musicxml`: the timpani part of a MusicXML score (`.musicxml`, `.xml`
 //! or compressed `.mxl`) as a score.
 
-use super::midi::kit_reference;
+use super::midi::{Imported, import_kit, save_imported};
 use crate::io::musicxml::{self, ImportOptions};
-use crate::kit::Kit;
 use std::path::Path;
 
 /// Import `input` with `kit` (default: the bundled standard kit) and save the score;
@@ -15,32 +14,23 @@ pub fn import(
     kit_path: Option<&Path>,
     title: Option<String>,
 ) -> anyhow::Result<()> {
-    let (kit, kit_ref) = match kit_path {
-        Some(p) => (Kit::load(p)?, kit_reference(p, output)?),
-        None => (Kit::standard(), "standard".to_string()),
-    };
+    let (kit, kit_ref) = import_kit(kit_path, output)?;
     let options = ImportOptions {
         part,
         kit_ref,
         title,
     };
     let (score, report) = musicxml::import_file(input, &kit, &options)?;
-    if let Some(p) = score.problems(&kit).first() {
-        anyhow::bail!(
-            "{}: the imported score is not playable: {p}",
-            input.display()
-        );
-    }
-    score.save(output)?;
-    println!(
-        "{} -> {}: {} beats from {}; {} duplicates dropped; {} notes moved by octaves",
-        input.display(),
-        output.display(),
-        score.beats.len(),
-        report.source,
-        report.duplicates_dropped,
-        report.octave_moves
-    );
+    save_imported(
+        (input, output),
+        &score,
+        &kit,
+        &Imported {
+            source: &report.source,
+            duplicates_dropped: report.duplicates_dropped,
+            octave_moves: report.octave_moves,
+        },
+    )?;
     for n in &report.notices {
         eprintln!("note: {n}");
     }
