@@ -113,29 +113,31 @@ impl SoundHead {
             .iter()
             .map(|&(k, w, scale)| {
                 let mode = &modes.modes()[k];
+                let axisymmetric = mode.m == 0 && !mode.listed;
+                let t60_s = calibration.t60_s(mode.m, mode.n, mode.freq_hz);
+                let radiated = if mode.listed {
+                    w
+                } else {
+                    let own = if axisymmetric {
+                        calibration.axisymmetric_gain()
+                    } else {
+                        1.0
+                    };
+                    w * scale * calibration.radiation_gain(mode.freq_hz / f11) * own
+                };
                 Voice {
                     freq_hz: mode.freq_hz,
                     // An axisymmetric mode dies at least as fast as its own radiation
                     // damps it.
-                    t60_s: if mode.m == 0 && !mode.listed {
-                        calibration
-                            .t60_s(mode.m, mode.n, mode.freq_hz)
-                            .min(mode.t60_s)
+                    t60_s: if axisymmetric {
+                        t60_s.min(mode.t60_s)
                     } else {
-                        calibration.t60_s(mode.m, mode.n, mode.freq_hz)
+                        t60_s
                     },
                     glide: glide_per_state * stretch(mode),
                     // Over ω_k: the mix differentiates (the head radiates its
                     // acceleration), giving w at the mode's own frequency.
-                    gain: if mode.listed {
-                        w
-                    } else if mode.m == 0 {
-                        w * scale
-                            * calibration.radiation_gain(mode.freq_hz / f11)
-                            * calibration.axisymmetric_gain()
-                    } else {
-                        w * scale * calibration.radiation_gain(mode.freq_hz / f11)
-                    } / (std::f64::consts::TAU * mode.freq_hz),
+                    gain: radiated / (std::f64::consts::TAU * mode.freq_hz),
                 }
             })
             .collect();
