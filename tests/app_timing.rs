@@ -12,7 +12,6 @@ use egui_kittest::kittest::{NodeT, Queryable};
 use std::path::Path;
 use std::time::Instant;
 use timpanist::app::EditorApp;
-use timpanist::mocap::db::MotionDb;
 use timpanist::render::{RenderParams, render};
 use timpanist::score::{Beat, Hand, Score};
 
@@ -92,7 +91,7 @@ fn edit_to_composition_and_frame_times() {
     // The score as edited, rendered in one simulation pass (the plots' cost does not
     // depend on how many passes made the rendering) and handed to the editor.
     let loaded = h.state().loaded().unwrap().clone();
-    let db = MotionDb::load(&timpanist::mocap::db::default_dir()).unwrap();
+    let db = timpanist::mocap::shipped::built_in().unwrap();
     let params = RenderParams {
         max_attempts: 1,
         ..RenderParams::default()

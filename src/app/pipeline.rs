@@ -244,8 +244,7 @@ fn compose_job(
     let db: OnceLock<Result<MotionDb, Arc<FileError>>> = OnceLock::new();
     move |loaded, job| {
         let began = Instant::now();
-        let db =
-            db.get_or_init(|| MotionDb::load(&crate::mocap::db::default_dir()).map_err(Arc::new));
+        let db = db.get_or_init(|| crate::mocap::shipped::locate().load().map_err(Arc::new));
         let params = RenderParams::for_score(&loaded.score.settings);
         let result = match db {
             Ok(db) => crate::render::compose(&loaded, db, &params)

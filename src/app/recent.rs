@@ -18,11 +18,7 @@ pub struct RecentFiles {
 
 /// The default list file under the user's config directory, if a home is known.
 pub fn default_store() -> Option<PathBuf> {
-    let base = std::env::var_os("XDG_CONFIG_HOME")
-        .filter(|v| !v.is_empty())
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".config")))?;
-    Some(base.join("timpanist").join("recent.txt"))
+    crate::base::dirs::config_dir().map(|d| d.join("recent.txt"))
 }
 
 impl RecentFiles {

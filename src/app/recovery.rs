@@ -22,7 +22,7 @@ const VERSION: u32 = 1;
 /// `recovery.ron` in the editor's configuration folder ($XDG_CONFIG_HOME/timpanist or
 /// ~/.config/timpanist); `None` without a home.
 pub fn default_file() -> Option<PathBuf> {
-    super::recent::default_store().map(|p| p.with_file_name("recovery.ron"))
+    crate::base::dirs::config_dir().map(|d| d.join("recovery.ron"))
 }
 
 /// What the recovery file holds.

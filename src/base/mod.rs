@@ -6,6 +6,7 @@
 //! of the crate.
 
 pub mod choices;
+pub mod dirs;
 pub mod gesture;
 pub mod limits;
 pub mod pitch;

@@ -10,6 +10,7 @@ use crate::io::plot::{Figure, Panel, Series};
 use crate::io::tips_csv;
 use crate::kit::Side;
 use crate::mocap::db::MotionDb;
+use crate::mocap::shipped::{self, DbSource};
 use crate::motion::compose::{ComposeParams, Composition};
 use crate::motion::perform;
 use crate::motion::plan::{self, PlanParams, Substitution};
@@ -21,16 +22,16 @@ use std::path::Path;
 /// Colour of each hand in figures.
 pub const HAND_COLOURS: [RGBColor; 2] = [RGBColor(31, 119, 180), RGBColor(230, 120, 20)];
 
-/// Compose `score` with the database in `db_dir`; write CSV to `output` and a plot.
+/// Compose `score` with the database from `source`; write CSV to `output` and a plot.
 pub fn run(
     score: &Path,
-    db_dir: &Path,
+    source: &DbSource,
     output: &Path,
     plot: Option<&Path>,
     seed: u64,
 ) -> anyhow::Result<()> {
     let loaded = LoadedScore::load(score)?;
-    let db = load_db(db_dir)?;
+    let db = load_db(source)?;
     let started = std::time::Instant::now();
     let comp = perform::trajectories(
         &loaded.score,
@@ -42,7 +43,7 @@ pub fn run(
         },
         &ComposeParams::default(),
     )
-    .map_err(|e| anyhow::anyhow!("{}: {e}", db_dir.display()))?;
+    .map_err(|e| anyhow::anyhow!("{source}: {e}"))?;
     let took = started.elapsed();
     print_substitutions(&plan::substitutions(&comp.strokes, &loaded.score, &db));
     let csv = tips_csv::to_csv(&comp);
@@ -63,52 +64,31 @@ pub fn run(
     Ok(())
 }
 
-/// The motion database in `db_dir`, completed for the playing modes (per grip) it has no
-/// unit of by the shipped synthetic database ([`MotionDb::with_fallback`]), saying on
-/// stderr which modes came from it. The shipped database itself (or one holding every
-/// mode of both grips) is used as it is; when the shipped one cannot be read, the
-/// database is used as it is with a note.
-pub fn load_db(db_dir: &Path) -> anyhow::Result<MotionDb> {
-    let db = MotionDb::load(db_dir)?;
-    let shipped_dir = crate::mocap::db::default_dir();
+/// The motion database from `source`, completed for the playing modes (per grip) it has
+/// no unit of by the shipped synthetic database ([`MotionDb::with_fallback`], from the
+/// copy built into the program), saying on stderr which modes came from it. The built-in
+/// database itself (or one holding every mode of both grips) is used as it is.
+pub fn load_db(source: &DbSource) -> anyhow::Result<MotionDb> {
+    let db = source.load()?;
     let has = |key: (Grip, PlayingMode)| db.index.units.iter().any(|u| (u.grip, u.mode) == key);
     let complete = [Grip::French, Grip::German]
         .into_iter()
         .all(|grip| PlayingMode::ALL.into_iter().all(|mode| has((grip, mode))));
-    if complete || same_dir(db_dir, &shipped_dir) {
+    if complete || *source == DbSource::BuiltIn {
         return Ok(db);
     }
-    let shipped = match MotionDb::load(&shipped_dir) {
-        Ok(shipped) => shipped,
-        Err(e) => {
-            eprintln!(
-                "note: the modes {} lacks are not completed: {e}",
-                db_dir.display()
-            );
-            return Ok(db);
-        }
-    };
+    let shipped = shipped::built_in()?;
     let lacking = db.modes_lacking(&shipped);
     if !lacking.is_empty() {
         let modes: Vec<String> = (lacking.iter())
             .map(|(grip, mode)| format!("{} ({grip:?})", mode.name()))
             .collect();
         eprintln!(
-            "note: {} has no unit of {}: those come from the synthetic database {}",
-            db_dir.display(),
+            "note: {source} has no unit of {}: those come from the built-in synthetic database",
             modes.join(", "),
-            shipped_dir.display()
         );
     }
     Ok(db.with_fallback(&shipped))
-}
-
-/// Whether two paths name the same folder.
-fn same_dir(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => a == b,
-    }
 }
 
 /// Substitutions told one by one; beyond these, a summary line.

@@ -9,7 +9,7 @@ use crate::body::sim::Motion;
 use crate::body::skeleton::{Joint, REST};
 use crate::io::plot::{Figure, Panel, Series};
 use crate::kit::Side;
-use crate::mocap::db::MotionDb;
+use crate::mocap::shipped::DbSource;
 use crate::render::evaluate::{self, EvalParams, Report};
 use crate::score::PlayingMode;
 use plotters::style::RGBColor;
@@ -22,12 +22,12 @@ use std::path::Path;
 /// are listed as skipped, and for tip-only captures ID replays the joint angles IK solves
 /// from the tips on the capture skeleton (`render::evaluate`'s doc).
 pub fn run(
-    db_dir: &Path,
+    source: &DbSource,
     trials: usize,
     joint_limits: bool,
     (json, plot): (Option<&Path>, Option<&Path>),
 ) -> anyhow::Result<()> {
-    let db = MotionDb::load(db_dir)?;
+    let db = source.load()?;
     let model = evaluate::simulated_body();
     let mut params = EvalParams {
         trials: trials.max(1),

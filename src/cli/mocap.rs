@@ -211,11 +211,7 @@ pub fn import(args: ImportArgs) -> anyhow::Result<()> {
     // The shipped database, read once and only if needed: the alignment's habits, the
     // dynamics' speeds.
     let loaded = std::cell::OnceCell::new();
-    let shipped = || {
-        loaded
-            .get_or_init(|| MotionDb::load(&crate::mocap::db::default_dir()))
-            .as_ref()
-    };
+    let shipped = || loaded.get_or_init(crate::mocap::shipped::built_in).as_ref();
     let align = alignment(&args, &shipped)?;
     // Strokes without a dynamic label get the shipped performer's marking for their speed.
     let speeds = if args.dynamic.is_some() {
@@ -647,7 +643,7 @@ pub fn columns(file: &Path, profile: Option<&str>) -> anyhow::Result<()> {
 /// from the real TrajOptDrums stroke, with `truth.ron`.
 pub fn corpus(dir: &Path, seed: u64) -> anyhow::Result<()> {
     use crate::mocap::labcorpus::{self, LabStyle, Layout};
-    let db = MotionDb::load(&crate::mocap::db::default_dir())?;
+    let db = crate::mocap::shipped::built_in()?;
     let takes = db.index.takes.len().max(1);
     let mut captures = Vec::new();
     for (k, layout) in Layout::ALL.into_iter().enumerate() {

@@ -5,6 +5,7 @@
 mod args;
 mod check;
 mod compose;
+mod demos;
 mod evaluate;
 mod midi;
 mod mocap;
@@ -96,6 +97,14 @@ pub enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// List the demo scores built into the program, or write them into a folder (their
+    /// kits named by bundled name, so they load anywhere).
+    Demos {
+        /// Write every demo score into this folder as NAME.ron (an existing file is never
+        /// overwritten).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+    },
     /// Assign hands to the beats marked Auto and print the sticking.
     Sticking {
         /// The score (.ron).
@@ -119,8 +128,9 @@ pub enum Command {
         /// Also draw tip height and depth against time, beats marked, as a PNG.
         #[arg(long)]
         plot: Option<PathBuf>,
-        /// The motion database folder [default: ./mocap if there is one, else the shipped
-        /// database].
+        /// The motion database folder [default: the first of ./mocap,
+        /// ~/.local/share/timpanist/mocap, <prefix>/share/timpanist/mocap holding an
+        /// index.ron, else the database built into the program].
         #[arg(long)]
         db: Option<PathBuf>,
         /// Seed of the choice among near-equal motion units.
@@ -160,8 +170,9 @@ pub enum Command {
         /// Print simulated seconds per wall second and where the time went.
         #[arg(long)]
         stats: bool,
-        /// The motion database folder [default: ./mocap if there is one, else the shipped
-        /// database].
+        /// The motion database folder [default: the first of ./mocap,
+        /// ~/.local/share/timpanist/mocap, <prefix>/share/timpanist/mocap holding an
+        /// index.ron, else the database built into the program].
         #[arg(long)]
         db: Option<PathBuf>,
         /// Seed of the choice among near-equal motion units.
@@ -187,8 +198,9 @@ pub enum Command {
         /// Draw the Fig. 5 comparison per mode as PNGs into this folder.
         #[arg(long)]
         plot: Option<PathBuf>,
-        /// The motion database folder [default: ./mocap if there is one, else the shipped
-        /// database].
+        /// The motion database folder [default: the first of ./mocap,
+        /// ~/.local/share/timpanist/mocap, <prefix>/share/timpanist/mocap holding an
+        /// index.ron, else the database built into the program].
         #[arg(long)]
         db: Option<PathBuf>,
         /// Hold every joint within the limits estimated from the database's captured
@@ -392,8 +404,8 @@ pub fn main() -> ExitCode {
     }
 }
 
-fn db_or_default(db: Option<PathBuf>) -> PathBuf {
-    db.unwrap_or_else(crate::mocap::db::default_dir)
+fn db_or_default(db: Option<PathBuf>) -> crate::mocap::shipped::DbSource {
+    crate::mocap::shipped::DbSource::named_or_located(db)
 }
 
 /// An error and its causes, each said once: a cause whose text its effect already
@@ -480,6 +492,9 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             title,
         }) => musicxml::import(&input, &output, part, kit.as_deref(), title)
             .map(|()| ExitCode::SUCCESS),
+        Some(Command::Demos { output }) => {
+            demos::run(output.as_deref()).map(|()| ExitCode::SUCCESS)
+        }
         Some(Command::Sticking {
             score,
             method,

@@ -10,6 +10,7 @@ use crate::base::ron_file;
 use crate::body::sim::Pipeline;
 use crate::io::plot::{Figure, Panel, Series};
 use crate::io::{motion_c3d, motion_csv};
+use crate::mocap::shipped::DbSource;
 use crate::motion::plan::{self, PlanParams};
 use crate::render::{Progress, RenderParams, Rendering, render, strikes};
 use crate::score::LoadedScore;
@@ -46,7 +47,7 @@ pub struct Choices {
 
 pub fn run(
     score: &Path,
-    db_dir: &Path,
+    source: &DbSource,
     outputs: &Outputs,
     choices: &Choices,
 ) -> anyhow::Result<()> {
@@ -61,7 +62,10 @@ pub fn run(
     for notice in &loaded.notices {
         eprintln!("note: {notice}");
     }
-    let db = super::compose::load_db(db_dir)?;
+    let db = super::compose::load_db(source)?;
+    if stats {
+        println!("database: {source}");
+    }
     let settings = RenderParams::for_score(&loaded.score.settings);
     let params = RenderParams {
         control: control.unwrap_or(settings.control),

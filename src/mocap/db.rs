@@ -22,7 +22,7 @@ use flate2::write::ZlibEncoder;
 use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
 use std::io::{Read, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::OnceLock;
 
 /// The database format this timpanist writes and the newest it reads.
@@ -250,7 +250,20 @@ impl MotionDb {
     pub fn load(dir: &Path) -> Result<MotionDb, FileError> {
         let index_path = dir.join("index.ron");
         let text = ron_file::read_text(&index_path)?;
-        let index: Index = ron_file::parse(&index_path, &text)?;
+        Self::from_parts(dir, &text, &|path| {
+            std::fs::read(path).map_err(|e| FileError::io(path, e))
+        })
+    }
+
+    /// A database from its index text and a reader of its sample files (`read` gets
+    /// `dir` joined with each take's file); errors name paths under `dir`.
+    pub(crate) fn from_parts(
+        dir: &Path,
+        index_text: &str,
+        read: &dyn Fn(&Path) -> Result<Vec<u8>, FileError>,
+    ) -> Result<MotionDb, FileError> {
+        let index_path = dir.join("index.ron");
+        let index: Index = ron_file::parse(&index_path, index_text)?;
         if index.version > DB_FORMAT_VERSION {
             return Err(FileError::TooNew {
                 path: index_path,
@@ -263,7 +276,7 @@ impl MotionDb {
             .iter()
             .map(|t| {
                 let path = dir.join(&t.file);
-                let bytes = std::fs::read(&path).map_err(|e| FileError::io(&path, e))?;
+                let bytes = read(&path)?;
                 let data = decode_take(&path, &bytes)?;
                 if data.frames() != t.frames {
                     return Err(FileError::invalid(
@@ -553,18 +566,6 @@ impl Channels<'_> {
             })
             .collect()
     }
-}
-
-/// The database to use when none is named: `./mocap` when the working directory has
-/// one, else the one shipped in the source tree the program was built from (so the
-/// command works from any directory), else `./mocap` (whose absence is then reported).
-pub fn default_dir() -> PathBuf {
-    let here = PathBuf::from("mocap");
-    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("mocap");
-    [here.clone(), shipped]
-        .into_iter()
-        .find(|d| d.join("index.ron").is_file())
-        .unwrap_or(here)
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@ pub mod import;
 pub mod ingest;
 pub mod labcorpus;
 pub mod segment;
+pub mod shipped;
 pub mod stats;
 pub mod synth;
 pub mod take;

@@ -2,6 +2,7 @@
 //! time signatures, each with hand, playing mode, dynamic, drum, pitch, impact location and
 //! an optional roll; read from and written to strict, versioned RON files (`scores/*.ron`).
 
+pub mod demos;
 pub mod edit;
 pub mod meter;
 mod migrate;
