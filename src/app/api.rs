@@ -27,6 +27,11 @@ impl EditorApp {
         self.doc.as_ref().map(|d| &d.loaded)
     }
 
+    /// Whether the editor's own in-window file browser is showing.
+    pub fn is_file_browser_open(&self) -> bool {
+        self.dialogs.is_open()
+    }
+
     /// Where the open score is saved, if anywhere.
     pub fn path(&self) -> Option<&Path> {
         self.doc.as_ref().and_then(|d| d.path.as_deref())

@@ -4,6 +4,7 @@
 //! view, the timeline, the tempo lane and the plots.
 
 use super::command::Command;
+use super::dialogs::{Purpose, Request};
 use super::session::ConfirmAnswer;
 use super::{
     Action, AfterConfirm, Camera, EditorApp, Export, plots, tempo_lane, timeline, viewport,
@@ -35,19 +36,31 @@ impl EditorApp {
                         }
                     }
                 });
-                if ui.button("Import MIDI...").clicked()
-                    && let Some(p) = rfd::FileDialog::new()
-                        .add_filter("MIDI", &["mid", "midi"])
-                        .pick_file()
-                {
-                    self.after_confirm(AfterConfirm::Open(p));
-                }
-                if ui.button("Import MusicXML...").clicked()
-                    && let Some(p) = rfd::FileDialog::new()
-                        .add_filter("MusicXML", &["musicxml", "xml", "mxl"])
-                        .pick_file()
-                {
-                    self.after_confirm(AfterConfirm::Open(p));
+                ui.menu_button("Demo scores", |ui| {
+                    for (name, _) in crate::score::demos::DEMOS {
+                        if ui.button(*name).clicked() {
+                            self.after_confirm(AfterConfirm::OpenDemo(name));
+                        }
+                    }
+                });
+                let imports: [(&str, (&str, &[&str])); 2] = [
+                    ("Import MIDI...", ("MIDI", &["mid", "midi"])),
+                    (
+                        "Import MusicXML...",
+                        ("MusicXML", &["musicxml", "xml", "mxl"]),
+                    ),
+                ];
+                for (label, filter) in imports {
+                    if ui.button(label).clicked() {
+                        self.ask_and_act(Request {
+                            purpose: Purpose::Open,
+                            title: label.trim_end_matches('.'),
+                            filter,
+                            save: false,
+                            file_name: None,
+                            folder: None,
+                        });
+                    }
                 }
                 ui.separator();
                 let mut item = |ui: &mut egui::Ui, label: &str, action: Action| {

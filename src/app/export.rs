@@ -7,6 +7,7 @@
 //! with the reason, while the only rendering is of an older version of the score or there
 //! is none.
 
+use super::dialogs::{Purpose, Request};
 use crate::base::ron_file::{self, FileError};
 use crate::io::{midi_export, motion_c3d, motion_csv};
 use crate::kit::Kit;
@@ -43,12 +44,12 @@ impl Export {
     }
 
     /// The dialog's filter: a name and the file extension.
-    pub fn filter(self) -> (&'static str, &'static str) {
+    pub fn filter(self) -> (&'static str, &'static [&'static str]) {
         match self {
-            Export::Wav => ("WAV audio", "wav"),
-            Export::Motion => ("motion CSV", "csv"),
-            Export::MotionC3d => ("C3D motion capture", "c3d"),
-            Export::Midi => ("Standard MIDI File", "mid"),
+            Export::Wav => ("WAV audio", &["wav"]),
+            Export::Motion => ("motion CSV", &["csv"]),
+            Export::MotionC3d => ("C3D motion capture", &["c3d"]),
+            Export::Midi => ("Standard MIDI File", &["mid"]),
         }
     }
 
@@ -189,21 +190,17 @@ pub fn write(
     }
 }
 
-/// Ask where to export `what`, starting beside `score_path` (when saved) with a name made
-/// from it or from `title`.
-pub fn ask_path(what: Export, score_path: Option<&Path>, title: &str) -> Option<PathBuf> {
-    let stem = score_path
-        .and_then(|p| p.file_stem())
-        .and_then(|s| s.to_str())
-        .unwrap_or(title);
-    let (name, ext) = what.filter();
-    let mut dialog = rfd::FileDialog::new()
-        .add_filter(name, &[ext])
-        .set_file_name(what.suggested_name(stem));
-    if let Some(dir) = score_path.and_then(Path::parent) {
-        dialog = dialog.set_directory(dir);
+/// The question for where to export `what`: beside `score_path` (when saved), named
+/// from `stem` (the score file's stem or the title).
+pub fn request(what: Export, score_path: Option<&Path>, stem: &str) -> Request {
+    Request {
+        purpose: Purpose::Export(what),
+        title: what.menu_label().trim_end_matches('.'),
+        filter: what.filter(),
+        save: true,
+        file_name: Some(what.suggested_name(stem)),
+        folder: score_path.and_then(Path::parent).map(Path::to_path_buf),
     }
-    dialog.save_file()
 }
 
 #[cfg(test)]
@@ -246,6 +243,6 @@ mod tests {
                 .contains("not been rendered")
         );
         assert_eq!(Export::Motion.suggested_name("etude"), "etude-motion.csv");
-        assert_eq!(Export::Wav.filter().1, "wav");
+        assert_eq!(Export::Wav.filter().1, ["wav"]);
     }
 }

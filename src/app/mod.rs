@@ -13,8 +13,10 @@ mod camera;
 mod chrome;
 mod clipboard;
 mod command;
+mod dialogs;
 mod document;
 mod export;
+mod file_browser;
 mod files;
 mod history;
 mod inspector;
@@ -78,6 +80,9 @@ pub struct EditorOptions {
     /// Render each version of the score (simulation and sound) on a worker thread for
     /// playback and the simulated body.
     pub render: bool,
+    /// Use the in-window file browser rather than the system's dialogs (which are used,
+    /// by default, while they open; see `dialogs`).
+    pub in_window_dialogs: bool,
 }
 
 impl Default for EditorOptions {
@@ -88,6 +93,7 @@ impl Default for EditorOptions {
             recovery_file: recovery::default_file(),
             audio_device: true,
             render: true,
+            in_window_dialogs: false,
         }
     }
 }
@@ -99,6 +105,8 @@ enum AfterConfirm {
     New,
     OpenDialog,
     Open(PathBuf),
+    /// A demo score built into the program, by name (`score::demos`).
+    OpenDemo(&'static str),
 }
 
 /// The views' own state (nothing here is saved with the score).
@@ -143,6 +151,7 @@ pub struct EditorApp {
     ctx: Option<egui::Context>,
     /// The window title last sent, so it is only sent when it changes.
     shown_title: String,
+    dialogs: dialogs::Dialogs,
 }
 
 impl EditorApp {
@@ -206,6 +215,11 @@ impl EditorApp {
             pending: Vec::new(),
             ctx: None,
             shown_title: String::new(),
+            dialogs: if options.in_window_dialogs {
+                dialogs::Dialogs::new(dialogs::Kind::InWindow)
+            } else {
+                dialogs::Dialogs::from_environment()
+            },
         }
     }
 
@@ -286,6 +300,7 @@ impl eframe::App for EditorApp {
         self.drain();
         self.confirm_dialog(&ctx);
         self.restore_dialog(&ctx);
+        self.file_dialog(&ctx);
         keys::help_window(&ctx, &mut self.views.show_help);
     }
 

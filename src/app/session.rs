@@ -3,6 +3,7 @@
 //! and quitting only once every file being written is written. Also where the pipeline's
 //! and the jobs' results are taken in, once per frame.
 
+use super::dialogs::{Asked, Purpose, Request};
 use super::document::Document;
 use super::export::{self, Export};
 use super::files::{self, FileKind, kind_of};
@@ -148,18 +149,74 @@ impl EditorApp {
     /// cancelled the dialog.
     pub(super) fn save(&mut self, ask: bool) -> bool {
         let Some(doc) = &self.doc else { return false };
-        let target = match (&doc.path, ask) {
-            (Some(p), false) => Some(p.clone()),
-            _ => rfd::FileDialog::new()
-                .add_filter("timpanist score", &["ron"])
-                .save_file(),
+        if let (Some(p), false) = (&doc.path, ask) {
+            let p = p.clone();
+            self.save_to(&p);
+            return true;
+        }
+        let request = Request {
+            purpose: Purpose::SaveScore,
+            title: "Save score as",
+            filter: ("timpanist score", &["ron"]),
+            save: true,
+            file_name: Some(format!("{}.ron", file_stem(doc))),
+            folder: doc
+                .path
+                .as_deref()
+                .and_then(Path::parent)
+                .map(Path::to_path_buf),
         };
-        match target {
-            Some(t) => {
-                self.save_to(&t);
+        match self.ask_file(request) {
+            Asked::Chosen(_, p) => {
+                self.save_to(&p);
                 true
             }
-            None => false,
+            Asked::Cancelled(_) => false,
+            Asked::InWindow => true,
+        }
+    }
+
+    /// Ask for a file with the system's dialog or the in-window one; the answer, when the
+    /// system's gave one.
+    pub(super) fn ask_file(&mut self, request: Request) -> Asked {
+        let mut places: Vec<PathBuf> = Vec::new();
+        for folder in self.recent.paths().iter().filter_map(|p| p.parent()) {
+            if !places.iter().any(|p| p == folder) {
+                places.push(folder.to_path_buf());
+            }
+        }
+        let asked = self.dialogs.ask(request, &places);
+        if let Some(notice) = self.dialogs.take_notice() {
+            self.messages.status = notice;
+        }
+        asked
+    }
+
+    /// Ask for a file and act on the answer when it comes (open, save or export).
+    pub(super) fn ask_and_act(&mut self, request: Request) {
+        let asked = self.ask_file(request);
+        self.act_on_file(asked);
+    }
+
+    /// Draw the in-window file browser, if open, and act on its answer.
+    pub(super) fn file_dialog(&mut self, ctx: &egui::Context) {
+        if let Some(asked) = self.dialogs.show(ctx) {
+            self.act_on_file(asked);
+        }
+    }
+
+    fn act_on_file(&mut self, asked: Asked) {
+        match asked {
+            Asked::Chosen(Purpose::Open, p) => self.after_confirm(AfterConfirm::Open(p)),
+            Asked::Chosen(Purpose::SaveScore, p) => self.save_to(&p),
+            Asked::Chosen(Purpose::Export(what), p) => self.export_to(what, &p),
+            // A save asked for before going on (quit, new, open): ask again.
+            Asked::Cancelled(Purpose::SaveScore) => {
+                if let Some(what) = self.after_save.take() {
+                    self.confirm = Some(what);
+                }
+            }
+            Asked::Cancelled(_) | Asked::InWindow => {}
         }
     }
 
@@ -191,9 +248,8 @@ impl EditorApp {
     /// Ask where to export, then export.
     pub(super) fn export_dialog(&mut self, what: Export) {
         let Some(doc) = &self.doc else { return };
-        if let Some(p) = export::ask_path(what, doc.path.as_deref(), &doc.loaded.score.title) {
-            self.export_to(what, &p);
-        }
+        let request = export::request(what, doc.path.as_deref(), &file_stem(doc));
+        self.ask_and_act(request);
     }
 
     fn new_document(&mut self) {
@@ -314,14 +370,28 @@ impl EditorApp {
             }
             AfterConfirm::New => self.new_document(),
             AfterConfirm::Open(p) => self.open_path(&p),
-            AfterConfirm::OpenDialog => {
-                if let Some(p) = rfd::FileDialog::new()
-                    .add_filter("score or MIDI", &["ron", "mid", "midi"])
-                    .pick_file()
-                {
-                    self.open_path(&p);
+            AfterConfirm::OpenDemo(name) => match crate::score::demos::load(name) {
+                Ok(loaded) => {
+                    self.set_document(loaded, None);
+                    self.messages.status = format!("opened the demo score {name} (unsaved)");
                 }
-            }
+                Err(e) => self.messages.error = Some(e.to_string()),
+            },
+            AfterConfirm::OpenDialog => self.ask_and_act(Request {
+                purpose: Purpose::Open,
+                title: "Open a score, MIDI or MusicXML file",
+                filter: (
+                    "score, MIDI or MusicXML",
+                    &["ron", "mid", "midi", "musicxml", "xml", "mxl"],
+                ),
+                save: false,
+                file_name: None,
+                folder: self
+                    .doc
+                    .as_ref()
+                    .and_then(|d| d.path.as_deref()?.parent())
+                    .map(Path::to_path_buf),
+            }),
         }
     }
 
@@ -356,4 +426,14 @@ pub enum ConfirmAnswer {
     Save,
     Discard,
     Cancel,
+}
+
+/// The name files made from `doc` start with: its file's stem, else its title.
+fn file_stem(doc: &Document) -> String {
+    doc.path
+        .as_deref()
+        .and_then(Path::file_stem)
+        .and_then(|s| s.to_str())
+        .unwrap_or(&doc.loaded.score.title)
+        .to_string()
 }

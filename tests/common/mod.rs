@@ -14,7 +14,8 @@ pub fn root() -> &'static Path {
 }
 
 /// The editor's options for `score`, its recent list and autosave in `dir`, no sound device,
-/// rendering if `render`; moves into the repository.
+/// rendering if `render`, the in-window file browser (a system dialog would block the
+/// test); moves into the repository.
 pub fn options(score: Option<PathBuf>, dir: &Path, render: bool) -> EditorOptions {
     std::env::set_current_dir(root()).unwrap();
     EditorOptions {
@@ -23,6 +24,7 @@ pub fn options(score: Option<PathBuf>, dir: &Path, render: bool) -> EditorOption
         recovery_file: Some(dir.join("recovery.ron")),
         audio_device: false,
         render,
+        in_window_dialogs: true,
     }
 }
 

@@ -1,0 +1,113 @@
+//! The in-window file browser the editor falls back to where the system's dialog cannot
+//! open (no desktop portal): Ctrl+O shows it, a click on a score and on Open loads that
+//! score; Save As writes where it is told; Cancel leaves everything as it was.
+
+mod common;
+
+use common::{editor, root, settle};
+use eframe::egui;
+use egui_kittest::kittest::Queryable;
+use std::path::Path;
+
+#[test]
+fn ctrl_o_opens_the_in_window_browser_and_it_opens_a_score() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = editor(
+        Some(root().join("scores/etude-modes.ron")),
+        dir.path(),
+        false,
+    );
+    settle(&mut h);
+    assert!(!h.state().is_file_browser_open());
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::O);
+    settle(&mut h);
+    assert!(h.state().is_file_browser_open(), "Ctrl+O showed no dialog");
+    // The browser starts in the score's folder, showing the other demo scores.
+    h.get_by_label("improvisation.ron").click();
+    settle(&mut h);
+    h.get_by_label("Open").click();
+    settle(&mut h);
+    assert!(!h.state().is_file_browser_open());
+    let path = h.state().path().map(Path::to_path_buf);
+    assert_eq!(
+        path.as_deref().and_then(|p| p.file_name()),
+        Some(std::ffi::OsStr::new("improvisation.ron")),
+        "error: {:?}",
+        h.state().error()
+    );
+}
+
+#[test]
+fn save_as_writes_where_the_browser_is_told_and_cancel_changes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = editor(
+        Some(root().join("scores/improvisation.ron")),
+        dir.path(),
+        false,
+    );
+    settle(&mut h);
+    // Cancel: nothing saved, the score still where it was.
+    h.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::S,
+    );
+    settle(&mut h);
+    assert!(h.state().is_file_browser_open(), "Save As showed no dialog");
+    h.get_by_label("Cancel").click();
+    settle(&mut h);
+    assert!(!h.state().is_file_browser_open());
+    assert!(
+        h.state()
+            .path()
+            .unwrap()
+            .ends_with("scores/improvisation.ron")
+    );
+
+    // The Places list offers the recent files' folder; go there and save.
+    let target_dir = dir.path().join("lessons");
+    std::fs::create_dir_all(&target_dir).unwrap();
+    let other = target_dir.join("other.ron");
+    std::fs::copy(root().join("scores/roll-exercise.ron"), &other).unwrap();
+    h.state_mut().open_path(&other);
+    h.state_mut()
+        .open_path(&root().join("scores/improvisation.ron"));
+    settle(&mut h);
+    h.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::S,
+    );
+    settle(&mut h);
+    h.get_by_label("lessons").click();
+    settle(&mut h);
+    h.get_by_label("Save").click();
+    settle(&mut h);
+    h.state_mut().wait_for_files();
+    settle(&mut h);
+    let saved = target_dir.join("improvisation.ron");
+    assert!(saved.is_file(), "not saved: {:?}", h.state().error());
+    assert_eq!(h.state().path(), Some(saved.as_path()));
+    timpanist::score::LoadedScore::load(&saved).expect("the saved score loads");
+}
+
+/// File > Demo scores opens a built-in demo as a new, unsaved score.
+#[test]
+fn the_demo_scores_menu_opens_a_built_in_demo() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = editor(
+        Some(root().join("scores/improvisation.ron")),
+        dir.path(),
+        false,
+    );
+    settle(&mut h);
+    h.get_by_label("File").click();
+    settle(&mut h);
+    h.get_by_label("Demo scores").click();
+    settle(&mut h);
+    h.get_by_label("roll-exercise").click();
+    settle(&mut h);
+    let want = timpanist::score::demos::score("roll-exercise").unwrap();
+    let loaded = h.state().loaded().expect("a score is open");
+    assert_eq!(loaded.score.title, want.title);
+    assert_eq!(loaded.score.beats.len(), want.beats.len());
+    assert_eq!(h.state().path(), None, "a demo opens unsaved");
+}
