@@ -3,7 +3,8 @@
 //! no portal answering (a minimal window manager, a remote X display, Xvfb), or a dialog
 //! that "closes" faster than anyone could cancel it — the editor says why once and from
 //! then on shows its own in-window file browser ([`super::file_browser`]), with the
-//! score's folder, the recent files' folders and the home folder as places to start.
+//! score's folder, the recent files' folders, the working folder, home and the installed
+//! demo scores (`<prefix>/share/timpanist/scores`) as places to start.
 //!
 //! A request names its [`Purpose`]; the chosen path comes back with it, at once from the
 //! system dialog or on a later frame from the in-window one ([`Dialogs::show`]).
@@ -138,10 +139,12 @@ impl Dialogs {
     fn open_in_window(&mut self, request: Request, recent: &[PathBuf]) {
         let mut places: Vec<PathBuf> = Vec::new();
         let home = std::env::var_os("HOME").map(PathBuf::from);
+        let installed_scores = crate::base::dirs::installed_data_dir().map(|d| d.join("scores"));
         let candidates = (request.folder.iter().chain(recent))
             .cloned()
             .chain(std::env::current_dir().ok())
-            .chain(home);
+            .chain(home)
+            .chain(installed_scores);
         for place in candidates {
             if place.is_dir() && !places.contains(&place) {
                 places.push(place);

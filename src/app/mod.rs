@@ -322,11 +322,17 @@ pub fn run_document(opened: files::Opened) -> anyhow::Result<()> {
 
 /// Open the editor window on the editor `make` builds and run until it closes.
 fn open_window(make: impl FnOnce() -> EditorApp + 'static) -> anyhow::Result<()> {
+    let mut viewport = egui::ViewportBuilder::default()
+        .with_inner_size([1400.0, 900.0])
+        .with_title("timpanist")
+        .with_app_id("timpanist")
+        .with_drag_and_drop(true);
+    // The icon the desktop entry names (src/app/assets, installed by the Debian package).
+    if let Ok(icon) = eframe::icon_data::from_png_bytes(include_bytes!("assets/timpanist.png")) {
+        viewport = viewport.with_icon(icon);
+    }
     let options = eframe::NativeOptions {
-        viewport: egui::ViewportBuilder::default()
-            .with_inner_size([1400.0, 900.0])
-            .with_title("timpanist")
-            .with_drag_and_drop(true),
+        viewport,
         ..Default::default()
     };
     eframe::run_native(
