@@ -59,6 +59,7 @@ impl EditorApp {
                 self.save(true);
             }
             Action::ToggleHelp => self.views.show_help = !self.views.show_help,
+            Action::TogglePreferences => self.settings.window_open = !self.settings.window_open,
             Action::ClearSelection => {
                 if let Some(d) = &mut self.doc {
                     d.selection = Selection::default();

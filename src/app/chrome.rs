@@ -110,6 +110,10 @@ impl EditorApp {
                         self.pending.push(Command::Do(action));
                     }
                 }
+                ui.separator();
+                if ui.button("Preferences...  (Ctrl+,)").clicked() {
+                    self.pending.push(Command::Do(Action::TogglePreferences));
+                }
             });
             ui.menu_button("View", |ui| {
                 if ui.button("Fit the score in the timeline").clicked() {

@@ -25,6 +25,7 @@ pub enum Action {
     NudgeLane(i64),
     SetMode(PlayingMode),
     ToggleHelp,
+    TogglePreferences,
     ClearSelection,
 }
 
@@ -68,6 +69,13 @@ pub const SHORTCUTS: &[Shortcut] = &[
     ),
     chord(CMD, Key::N, Action::New, "Ctrl+N", "new score"),
     chord(CMD, Key::O, Action::Open, "Ctrl+O", "open a score"),
+    chord(
+        CMD,
+        Key::Comma,
+        Action::TogglePreferences,
+        "Ctrl+,",
+        "preferences",
+    ),
     chord(CMD_SHIFT, Key::S, Action::SaveAs, "Ctrl+Shift+S", "save as"),
     chord(CMD, Key::S, Action::Save, "Ctrl+S", "save"),
     chord(CMD_SHIFT, Key::Z, Action::Redo, "Ctrl+Shift+Z", "redo"),

@@ -27,6 +27,8 @@ mod pipeline;
 pub mod playback;
 mod plots;
 mod pose;
+mod preferences;
+mod preferences_window;
 mod recent;
 mod recovery;
 mod renderer;
@@ -83,6 +85,8 @@ pub struct EditorOptions {
     /// Use the in-window file browser rather than the system's dialogs (which are used,
     /// by default, while they open; see `dialogs`).
     pub in_window_dialogs: bool,
+    /// The preferences file (see `preferences`); `None` keeps them in memory only.
+    pub preferences_file: Option<PathBuf>,
 }
 
 impl Default for EditorOptions {
@@ -94,6 +98,7 @@ impl Default for EditorOptions {
             audio_device: true,
             render: true,
             in_window_dialogs: false,
+            preferences_file: preferences::default_file(),
         }
     }
 }
@@ -152,6 +157,8 @@ pub struct EditorApp {
     /// The window title last sent, so it is only sent when it changes.
     shown_title: String,
     dialogs: dialogs::Dialogs,
+    /// The preferences and their window.
+    settings: preferences_window::Settings,
 }
 
 impl EditorApp {
@@ -169,6 +176,7 @@ impl EditorApp {
         let mut app = EditorApp::start(&options);
         app.open_document(opened);
         app.find_left_behind();
+        app.report_preferences_error();
         app
     }
 
@@ -180,19 +188,34 @@ impl EditorApp {
             None => app.open_demo(),
         }
         app.find_left_behind();
+        app.report_preferences_error();
         app
+    }
+
+    /// Show why the preferences file could not be read (after the document, whose
+    /// opening clears the error line).
+    fn report_preferences_error(&mut self) {
+        if let Some(e) = self.settings.load_error.take() {
+            self.messages.error = Some(format!("{e} (using the default preferences)"));
+        }
     }
 
     /// The editor with no document yet.
     fn start(options: &EditorOptions) -> EditorApp {
+        let (prefs, prefs_error) =
+            match preferences::Preferences::load(options.preferences_file.as_deref()) {
+                Ok(p) => (p, None),
+                Err(e) => (preferences::Preferences::default(), Some(e.to_string())),
+            };
         let playback = if options.audio_device {
-            Playback::new()
+            Playback::open(prefs.audio_device.as_deref(), prefs.buffer_frames)
         } else {
             Playback::silent()
         };
+        let db = crate::mocap::shipped::DbSource::named_or_located(prefs.database.clone());
         EditorApp {
             doc: None,
-            pipeline: Pipeline::new(options.render),
+            pipeline: Pipeline::new(options.render, db),
             transport: Transport::new(playback),
             views: Views {
                 timeline: timeline::TimelineView::new(),
@@ -215,6 +238,12 @@ impl EditorApp {
             pending: Vec::new(),
             ctx: None,
             shown_title: String::new(),
+            settings: preferences_window::Settings::new(
+                prefs,
+                options.preferences_file.clone(),
+                options.audio_device,
+            )
+            .with_load_error(prefs_error),
             dialogs: if options.in_window_dialogs {
                 dialogs::Dialogs::new(dialogs::Kind::InWindow)
             } else {
@@ -228,6 +257,7 @@ impl EditorApp {
     fn take_inputs(&mut self, ctx: &egui::Context) {
         if self.ctx.is_none() {
             self.ctx = Some(ctx.clone());
+            self.settings.apply_look(ctx);
             let (a, b) = (ctx.clone(), ctx.clone());
             self.pipeline.set_waker(move || a.request_repaint());
             self.jobs.set_waker(move || b.request_repaint());
@@ -302,6 +332,7 @@ impl eframe::App for EditorApp {
         self.restore_dialog(&ctx);
         self.file_dialog(&ctx);
         keys::help_window(&ctx, &mut self.views.show_help);
+        self.preferences_window(&ctx);
     }
 
     /// A clean quit: nothing is left to recover.

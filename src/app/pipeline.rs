@@ -9,6 +9,7 @@ use super::renderer::{self, Failure, Rendered};
 use super::worker::{Job, Requester, Waker, Worker};
 use crate::base::ron_file::FileError;
 use crate::mocap::db::MotionDb;
+use crate::mocap::shipped::DbSource;
 use crate::motion::compose::Composition;
 use crate::render::{RenderError, RenderParams, Rendering};
 use crate::score::LoadedScore;
@@ -54,13 +55,14 @@ pub struct Pipeline {
 }
 
 impl Pipeline {
-    /// Start the workers (the rendering one only if `render`).
-    pub fn new(render: bool) -> Pipeline {
+    /// Start the workers (the rendering one only if `render`), composing with the motion
+    /// database from `db` (read on first use).
+    pub fn new(render: bool, db: DbSource) -> Pipeline {
         let waker: Waker = Arc::default();
         let renderer = render.then(|| Worker::spawn("render", waker.clone(), renderer::job()));
         let forward = renderer.as_ref().map(Worker::requester);
         let compositions_made = Arc::new(AtomicU64::new(0));
-        let job = compose_job(forward, Arc::clone(&compositions_made));
+        let job = compose_job(forward, Arc::clone(&compositions_made), db);
         Pipeline {
             composer: Worker::spawn("compose", waker.clone(), job),
             renderer,
@@ -240,11 +242,12 @@ impl Pipeline {
 fn compose_job(
     forward: Option<Requester<renderer::Request>>,
     made: Arc<AtomicU64>,
+    source: DbSource,
 ) -> impl FnMut(LoadedScore, &Job<Composed>) + Send + 'static {
     let db: OnceLock<Result<MotionDb, Arc<FileError>>> = OnceLock::new();
     move |loaded, job| {
         let began = Instant::now();
-        let db = db.get_or_init(|| crate::mocap::shipped::locate().load().map_err(Arc::new));
+        let db = db.get_or_init(|| source.load().map_err(Arc::new));
         let params = RenderParams::for_score(&loaded.score.settings);
         let result = match db {
             Ok(db) => crate::render::compose(&loaded, db, &params)

@@ -9,6 +9,9 @@
 //! restarting (a 5 ms crossfade), and play, pause and seek ramp over 5 ms.
 
 use super::tape::{StereoSource, TapeData, TapeHandle};
+use kira::backend::cpal::CpalBackendSettings;
+use kira::backend::cpal::cpal::traits::{DeviceTrait, HostTrait};
+use kira::backend::cpal::cpal::{self, BufferSize};
 use kira::{AudioManager, AudioManagerSettings, DefaultBackend};
 use std::sync::Arc;
 use std::time::Instant;
@@ -45,13 +48,28 @@ impl Playback {
     /// Open the default sound device and start the tape on it (paused), or fall back to a
     /// silent clock if there is no device.
     pub fn new() -> Playback {
+        Playback::open(None, None)
+    }
+
+    /// Open the output device named `device` (the default one when `None`, or when no
+    /// device has that name any more, with a notice) with `buffer_frames` frames per
+    /// buffer (the device's choice when `None`), and start the tape on it (paused); a
+    /// silent clock if no device opens.
+    pub fn open(device: Option<&str>, buffer_frames: Option<u32>) -> Playback {
         let mut p = Playback::silent();
-        match AudioManager::<DefaultBackend>::new(AudioManagerSettings::default()) {
+        let (settings, missing) = backend_settings(device, buffer_frames);
+        let settings = AudioManagerSettings {
+            backend_settings: settings,
+            ..AudioManagerSettings::default()
+        };
+        match AudioManager::<DefaultBackend>::new(settings) {
             Ok(mut manager) => match manager.play(TapeData::new()) {
                 Ok(tape) => {
                     p.tape = Some(tape);
                     p.manager = Some(manager);
-                    p.notice = None;
+                    p.notice = missing.map(|name| {
+                        format!("audio device \"{name}\" not found: playing on the default device")
+                    });
                 }
                 Err(e) => p.notice = Some(format!("{SILENT_NOTICE} (could not play: {e})")),
             },
@@ -153,6 +171,37 @@ impl Default for Playback {
     fn default() -> Self {
         Playback::new()
     }
+}
+
+/// The names of the output devices the system has now (listed afresh each call, so a
+/// device plugged in or out shows at the next call).
+pub fn output_devices() -> Vec<String> {
+    let host = cpal::default_host();
+    host.output_devices()
+        .map(|devices| devices.map(|d| d.to_string()).collect())
+        .unwrap_or_default()
+}
+
+/// The backend settings for `device` and `buffer_frames`, and the name asked for when no
+/// device has it.
+fn backend_settings(
+    device: Option<&str>,
+    buffer_frames: Option<u32>,
+) -> (CpalBackendSettings, Option<String>) {
+    let host = cpal::default_host();
+    let found = device.and_then(|name| host.output_devices().ok()?.find(|d| d.to_string() == name));
+    let missing = device.filter(|_| found.is_none()).map(str::to_string);
+    let config = buffer_frames.and_then(|frames| {
+        let chosen = found.clone().or_else(|| host.default_output_device())?;
+        let mut config = chosen.default_output_config().ok()?.config();
+        config.buffer_size = BufferSize::Fixed(frames);
+        Some(config)
+    });
+    let settings = CpalBackendSettings {
+        device: found,
+        config,
+    };
+    (settings, missing)
 }
 
 #[cfg(test)]

@@ -248,16 +248,25 @@ impl EditorApp {
     /// Ask where to export, then export.
     pub(super) fn export_dialog(&mut self, what: Export) {
         let Some(doc) = &self.doc else { return };
-        let request = export::request(what, doc.path.as_deref(), &file_stem(doc));
+        let mut request = export::request(what, doc.path.as_deref(), &file_stem(doc));
+        if let Some(folder) = &self.settings.prefs.export_folder {
+            request.folder = Some(folder.clone());
+        }
         self.ask_and_act(request);
     }
 
     fn new_document(&mut self) {
-        let kit = Kit::bundled("standard").expect("the standard kit is bundled");
+        let name = self.settings.prefs.default_kit.clone();
+        let kit = Kit::bundled(&name)
+            .or_else(|| Kit::bundled("standard"))
+            .expect("the standard kit is bundled");
         let loaded = LoadedScore {
-            score: Score::new("Untitled"),
+            score: Score {
+                kit: name.clone(),
+                ..Score::new("Untitled")
+            },
             kit,
-            kit_source: "bundled kit \"standard\"".into(),
+            kit_source: format!("bundled kit \"{name}\""),
             notices: Vec::new(),
         };
         self.set_document(loaded, None);

@@ -13,7 +13,7 @@ pub fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// The editor's options for `score`, its recent list and autosave in `dir`, no sound device,
+/// The editor's options for `score`, its recent list, autosave and preferences in `dir`, no sound device,
 /// rendering if `render`, the in-window file browser (a system dialog would block the
 /// test); moves into the repository.
 pub fn options(score: Option<PathBuf>, dir: &Path, render: bool) -> EditorOptions {
@@ -25,6 +25,7 @@ pub fn options(score: Option<PathBuf>, dir: &Path, render: bool) -> EditorOption
         audio_device: false,
         render,
         in_window_dialogs: true,
+        preferences_file: Some(dir.join("preferences.ron")),
     }
 }
 
