@@ -293,11 +293,26 @@ pub struct ReadError {
 
 /// A WAV file's channels averaged to mono (PCM 8–32 bit or float), with its rate.
 pub fn read_mono(path: &Path) -> Result<(Vec<f32>, u32), ReadError> {
+    let bytes = crate::base::limits::read_at_most(
+        path,
+        crate::base::limits::MAX_CAPTURE_FILE_BYTES,
+        "WAV file",
+    )
+    .map_err(|e| ReadError {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    read_mono_bytes(path, &bytes)
+}
+
+/// [`read_mono`] of a WAV file held in memory (`path` names it in errors).
+pub fn read_mono_bytes(path: &Path, bytes: &[u8]) -> Result<(Vec<f32>, u32), ReadError> {
     let bad = |message: String| ReadError {
         path: path.to_path_buf(),
         message,
     };
-    let mut reader = hound::WavReader::open(path).map_err(|e| bad(e.to_string()))?;
+    let mut reader =
+        hound::WavReader::new(std::io::Cursor::new(bytes)).map_err(|e| bad(e.to_string()))?;
     let spec = reader.spec();
     let ch = usize::from(spec.channels.max(1));
     let raw: Vec<f32> = match spec.sample_format {
