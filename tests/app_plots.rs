@@ -5,6 +5,7 @@
 //! WAV and a motion CSV of the current rendering or refuses with the reason.
 
 mod common;
+mod readers;
 
 use eframe::egui;
 use egui_kittest::Harness;
@@ -279,6 +280,20 @@ fn export_writes_wav_and_motion() {
     let tip = take.track("RTIP").unwrap().positions[0].unwrap();
     assert!((tip - r.motion.tips[1][0]).length() < 1e-6, "{tip}");
 
+    // The motion as BVH: read by the independent parser, a frame per sample at 250 Hz,
+    // the right stick's end site at the simulated tip (Y up, the performer facing -Z).
+    let bvh = out.path().join("improvisation.bvh");
+    h.state_mut().export_bvh_to(&bvh);
+    h.state_mut().wait_for_files();
+    assert!(h.state().error().is_none(), "{:?}", h.state().error());
+    let parsed = readers::Bvh::parse(&std::fs::read_to_string(&bvh).unwrap());
+    assert_eq!(parsed.frames.len(), r.motion.poses.len());
+    assert!((parsed.frame_time_s - 1.0 / r.motion.rate_hz).abs() < 1e-9);
+    let tip = parsed.positions(0)[parsed.index("grip_r_end")];
+    let want = r.motion.tips[1][0];
+    let d = glam::DVec3::from(tip).distance(glam::DVec3::new(want.x, want.z, -want.y));
+    assert!(d < 1e-3, "right tip {d} m off");
+
     // The score as MIDI: imported again, the same beats at the same ticks.
     let mid = out.path().join("improvisation.mid");
     h.state_mut().export_midi_to(&mid);
@@ -296,7 +311,7 @@ fn export_writes_wav_and_motion() {
         .unwrap()
         .map(|e| e.unwrap().file_name())
         .collect();
-    assert_eq!(names.len(), 4, "no temporary files: {names:?}");
+    assert_eq!(names.len(), 5, "no temporary files: {names:?}");
 
     // A failing write is an error in the window, not a panic.
     h.state_mut().export_wav_to(Path::new("/no/such/dir/x.wav"));

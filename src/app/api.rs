@@ -209,6 +209,11 @@ impl EditorApp {
         self.export_to(Export::MotionC3d, path);
     }
 
+    /// Export the current rendering's motion as BVH at `path` (File > Export motion BVH).
+    pub fn export_bvh_to(&mut self, path: &Path) {
+        self.export_to(Export::Bvh, path);
+    }
+
     /// The open plot tab.
     pub fn plot_tab(&self) -> PlotTab {
         self.views.plots.tab

@@ -8,7 +8,7 @@
 //! is none.
 
 use crate::base::ron_file::{self, FileError};
-use crate::io::{midi_export, motion_c3d, motion_csv};
+use crate::io::{bvh, midi_export, motion_c3d, motion_csv};
 use crate::kit::Kit;
 use crate::render::Rendering;
 use crate::score::Score;
@@ -24,13 +24,21 @@ pub enum Export {
     Motion,
     /// Joint positions and tips per task sample, as C3D points.
     MotionC3d,
+    /// The skeleton animated, one frame per task sample (BVH).
+    Bvh,
     /// The score (no rendering needed).
     Midi,
 }
 
 impl Export {
     /// Every export, in menu order.
-    pub const ALL: [Export; 4] = [Export::Wav, Export::Motion, Export::MotionC3d, Export::Midi];
+    pub const ALL: [Export; 5] = [
+        Export::Wav,
+        Export::Motion,
+        Export::MotionC3d,
+        Export::Bvh,
+        Export::Midi,
+    ];
 
     /// The File menu item.
     pub fn menu_label(self) -> &'static str {
@@ -38,6 +46,7 @@ impl Export {
             Export::Wav => "Export WAV...",
             Export::Motion => "Export motion CSV...",
             Export::MotionC3d => "Export motion C3D...",
+            Export::Bvh => "Export motion BVH...",
             Export::Midi => "Export MIDI...",
         }
     }
@@ -48,6 +57,7 @@ impl Export {
             Export::Wav => ("WAV audio", "wav"),
             Export::Motion => ("motion CSV", "csv"),
             Export::MotionC3d => ("C3D motion capture", "c3d"),
+            Export::Bvh => ("BVH animation", "bvh"),
             Export::Midi => ("Standard MIDI File", "mid"),
         }
     }
@@ -58,6 +68,7 @@ impl Export {
             Export::Wav => format!("{stem}.wav"),
             Export::Motion => format!("{stem}-motion.csv"),
             Export::MotionC3d => format!("{stem}-motion.c3d"),
+            Export::Bvh => format!("{stem}.bvh"),
             Export::Midi => format!("{stem}.mid"),
         }
     }
@@ -111,6 +122,12 @@ pub enum ExportError {
         source: FileError,
     },
     #[error("cannot export to {}: {source}", path.display())]
+    Bvh {
+        path: PathBuf,
+        #[source]
+        source: bvh::BvhError,
+    },
+    #[error("cannot export to {}: {source}", path.display())]
     Sound {
         path: PathBuf,
         #[source]
@@ -162,6 +179,19 @@ pub fn write(
                 &rendering.skeleton(),
             );
             ron_file::write_atomic(path, &bytes).map_err(failed)?;
+            Ok(samples(rendering))
+        }
+        Export::Bvh => {
+            let text = bvh::to_bvh(
+                &rendering.motion,
+                &rendering.skeleton(),
+                &bvh::Options::default(),
+            )
+            .map_err(|e| ExportError::Bvh {
+                path: path.to_path_buf(),
+                source: e,
+            })?;
+            ron_file::write_atomic(path, text.as_bytes()).map_err(failed)?;
             Ok(samples(rendering))
         }
         Export::Wav => {

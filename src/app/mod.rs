@@ -20,6 +20,7 @@ mod history;
 mod inspector;
 mod jobs;
 mod keys;
+mod osc_out;
 pub mod picking;
 mod pipeline;
 pub mod playback;
@@ -125,6 +126,8 @@ pub struct EditorApp {
     doc: Option<Document>,
     pipeline: Pipeline,
     transport: Transport,
+    /// Live OSC output of the hits during playback.
+    osc: osc_out::OscOut,
     views: Views,
     jobs: Jobs,
     recent: RecentFiles,
@@ -185,6 +188,7 @@ impl EditorApp {
             doc: None,
             pipeline: Pipeline::new(options.render),
             transport: Transport::new(playback),
+            osc: osc_out::OscOut::default(),
             views: Views {
                 timeline: timeline::TimelineView::new(),
                 tempo_lane: tempo_lane::TempoLane::default(),
@@ -258,6 +262,11 @@ impl EditorApp {
         if let Some(tick) = tick {
             self.views.timeline.follow(tick);
         }
+        self.osc.tick(
+            self.transport.playback.is_playing(),
+            self.transport.playhead_s,
+            self.pipeline.rendering().map(|(r, _)| r),
+        );
         if self.transport.playback.is_playing() || self.pipeline.is_composing() {
             ctx.request_repaint_after(std::time::Duration::from_millis(30));
         }
@@ -280,6 +289,7 @@ impl eframe::App for EditorApp {
                     if let Some(d) = &self.doc {
                         inspector::show(ui, &d.loaded, &d.selection, &mut self.pending);
                     }
+                    self.osc.ui(ui);
                 });
             });
         egui::CentralPanel::default_margins().show(ui, |ui| self.central(ui));
