@@ -102,6 +102,10 @@ fn bvh_forward_kinematics_matches_the_motion_csv() {
             worst = worst.max(distance(p[*tip], tip_in_bvh(&header, row, hand, 1.0)));
         }
     }
+    eprintln!(
+        "BVH tips vs motion CSV: worst {worst} m over {} frames",
+        rows.len()
+    );
     assert!(worst < 1e-3, "worst tip distance {worst} m");
     // Y is up: the head is above the trunk, the tips below the shoulders at rest height.
     let p = parsed.positions(0);
