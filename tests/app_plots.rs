@@ -469,3 +469,58 @@ fn a_render_error_shows_its_beat() {
     let t = h.state().playhead_s();
     assert!((t - (beat_s - 0.5)).abs() < 1e-9, "{t} vs {beat_s}");
 }
+
+/// The live OSC output, turned on in the inspector and aimed at a UDP receiver on
+/// loopback, sends each contact of the rendering once as the silent playback clock
+/// passes it — the first one a moment before score time 0 included — and nothing
+/// beyond the playhead; every message decodes (rosc) to its event's drum, hand and time.
+#[test]
+fn live_osc_sends_the_hits_as_they_sound() {
+    let rx = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    rx.set_read_timeout(Some(std::time::Duration::from_millis(500)))
+        .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(dir.path(), false, true);
+    let r = rendering();
+    h.state_mut()
+        .set_osc_target("127.0.0.1", rx.local_addr().unwrap().port());
+    h.get_by_label("Live OSC output").click();
+    settle(&mut h);
+    h.get_by_label("Send hits during playback").click();
+    settle(&mut h);
+    h.state_mut().seek(0.0);
+    h.key_press(egui::Key::Space);
+    h.step();
+    let until_s = r.events[2].contact_s + 0.1;
+    let started = std::time::Instant::now();
+    while h.state().playhead_s() < until_s {
+        assert!(started.elapsed().as_secs() < 30, "playback stalled");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        h.step();
+    }
+    h.key_press(egui::Key::Space);
+    h.step();
+    let stopped_s = h.state().playhead_s();
+    let want: Vec<_> = r
+        .events
+        .iter()
+        .filter(|e| e.contact_s <= stopped_s)
+        .collect();
+    assert!(want.len() >= 3 && r.events[0].contact_s < 0.0, "{want:?}");
+    let mut buf = [0u8; 1536];
+    let mut got = Vec::new();
+    while let Ok(n) = rx.recv(&mut buf) {
+        let (_, packet) = rosc::decoder::decode_udp(&buf[..n]).unwrap();
+        let rosc::OscPacket::Message(m) = packet else {
+            panic!("not a message")
+        };
+        got.push(m);
+    }
+    assert_eq!(got.len(), want.len(), "{:?}", h.state().osc_sent());
+    for (m, e) in got.iter().zip(want) {
+        assert_eq!(m.addr, "/timpanist/hit");
+        assert_eq!(m.args[0].clone().int().unwrap() as usize, e.drum);
+        assert_eq!(m.args[1].clone().string().unwrap(), e.hand);
+        assert_eq!(m.args[6].clone().float().unwrap(), e.contact_s as f32);
+    }
+}

@@ -2,8 +2,9 @@
 //! `/timpanist/hit` message (`io::osc`) over UDP when the playhead passes it (once per
 //! frame, so up to a frame late), off by default, with its host and port set in the
 //! inspector's "Live OSC output" section (kept for the session, not in the score).
-//! Seeking, a loop wrap or a jump of more than [`MAX_STEP_S`] sends nothing for what was
-//! skipped. A send that fails is shown in the section and the output goes on.
+//! Seeking or a loop wrap — the playhead moving back, or further than the wall clock
+//! by more than [`MAX_DRIFT_S`] — sends nothing for what was skipped; a slow frame sends
+//! what it passed. A send that fails is shown in the section and the output goes on.
 
 use crate::base::hit::Hit;
 use crate::io::osc;
@@ -11,9 +12,11 @@ use crate::render::Rendering;
 use eframe::egui;
 use std::net::{SocketAddr, ToSocketAddrs, UdpSocket};
 use std::sync::Arc;
+use std::time::Instant;
 
-/// A playhead step longer than this between two frames is a jump (nothing sent), s.
-pub const MAX_STEP_S: f64 = 0.25;
+/// A playhead step differing from the wall-clock time between two frames by more than
+/// this is a jump (nothing sent), s.
+pub const MAX_DRIFT_S: f64 = 0.1;
 
 /// Where to send, as edited.
 #[derive(Clone, Debug, PartialEq)]
@@ -34,6 +37,15 @@ impl Default for OscSettings {
     }
 }
 
+/// How the playhead came to where it is this frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Step {
+    /// Playback started from this position, s.
+    Started(f64),
+    /// Playing on: the wall-clock time since last frame, s.
+    Played(f64),
+}
+
 /// The output: settings, socket, the rendering's hits and where the playhead was.
 #[derive(Default)]
 pub struct OscOut {
@@ -42,8 +54,10 @@ pub struct OscOut {
     socket: Option<(UdpSocket, String, u16)>,
     /// The hits and the rendering they were taken from.
     hits: Option<(Arc<Rendering>, Vec<Hit>)>,
-    /// The playhead last frame while playing, s.
-    last_s: Option<f64>,
+    /// The playhead last frame while playing, s, and when that frame was.
+    last: Option<(f64, Instant)>,
+    /// The playhead while stopped: where playback starts, s.
+    paused_s: f64,
     /// Messages sent since the output was turned on.
     pub sent: usize,
     pub error: Option<String>,
@@ -52,27 +66,47 @@ pub struct OscOut {
 impl OscOut {
     /// Once per frame: send the hits of `rendering` the playhead passed since last frame.
     pub fn tick(&mut self, playing: bool, playhead_s: f64, rendering: Option<&Arc<Rendering>>) {
+        let now = Instant::now();
         let Some(r) = rendering.filter(|_| self.settings.enabled && playing) else {
-            self.last_s = None;
+            // Where playback will start from.
+            self.last = None;
+            self.paused_s = playhead_s;
             return;
         };
         let (from, hits) = match self.hits.take() {
             Some((from, hits)) if Arc::ptr_eq(&from, r) => (from, hits),
             _ => (Arc::clone(r), r.events.iter().map(|e| e.hit()).collect()),
         };
-        self.send_due(playhead_s, &hits);
+        let step = match self.last {
+            Some((_, at)) => Step::Played((now - at).as_secs_f64()),
+            None => Step::Started(self.paused_s),
+        };
+        self.send_due((playhead_s, step), &hits);
+        self.last = Some((playhead_s, now));
         self.hits = Some((from, hits));
     }
 
-    /// Send the hits of `hits` (time order) after last frame's playhead up to `playhead_s`.
-    pub fn send_due(&mut self, playhead_s: f64, hits: &[Hit]) {
-        let after = match self.last_s {
-            Some(last) if playhead_s >= last && playhead_s - last <= MAX_STEP_S => last,
-            // Just started: what sounds from here on.
-            None => playhead_s - 1e-9,
-            Some(_) => playhead_s, // a jump
+    /// Send the hits of `hits` (time order) that sounded on the way to `playhead_s`.
+    pub fn send_due(&mut self, (playhead_s, step): (f64, Step), hits: &[Hit]) {
+        // From `p` on, and from the start of the audio what sounds at it too (a contact a
+        // moment before score time 0).
+        let from = |p: f64| {
+            if p <= 0.0 {
+                f64::NEG_INFINITY
+            } else {
+                p - 1e-9
+            }
         };
-        self.last_s = Some(playhead_s);
+        let after = match (step, self.last) {
+            (Step::Started(p), _) => from(p),
+            (Step::Played(wall), Some((last, _)))
+                if playhead_s >= last && (playhead_s - last - wall).abs() <= MAX_DRIFT_S =>
+            {
+                last
+            }
+            (Step::Played(_), _) => from(playhead_s), // a seek or a loop wrap
+        };
+        self.last = Some((playhead_s, Instant::now()));
         let due = osc::due(hits, after, playhead_s);
         if due.is_empty() {
             return;
@@ -189,19 +223,24 @@ mod tests {
             },
             ..OscOut::default()
         };
-        let hits: Vec<Hit> = [0.5, 0.52, 0.9, 3.0].into_iter().map(hit).collect();
-        // Frames every 16 ms from 0.5 s (exactly on the first hit) to 1.2 s, then a jump
-        // to 2.9 s and frames to 3.1 s.
-        let frames = (0..44)
-            .map(|k| 0.5 + 0.016 * f64::from(k))
-            .chain((0..13).map(|k| 2.95 + 0.016 * f64::from(k)));
-        for t in frames {
-            out.send_due(t, &hits);
+        let hits: Vec<Hit> = [0.5, 0.52, 0.9, 1.5, 2.0, 3.0]
+            .into_iter()
+            .map(hit)
+            .collect();
+        // Frames every 16 ms from 0.5 s (exactly on the first hit) to 1.19 s, one slow
+        // frame of 0.4 s, then a seek to 2.95 s and frames to 3.14 s.
+        let mut frames: Vec<(f64, Step)> = vec![(0.5, Step::Started(0.5))];
+        frames.extend((1..44).map(|k| (0.5 + 0.016 * f64::from(k), Step::Played(0.016))));
+        frames.push((1.6, Step::Played(0.4)));
+        frames.push((2.95, Step::Played(0.016)));
+        frames.extend((1..13).map(|k| (2.95 + 0.016 * f64::from(k), Step::Played(0.016))));
+        for f in frames {
+            out.send_due(f, &hits);
         }
-        assert_eq!(out.sent, 4, "{:?}", out.error);
+        assert_eq!(out.sent, 5, "{:?}", out.error);
         let mut times = Vec::new();
         let mut buf = [0u8; 1536];
-        for _ in 0..4 {
+        for _ in 0..5 {
             let n = rx.recv(&mut buf).unwrap();
             let (_, packet) = rosc::decoder::decode_udp(&buf[..n]).unwrap();
             let rosc::OscPacket::Message(m) = packet else {
@@ -210,11 +249,25 @@ mod tests {
             assert_eq!(m.addr, "/timpanist/hit");
             times.push(m.args[6].clone().float().unwrap());
         }
-        assert_eq!(times, vec![0.5, 0.52, 0.9, 3.0]);
-        // A jump past a hit sends nothing for it.
-        out.send_due(3.5, &hits);
-        out.send_due(0.0, &hits);
-        out.send_due(0.6, &hits);
-        assert_eq!(out.sent, 4);
+        assert_eq!(
+            times,
+            vec![0.5, 0.52, 0.9, 1.5, 3.0],
+            "2.0 s was sought past"
+        );
+        // A seek forward, or back to before a hit, sends nothing for what it skips...
+        for t in [3.5, 0.3, 0.6] {
+            out.send_due((t, Step::Played(0.016)), &hits);
+        }
+        assert_eq!(out.sent, 5);
+        // ...and playing on from there sends the next hit.
+        out.send_due((0.95, Step::Played(0.35)), &hits);
+        assert_eq!(out.sent, 6);
+        // Playback started at the start sends a contact a moment before score time 0,
+        // even when the first frame comes later.
+        let early = [hit(-1e-4), hit(0.01), hit(0.03)];
+        out.send_due((0.02, Step::Started(0.0)), &early);
+        assert_eq!(out.sent, 8);
+        out.send_due((0.036, Step::Played(0.016)), &early);
+        assert_eq!(out.sent, 9);
     }
 }

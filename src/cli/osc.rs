@@ -1,6 +1,7 @@
 //! `render --osc HOST:PORT`: every contact of the rendering sent as an OSC
 //! `/timpanist/hit` message (`io::osc`) over UDP, in time order — at once, or with
-//! `--osc-realtime` each when it sounds (score time from the first message sent).
+//! `--osc-realtime` each when it sounds, as if the WAV started playing (score time 0)
+//! when sending began.
 
 use crate::base::hit::Hit;
 use crate::io::osc;
@@ -30,13 +31,12 @@ pub fn connect((host, port): &(String, u16)) -> anyhow::Result<UdpSocket> {
 }
 
 /// Send one message per hit in time order; with `realtime`, each at its score time
-/// after the first one's. Returns how many were sent.
+/// after the call. Returns how many were sent.
 pub fn send(socket: &UdpSocket, hits: &[Hit], realtime: bool) -> anyhow::Result<usize> {
     let start = Instant::now();
-    let first_s = hits.first().map_or(0.0, |h| h.time_s);
     for hit in hits {
         if realtime {
-            let due = Duration::from_secs_f64((hit.time_s - first_s).max(0.0));
+            let due = Duration::from_secs_f64(hit.time_s.max(0.0));
             if let Some(wait) = due.checked_sub(start.elapsed()) {
                 std::thread::sleep(wait);
             }
