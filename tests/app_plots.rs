@@ -281,7 +281,7 @@ fn export_writes_wav_and_motion() {
     assert!((tip - r.motion.tips[1][0]).length() < 1e-6, "{tip}");
 
     // The motion as BVH: read by the independent parser, a frame per sample at 250 Hz,
-    // the right stick's end site at the simulated tip (Y up, the performer facing -Z).
+    // the right stick's end site at the simulated tip (Y up, the performer facing +Z).
     let bvh = out.path().join("improvisation.bvh");
     h.state_mut().export_bvh_to(&bvh);
     h.state_mut().wait_for_files();
@@ -291,8 +291,21 @@ fn export_writes_wav_and_motion() {
     assert!((parsed.frame_time_s - 1.0 / r.motion.rate_hz).abs() < 1e-9);
     let tip = parsed.positions(0)[parsed.index("grip_r_end")];
     let want = r.motion.tips[1][0];
-    let d = glam::DVec3::from(tip).distance(glam::DVec3::new(want.x, want.z, -want.y));
+    let d = glam::DVec3::from(tip).distance(glam::DVec3::new(-want.x, want.z, want.y));
     assert!(d < 1e-3, "right tip {d} m off");
+
+    // The scene as glTF: read by the gltf crate, a rotation key per sample for each of
+    // the 11 joints.
+    let glb = out.path().join("improvisation.glb");
+    h.state_mut().export_glb_to(&glb);
+    h.state_mut().wait_for_files();
+    assert!(h.state().error().is_none(), "{:?}", h.state().error());
+    let scene = gltf::Gltf::from_slice(&std::fs::read(&glb).unwrap()).unwrap();
+    let animation = scene.animations().next().unwrap();
+    assert_eq!(animation.channels().count(), 11);
+    for c in animation.channels() {
+        assert_eq!(c.sampler().output().count(), r.motion.poses.len());
+    }
 
     // The score as MIDI: imported again, the same beats at the same ticks.
     let mid = out.path().join("improvisation.mid");
@@ -311,7 +324,7 @@ fn export_writes_wav_and_motion() {
         .unwrap()
         .map(|e| e.unwrap().file_name())
         .collect();
-    assert_eq!(names.len(), 5, "no temporary files: {names:?}");
+    assert_eq!(names.len(), 6, "no temporary files: {names:?}");
 
     // A failing write is an error in the window, not a panic.
     h.state_mut().export_wav_to(Path::new("/no/such/dir/x.wav"));

@@ -41,14 +41,14 @@ fn csv_rows(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
     (header, rows)
 }
 
-/// A CSV tip (performer frame: x right, y forward, z up, m) in BVH axes (Y up, the
-/// performer facing −Z) and `per_metre` units.
-fn tip_in_bvh(header: &[String], row: &[f64], hand: &str, per_metre: f64) -> [f64; 3] {
+/// A CSV tip (performer frame: x right, y forward, z up, m) in the Y-up axes of the BVH
+/// and glTF files (the performer facing +Z: (−x, z, y)) and `per_metre` units.
+fn tip_y_up(header: &[String], row: &[f64], hand: &str, per_metre: f64) -> [f64; 3] {
     let col = |axis: &str| {
         let name = format!("{hand}_tip_{axis}_m");
         row[header.iter().position(|h| *h == name).unwrap()]
     };
-    [col("x"), col("z"), -col("y")].map(|v| v * per_metre)
+    [-col("x"), col("z"), col("y")].map(|v| v * per_metre)
 }
 
 fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -99,7 +99,7 @@ fn bvh_forward_kinematics_matches_the_motion_csv() {
     for (f, row) in rows.iter().enumerate() {
         let p = parsed.positions(f);
         for (tip, hand) in tips.iter().zip(["left", "right"]) {
-            worst = worst.max(distance(p[*tip], tip_in_bvh(&header, row, hand, 1.0)));
+            worst = worst.max(distance(p[*tip], tip_y_up(&header, row, hand, 1.0)));
         }
     }
     eprintln!(
@@ -137,7 +137,7 @@ fn bvh_forward_kinematics_matches_the_motion_csv() {
         let row = &rows[f / 6 * 25];
         let p = parsed.positions(f);
         for (tip, hand) in tips.iter().zip(["left", "right"]) {
-            let d = distance(p[*tip], tip_in_bvh(&header, row, hand, 100.0));
+            let d = distance(p[*tip], tip_y_up(&header, row, hand, 100.0));
             assert!(d < 0.1, "frame {f} {hand}: {d} cm");
         }
         checked += 1;
@@ -494,4 +494,114 @@ fn osc_target_is_checked() {
         assert!(err.contains("--osc"), "{bad}: {err}");
     }
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+}
+
+/// `--glb` is read back by the `gltf` crate (an independent reader): one scene with the
+/// body, the sticks and the kit's drum; one animation whose channels are exactly the 11
+/// joint nodes' rotations, every sampler with a key per motion sample (the CSV's rows,
+/// 4 ms apart) in its input and output accessors; and the node hierarchy posed by those
+/// rotations puts the `stick_tip_l`/`stick_tip_r` nodes where the motion CSV has the tips
+/// (glTF axes, Y up and the performer facing +Z: (−x, z, y)) within 1 mm in every tenth frame.
+#[test]
+fn glb_animates_every_joint_and_reaches_the_tips() {
+    use glam::{DMat4, DQuat, DVec3};
+    let dir = tempfile::tempdir().unwrap();
+    let (wav, csv, glb) = (
+        dir.path().join("out.wav"),
+        dir.path().join("motion.csv"),
+        dir.path().join("scene.glb"),
+    );
+    let args = [
+        "--wav".as_ref(),
+        wav.as_os_str(),
+        "--motion".as_ref(),
+        csv.as_os_str(),
+        "--glb".as_ref(),
+        glb.as_os_str(),
+    ];
+    ok(&render("scores/improvisation.ron", &args));
+    let (header, rows) = csv_rows(&csv);
+    let gltf = gltf::Gltf::from_slice(&std::fs::read(&glb).unwrap()).unwrap();
+    let blob = gltf.blob.clone().unwrap();
+    let names: Vec<String> = gltf
+        .nodes()
+        .map(|n| n.name().unwrap_or_default().to_string())
+        .collect();
+    let joints = [
+        "trunk",
+        "neck",
+        "head",
+        "shoulder_l",
+        "elbow_l",
+        "wrist_l",
+        "grip_l",
+        "shoulder_r",
+        "elbow_r",
+        "wrist_r",
+        "grip_r",
+    ];
+    assert_eq!(gltf.scenes().count(), 1);
+    assert!(names.iter().any(|n| n == "23-inch"), "the solo kit's drum");
+    assert!(gltf.meshes().count() >= 3);
+    let animation = gltf.animations().next().unwrap();
+    assert_eq!(gltf.animations().count(), 1);
+    let mut rotations: std::collections::HashMap<usize, Vec<[f32; 4]>> = Default::default();
+    for channel in animation.channels() {
+        assert_eq!(
+            channel.target().property(),
+            gltf::animation::Property::Rotation
+        );
+        let sampler = channel.sampler();
+        assert_eq!(sampler.input().count(), rows.len());
+        assert_eq!(sampler.output().count(), rows.len());
+        let reader = channel.reader(|_| Some(&blob[..]));
+        let times: Vec<f32> = reader.read_inputs().unwrap().collect();
+        assert!((f64::from(times[1] - times[0]) - 0.004).abs() < 1e-6);
+        let gltf::animation::util::ReadOutputs::Rotations(r) = reader.read_outputs().unwrap()
+        else {
+            panic!("not rotations")
+        };
+        rotations.insert(channel.target().node().index(), r.into_f32().collect());
+    }
+    let mut animated: Vec<&str> = rotations.keys().map(|&i| names[i].as_str()).collect();
+    animated.sort();
+    let mut want = joints.to_vec();
+    want.sort();
+    assert_eq!(
+        animated, want,
+        "a channel for every joint node and no other"
+    );
+    // Parents, then each node's world transform at frame k.
+    let mut parent = vec![None; names.len()];
+    for n in gltf.nodes() {
+        for c in n.children() {
+            parent[c.index()] = Some(n.index());
+        }
+    }
+    let world = |node: usize, k: usize| {
+        let mut m = DMat4::IDENTITY;
+        let mut at = Some(node);
+        while let Some(i) = at {
+            let (t, r, s) = gltf.nodes().nth(i).unwrap().transform().decomposed();
+            let r = rotations.get(&i).map_or(r, |v| v[k]);
+            let local = DMat4::from_scale_rotation_translation(
+                DVec3::from(s.map(f64::from)),
+                DQuat::from_array(r.map(f64::from)).normalize(),
+                DVec3::from(t.map(f64::from)),
+            );
+            m = local * m;
+            at = parent[i];
+        }
+        m.transform_point3(DVec3::ZERO)
+    };
+    let tips = ["stick_tip_l", "stick_tip_r"].map(|n| names.iter().position(|m| m == n).unwrap());
+    let mut worst = 0.0f64;
+    for (k, row) in rows.iter().enumerate().step_by(10) {
+        for (tip, hand) in tips.iter().zip(["left", "right"]) {
+            let want = DVec3::from(tip_y_up(&header, row, hand, 1.0));
+            worst = worst.max(world(*tip, k).distance(want));
+        }
+    }
+    eprintln!("glTF tips vs motion CSV: worst {worst} m");
+    assert!(worst < 1e-3, "worst tip distance {worst} m");
 }

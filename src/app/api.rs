@@ -214,6 +214,11 @@ impl EditorApp {
         self.export_to(Export::Bvh, path);
     }
 
+    /// Export the current rendering as a glTF scene at `path` (File > Export scene glTF).
+    pub fn export_glb_to(&mut self, path: &Path) {
+        self.export_to(Export::Glb, path);
+    }
+
     /// Aim the live OSC output at `host`:`port` (the inspector's "Live OSC output" fields;
     /// its checkbox turns it on).
     pub fn set_osc_target(&mut self, host: &str, port: u16) {

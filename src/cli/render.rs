@@ -10,7 +10,7 @@ use super::compose::HAND_COLOURS;
 use crate::base::ron_file;
 use crate::body::sim::Pipeline;
 use crate::io::plot::{Figure, Panel, Series};
-use crate::io::{bvh, midi_performed, motion_c3d, motion_csv};
+use crate::io::{bvh, glb, midi_performed, motion_c3d, motion_csv};
 use crate::motion::plan::{self, PlanParams};
 use crate::render::{Progress, RenderParams, Rendering, render, strikes};
 use crate::score::LoadedScore;
@@ -45,6 +45,10 @@ pub struct ExportArgs {
     /// BVH length unit: metres or centimetres.
     #[arg(long, value_enum, default_value = "m", requires = "bvh")]
     pub bvh_units: BvhUnitsArg,
+    /// Also write the scene as binary glTF 2.0: the body and sticks as boxes, the drums,
+    /// the performance as node animation (250 Hz).
+    #[arg(long)]
+    pub glb: Option<PathBuf>,
     /// Sample format of every WAV written (the mix and the stems): 16- or 24-bit integer
     /// PCM or 32-bit float.
     #[arg(long, value_enum, default_value = "16")]
@@ -158,6 +162,14 @@ pub fn run(
                 .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
         })
         .transpose()?;
+    let glb = ex
+        .glb
+        .as_ref()
+        .map(|path| {
+            glb::to_glb(&rendering.motion, &rendering.skeleton(), &rendering.kit)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+        })
+        .transpose()?;
     let figure = outputs
         .plot
         .map(|_| figure(&rendering, &loaded.score.title));
@@ -226,6 +238,9 @@ pub fn run(
     }
     if let (Some(path), Some(text)) = (&ex.bvh, bvh) {
         ron_file::write_atomic(path, text.as_bytes())?;
+    }
+    if let (Some(path), Some(bytes)) = (&ex.glb, glb) {
+        ron_file::write_atomic(path, &bytes)?;
     }
     let t = &rendering.timing;
     println!(

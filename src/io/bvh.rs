@@ -4,9 +4,10 @@
 //! in one at the top of the skull), offsets from the skeleton's rest geometry, and one
 //! frame per task sample (250 Hz) or resampled to a lower rate (slerp between samples).
 //!
-//! Axes: BVH files are read as Y-up (Blender's importer assumes Y up, −Z forward). The
-//! performer frame (x right, y forward, z up) is written as (X, Y, Z) = (x, z, −y): the
-//! performer faces −Z, which Blender turns into its own front (−Y). Rest pose: standing,
+//! Axes: BVH files are read as Y-up (Blender's importer assumes Y up and maps the file's
+//! +Z to its −Y). The performer frame (x right, y forward, z up) is written as
+//! (X, Y, Z) = (−x, z, y): the performer faces +Z, as in the CMU captures, which Blender
+//! stands facing its front view (−Y), right hand at −X. Rest pose: standing,
 //! arms and sticks hanging (every joint rotation zero). Units: metres or centimetres for
 //! offsets and the root position; angles in degrees. Every joint declares its channels:
 //! the root `Xposition Yposition Zposition` then, like every joint, `Xrotation Zrotation
@@ -14,6 +15,7 @@
 //! 90° flexions of playing); each frame's angles are chosen nearest the previous frame's
 //! (no 360° jumps), so tools interpolating the curves do not spin.
 
+use super::y_up;
 use crate::body::model::segment_axis;
 use crate::body::sim::Motion;
 use crate::body::skeleton::{Joint, Pose, Skeleton};
@@ -70,17 +72,6 @@ pub enum BvhError {
 const ROTATION_CHANNELS: &str = "Xrotation Zrotation Yrotation";
 const EULER: EulerRot = EulerRot::XZY;
 
-/// A performer-frame vector in the file's Y-up axes.
-pub fn to_y_up(v: DVec3) -> DVec3 {
-    DVec3::new(v.x, v.z, -v.y)
-}
-
-/// A performer-frame rotation in the file's Y-up axes (the same turn, its axis mapped).
-fn rotation_to_y_up(q: DQuat) -> DQuat {
-    let axis = to_y_up(DVec3::new(q.x, q.y, q.z));
-    DQuat::from_xyzw(axis.x, axis.y, axis.z, q.w)
-}
-
 /// The joints in the file's order: depth first, children in [`Joint::ALL`] order.
 fn depth_first() -> Vec<Joint> {
     fn visit(j: Joint, out: &mut Vec<Joint>) {
@@ -113,13 +104,13 @@ pub fn to_bvh(motion: &Motion, skeleton: &Skeleton, options: &Options) -> Result
     let poses = resample(&motion.poses, source_hz, rate_hz);
     writeln!(out, "MOTION\nFrames: {}", poses.len()).expect("writing to a String");
     writeln!(out, "Frame Time: {:.8}", 1.0 / rate_hz).expect("writing to a String");
-    let root = to_y_up(skeleton.trunk_origin) * scale;
+    let root = y_up::vector(skeleton.trunk_origin) * scale;
     let mut previous: Vec<Option<[f64; 3]>> = vec![None; order.len()];
     for pose in &poses {
         write!(out, "{} {} {}", fixed(root.x), fixed(root.y), fixed(root.z))
             .expect("writing to a String");
         for (slot, j) in previous.iter_mut().zip(&order) {
-            let angles = euler_near(rotation_to_y_up(pose[j.index()]), *slot);
+            let angles = euler_near(y_up::rotation(pose[j.index()]), *slot);
             *slot = Some(angles);
             for a in angles {
                 write!(out, " {}", fixed(a.to_degrees())).expect("writing to a String");
@@ -136,7 +127,7 @@ fn write_joint(out: &mut String, skeleton: &Skeleton, joint: Joint, depth: usize
     let offset = if joint.parent().is_none() {
         DVec3::ZERO // the root's place is in its position channels
     } else {
-        to_y_up(skeleton.offsets[joint.index()]) * scale
+        y_up::vector(skeleton.offsets[joint.index()]) * scale
     };
     let kind = if depth == 0 { "ROOT" } else { "JOINT" };
     let channels = if depth == 0 {
@@ -160,7 +151,7 @@ fn write_joint(out: &mut String, skeleton: &Skeleton, joint: Joint, depth: usize
         write_joint(out, skeleton, *c, depth + 1, scale);
     }
     if children.is_empty() {
-        let end = to_y_up(segment_axis(skeleton, joint)) * scale;
+        let end = y_up::vector(segment_axis(skeleton, joint)) * scale;
         w(out, format_args!("{pad}  End Site"));
         w(out, format_args!("{pad}  {{"));
         w(out, format_args!("{pad}    OFFSET {}", v(end)));

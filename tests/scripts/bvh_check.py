@@ -3,7 +3,7 @@
 package parses it; forward kinematics written here (plain Python, the channels in the
 order each joint declares) puts the stick tips (the grips' End Sites) where the motion
 CSV of the same render has them (performer frame x right, y forward, z up -> BVH
-(x, z, -y)). Prints the joint count, frames, frame time and the worst tip distance;
+(-x, z, y)): the performer faces +Z. Prints the joint count, frames, frame time and the worst tip distance;
 exits 1 if the frames differ or a tip is more than 1 mm off.
 
 Usage: pip install bvh; tests/scripts/bvh_check.py OUT.bvh MOTION.csv [--cm]
@@ -76,7 +76,7 @@ def main():
             d = apply(rot_of[grip], ends[hand])
             tip = [pos[grip][i] + d[i] for i in range(3)]
             x, y, z = (float(row[f"{hand}_tip_{a}_m"]) for a in "xyz")
-            want = [x * per_metre, z * per_metre, -y * per_metre]
+            want = [-x * per_metre, z * per_metre, y * per_metre]
             worst = max(worst, math.dist(tip, want) / per_metre)
     print(f"worst stick-tip distance to the motion CSV: {worst * 1e3:.4f} mm")
     if worst > 1e-3:
