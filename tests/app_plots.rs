@@ -5,6 +5,7 @@
 //! WAV and a motion CSV of the current rendering or refuses with the reason.
 
 mod common;
+mod readers;
 
 use eframe::egui;
 use egui_kittest::Harness;
@@ -279,6 +280,33 @@ fn export_writes_wav_and_motion() {
     let tip = take.track("RTIP").unwrap().positions[0].unwrap();
     assert!((tip - r.motion.tips[1][0]).length() < 1e-6, "{tip}");
 
+    // The motion as BVH: read by the independent parser, a frame per sample at 250 Hz,
+    // the right stick's end site at the simulated tip (Y up, the performer facing +Z).
+    let bvh = out.path().join("improvisation.bvh");
+    h.state_mut().export_bvh_to(&bvh);
+    h.state_mut().wait_for_files();
+    assert!(h.state().error().is_none(), "{:?}", h.state().error());
+    let parsed = readers::Bvh::parse(&std::fs::read_to_string(&bvh).unwrap());
+    assert_eq!(parsed.frames.len(), r.motion.poses.len());
+    assert!((parsed.frame_time_s - 1.0 / r.motion.rate_hz).abs() < 1e-9);
+    let tip = parsed.positions(0)[parsed.index("grip_r_end")];
+    let want = r.motion.tips[1][0];
+    let d = glam::DVec3::from(tip).distance(glam::DVec3::new(-want.x, want.z, want.y));
+    assert!(d < 1e-3, "right tip {d} m off");
+
+    // The scene as glTF: read by the gltf crate, a rotation key per sample for each of
+    // the 11 joints.
+    let glb = out.path().join("improvisation.glb");
+    h.state_mut().export_glb_to(&glb);
+    h.state_mut().wait_for_files();
+    assert!(h.state().error().is_none(), "{:?}", h.state().error());
+    let scene = gltf::Gltf::from_slice(&std::fs::read(&glb).unwrap()).unwrap();
+    let animation = scene.animations().next().unwrap();
+    assert_eq!(animation.channels().count(), 11);
+    for c in animation.channels() {
+        assert_eq!(c.sampler().output().count(), r.motion.poses.len());
+    }
+
     // The score as MIDI: imported again, the same beats at the same ticks.
     let mid = out.path().join("improvisation.mid");
     h.state_mut().export_midi_to(&mid);
@@ -296,7 +324,7 @@ fn export_writes_wav_and_motion() {
         .unwrap()
         .map(|e| e.unwrap().file_name())
         .collect();
-    assert_eq!(names.len(), 4, "no temporary files: {names:?}");
+    assert_eq!(names.len(), 6, "no temporary files: {names:?}");
 
     // A failing write is an error in the window, not a panic.
     h.state_mut().export_wav_to(Path::new("/no/such/dir/x.wav"));
@@ -453,4 +481,59 @@ fn a_render_error_shows_its_beat() {
     );
     let t = h.state().playhead_s();
     assert!((t - (beat_s - 0.5)).abs() < 1e-9, "{t} vs {beat_s}");
+}
+
+/// The live OSC output, turned on in the inspector and aimed at a UDP receiver on
+/// loopback, sends each contact of the rendering once as the silent playback clock
+/// passes it — the first one a moment before score time 0 included — and nothing
+/// beyond the playhead; every message decodes (rosc) to its event's drum, hand and time.
+#[test]
+fn live_osc_sends_the_hits_as_they_sound() {
+    let rx = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    rx.set_read_timeout(Some(std::time::Duration::from_millis(500)))
+        .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(dir.path(), false, true);
+    let r = rendering();
+    h.state_mut()
+        .set_osc_target("127.0.0.1", rx.local_addr().unwrap().port());
+    h.get_by_label("Live OSC output").click();
+    settle(&mut h);
+    h.get_by_label("Send hits during playback").click();
+    settle(&mut h);
+    h.state_mut().seek(0.0);
+    h.key_press(egui::Key::Space);
+    h.step();
+    let until_s = r.events[2].contact_s + 0.1;
+    let started = std::time::Instant::now();
+    while h.state().playhead_s() < until_s {
+        assert!(started.elapsed().as_secs() < 30, "playback stalled");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        h.step();
+    }
+    h.key_press(egui::Key::Space);
+    h.step();
+    let stopped_s = h.state().playhead_s();
+    let want: Vec<_> = r
+        .events
+        .iter()
+        .filter(|e| e.contact_s <= stopped_s)
+        .collect();
+    assert!(want.len() >= 3 && r.events[0].contact_s < 0.0, "{want:?}");
+    let mut buf = [0u8; 1536];
+    let mut got = Vec::new();
+    while let Ok(n) = rx.recv(&mut buf) {
+        let (_, packet) = rosc::decoder::decode_udp(&buf[..n]).unwrap();
+        let rosc::OscPacket::Message(m) = packet else {
+            panic!("not a message")
+        };
+        got.push(m);
+    }
+    assert_eq!(got.len(), want.len(), "{:?}", h.state().osc_sent());
+    for (m, e) in got.iter().zip(want) {
+        assert_eq!(m.addr, "/timpanist/hit");
+        assert_eq!(m.args[0].clone().int().unwrap() as usize, e.drum);
+        assert_eq!(m.args[1].clone().string().unwrap(), e.hand);
+        assert_eq!(m.args[6].clone().float().unwrap(), e.contact_s as f32);
+    }
 }

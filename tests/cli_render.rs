@@ -53,12 +53,14 @@ fn cli_render_writes_wav_motion_and_events() {
         (reader.spec().sample_rate, reader.spec().channels),
         (48_000, 2)
     );
-    // One stereo stem per drum, panned as in the mix (the solo kit has one drum): the
-    // stems sum to the mix.
-    let stems: Vec<_> = std::fs::read_dir(dir.path().join("stems"))
+    // One stereo stem per drum, panned as in the mix (the solo kit has one drum), and
+    // one per hand (tests/exports.rs): the stems sum to the mix.
+    let mut stems: Vec<_> = std::fs::read_dir(dir.path().join("stems"))
         .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
         .collect();
-    assert_eq!(stems.len(), 1);
+    stems.sort();
+    assert_eq!(stems, ["1-23-inch.wav", "left.wav", "right.wav"]);
     let mut stem = hound::WavReader::open(dir.path().join("stems/1-23-inch.wav")).unwrap();
     assert_eq!(stem.spec().channels, 2);
     let stem: Vec<i16> = stem.samples::<i16>().map(Result::unwrap).collect();

@@ -214,6 +214,28 @@ impl EditorApp {
         self.export_to(Export::MotionC3d, path);
     }
 
+    /// Export the current rendering's motion as BVH at `path` (File > Export motion BVH).
+    pub fn export_bvh_to(&mut self, path: &Path) {
+        self.export_to(Export::Bvh, path);
+    }
+
+    /// Export the current rendering as a glTF scene at `path` (File > Export scene glTF).
+    pub fn export_glb_to(&mut self, path: &Path) {
+        self.export_to(Export::Glb, path);
+    }
+
+    /// Aim the live OSC output at `host`:`port` (the inspector's "Live OSC output" fields;
+    /// its checkbox turns it on).
+    pub fn set_osc_target(&mut self, host: &str, port: u16) {
+        self.osc.settings.host = host.to_string();
+        self.osc.settings.port = port;
+    }
+
+    /// Hits the live OSC output sent since it was turned on, and its latest error.
+    pub fn osc_sent(&self) -> (usize, Option<&str>) {
+        (self.osc.sent, self.osc.error.as_deref())
+    }
+
     /// The open plot tab.
     pub fn plot_tab(&self) -> PlotTab {
         self.views.plots.tab

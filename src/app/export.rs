@@ -1,7 +1,9 @@
 //! File > Export: the rendering of the score as it is now, written as a WAV
 //! (16-bit stereo 48 kHz, `sound::write_wav`), as motion CSV (`io::motion_csv`, the same
-//! columns as `timpanist render --motion`) or as motion C3D (`io::motion_c3d`, joints and
-//! tips for motion-capture tools); and the score itself as a Standard MIDI File
+//! columns as `timpanist render --motion`), as motion C3D (`io::motion_c3d`, joints and
+//! tips for motion-capture tools), as BVH (`io::bvh`, the skeleton animated for Blender:
+//! 250 Hz, metres, as `timpanist render --bvh`), as glTF (`io::glb`, the scene animated,
+//! as `timpanist render --glb`); and the score itself as a Standard MIDI File
 //! (`io::midi_export`, as `timpanist export-midi`). Each is written atomically (a
 //! temporary file beside the target, renamed over it). The rendered exports are refused,
 //! with the reason, while the only rendering is of an older version of the score or there
@@ -9,7 +11,7 @@
 
 use super::dialogs::{Purpose, Request};
 use crate::base::ron_file::{self, FileError};
-use crate::io::{midi_export, motion_c3d, motion_csv};
+use crate::io::{bvh, glb, midi_export, motion_c3d, motion_csv};
 use crate::kit::Kit;
 use crate::render::Rendering;
 use crate::score::Score;
@@ -25,13 +27,24 @@ pub enum Export {
     Motion,
     /// Joint positions and tips per task sample, as C3D points.
     MotionC3d,
+    /// The skeleton animated, one frame per task sample (BVH).
+    Bvh,
+    /// The scene (body, sticks, drums) animated, as binary glTF.
+    Glb,
     /// The score (no rendering needed).
     Midi,
 }
 
 impl Export {
     /// Every export, in menu order.
-    pub const ALL: [Export; 4] = [Export::Wav, Export::Motion, Export::MotionC3d, Export::Midi];
+    pub const ALL: [Export; 6] = [
+        Export::Wav,
+        Export::Motion,
+        Export::MotionC3d,
+        Export::Bvh,
+        Export::Glb,
+        Export::Midi,
+    ];
 
     /// The File menu item.
     pub fn menu_label(self) -> &'static str {
@@ -39,6 +52,8 @@ impl Export {
             Export::Wav => "Export WAV...",
             Export::Motion => "Export motion CSV...",
             Export::MotionC3d => "Export motion C3D...",
+            Export::Bvh => "Export motion BVH...",
+            Export::Glb => "Export scene glTF...",
             Export::Midi => "Export MIDI...",
         }
     }
@@ -49,6 +64,8 @@ impl Export {
             Export::Wav => ("WAV audio", &["wav"]),
             Export::Motion => ("motion CSV", &["csv"]),
             Export::MotionC3d => ("C3D motion capture", &["c3d"]),
+            Export::Bvh => ("BVH animation", &["bvh"]),
+            Export::Glb => ("binary glTF", &["glb"]),
             Export::Midi => ("Standard MIDI File", &["mid"]),
         }
     }
@@ -59,6 +76,8 @@ impl Export {
             Export::Wav => format!("{stem}.wav"),
             Export::Motion => format!("{stem}-motion.csv"),
             Export::MotionC3d => format!("{stem}-motion.c3d"),
+            Export::Bvh => format!("{stem}.bvh"),
+            Export::Glb => format!("{stem}.glb"),
             Export::Midi => format!("{stem}.mid"),
         }
     }
@@ -112,6 +131,18 @@ pub enum ExportError {
         source: FileError,
     },
     #[error("cannot export to {}: {source}", path.display())]
+    Bvh {
+        path: PathBuf,
+        #[source]
+        source: bvh::BvhError,
+    },
+    #[error("cannot export to {}: {source}", path.display())]
+    Glb {
+        path: PathBuf,
+        #[source]
+        source: glb::GlbError,
+    },
+    #[error("cannot export to {}: {source}", path.display())]
     Sound {
         path: PathBuf,
         #[source]
@@ -162,6 +193,28 @@ pub fn write(
                 &rendering.reference,
                 &rendering.skeleton(),
             );
+            ron_file::write_atomic(path, &bytes).map_err(failed)?;
+            Ok(samples(rendering))
+        }
+        Export::Bvh => {
+            let text = bvh::to_bvh(
+                &rendering.motion,
+                &rendering.skeleton(),
+                &bvh::Options::default(),
+            )
+            .map_err(|e| ExportError::Bvh {
+                path: path.to_path_buf(),
+                source: e,
+            })?;
+            ron_file::write_atomic(path, text.as_bytes()).map_err(failed)?;
+            Ok(samples(rendering))
+        }
+        Export::Glb => {
+            let bytes = glb::to_glb(&rendering.motion, &rendering.skeleton(), &rendering.kit)
+                .map_err(|e| ExportError::Glb {
+                    path: path.to_path_buf(),
+                    source: e,
+                })?;
             ron_file::write_atomic(path, &bytes).map_err(failed)?;
             Ok(samples(rendering))
         }

@@ -22,6 +22,7 @@ mod history;
 mod inspector;
 mod jobs;
 mod keys;
+mod osc_out;
 pub mod picking;
 mod pipeline;
 pub mod playback;
@@ -138,6 +139,8 @@ pub struct EditorApp {
     doc: Option<Document>,
     pipeline: Pipeline,
     transport: Transport,
+    /// Live OSC output of the hits during playback.
+    osc: osc_out::OscOut,
     views: Views,
     jobs: Jobs,
     recent: RecentFiles,
@@ -217,6 +220,7 @@ impl EditorApp {
             doc: None,
             pipeline: Pipeline::new(options.render, db),
             transport: Transport::new(playback),
+            osc: osc_out::OscOut::default(),
             views: Views {
                 timeline: timeline::TimelineView::new(),
                 tempo_lane: tempo_lane::TempoLane::default(),
@@ -302,6 +306,11 @@ impl EditorApp {
         if let Some(tick) = tick {
             self.views.timeline.follow(tick);
         }
+        self.osc.tick(
+            self.transport.playback.is_playing(),
+            self.transport.playhead_s,
+            self.pipeline.rendering().map(|(r, _)| r),
+        );
         if self.transport.playback.is_playing() || self.pipeline.is_composing() {
             ctx.request_repaint_after(std::time::Duration::from_millis(30));
         }
@@ -324,6 +333,7 @@ impl eframe::App for EditorApp {
                     if let Some(d) = &self.doc {
                         inspector::show(ui, &d.loaded, &d.selection, &mut self.pending);
                     }
+                    self.osc.ui(ui);
                 });
             });
         egui::CentralPanel::default_margins().show(ui, |ui| self.central(ui));

@@ -1,13 +1,15 @@
 //! The ground floor: the vocabulary every other layer shares and nothing else. Musical
 //! pitch, problems found while checking a file, the deterministic random generator,
-//! strict RON reading with atomic writing, the limits inputs are held to, the median, the words of a gesture score (side, hand,
-//! playing mode, grip, dynamic, impact location) and the choices its settings make
-//! (control pipeline, IK method, mode frequencies, sound model). Imports no other module
-//! of the crate.
+//! strict RON reading with atomic writing, the limits inputs are held to, the median, the
+//! words of a gesture score (side, hand, playing mode, grip, dynamic, impact location), a
+//! performed hit (`hit`: what `render` makes and `io` writes) and the choices its settings
+//! make (control pipeline, IK method, mode frequencies, sound model). Imports no other
+//! module of the crate.
 
 pub mod choices;
 pub mod dirs;
 pub mod gesture;
+pub mod hit;
 pub mod limits;
 pub mod pitch;
 pub mod problem;

@@ -117,9 +117,9 @@ fn inertia_along(axis: DVec3, transverse: f64, axial: f64) -> DMat3 {
     r * DMat3::from_diagonal(DVec3::new(transverse, transverse, axial)) * r.transpose()
 }
 
-/// The segment's extent from its joint (segment frame): to its child joint, or for the
+/// The segment's extent from its joint (segment frame, m): to its child joint, or for the
 /// end segments (head, sticks) along their rest direction.
-fn segment_axis(skeleton: &Skeleton, joint: Joint) -> DVec3 {
+pub fn segment_axis(skeleton: &Skeleton, joint: Joint) -> DVec3 {
     let child = Joint::ALL
         .iter()
         .find(|c| c.parent() == Some(joint) && !matches!(c, Joint::ShoulderL | Joint::ShoulderR));

@@ -86,3 +86,55 @@ arg_enum!(SoundArg => crate::sound::SoundModel {
     Sample => crate::sound::SoundModel::Sample,
     Signal => crate::sound::SoundModel::Signal,
 });
+
+/// `render --bvh-rate`: the task rate or a video rate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum BvhRateArg {
+    /// Every task sample (250 Hz).
+    #[value(name = "250")]
+    Task,
+    #[value(name = "120")]
+    Hz120,
+    #[value(name = "60")]
+    Hz60,
+}
+
+impl BvhRateArg {
+    /// Frames per second, `None` for the motion's own rate.
+    pub fn hz(self) -> Option<f64> {
+        match self {
+            BvhRateArg::Task => None,
+            BvhRateArg::Hz120 => Some(120.0),
+            BvhRateArg::Hz60 => Some(60.0),
+        }
+    }
+}
+
+arg_enum!(BvhUnitsArg => crate::io::bvh::Units {
+    M => crate::io::bvh::Units::Metres,
+    Cm => crate::io::bvh::Units::Centimetres,
+});
+
+/// `render --wav-format`: the WAVs' sample format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum WavFormatArg {
+    /// 16-bit integer PCM.
+    #[value(name = "16")]
+    Pcm16,
+    /// 24-bit integer PCM.
+    #[value(name = "24")]
+    Pcm24,
+    /// 32-bit float.
+    #[value(name = "f32")]
+    Float32,
+}
+
+impl From<WavFormatArg> for crate::sound::WavFormat {
+    fn from(a: WavFormatArg) -> Self {
+        match a {
+            WavFormatArg::Pcm16 => crate::sound::WavFormat::Pcm16,
+            WavFormatArg::Pcm24 => crate::sound::WavFormat::Pcm24,
+            WavFormatArg::Float32 => crate::sound::WavFormat::Float32,
+        }
+    }
+}

@@ -10,6 +10,7 @@ mod evaluate;
 mod midi;
 mod mocap;
 mod musicxml;
+mod osc;
 mod render;
 mod sound;
 mod sticking;
@@ -185,6 +186,8 @@ pub enum Command {
         /// then fail to render.
         #[arg(long)]
         joint_limits: bool,
+        #[command(flatten)]
+        exports: render::ExportArgs,
     },
     /// Compare the IK, ID and HIMC control pipelines on captured strokes of each playing
     /// mode (seed 000 §3.3): tip RMS error per mode with its spread across trials.
@@ -522,6 +525,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             db,
             seed,
             joint_limits,
+            exports,
         }) => render::run(
             &score,
             &db_or_default(db),
@@ -532,6 +536,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 events: events.as_deref(),
                 plot: plot.as_deref(),
                 stems: stems.as_deref(),
+                exports: &exports,
             },
             &render::Choices {
                 control: control.map(Into::into),

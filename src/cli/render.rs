@@ -5,11 +5,12 @@
 //! playing mode is completed from the shipped synthetic one, and the beats played with a
 //! unit of other labels than asked are told as notes (`super::compose`).
 
+use super::args::{BvhRateArg, BvhUnitsArg, WavFormatArg};
 use super::compose::HAND_COLOURS;
 use crate::base::ron_file;
 use crate::body::sim::Pipeline;
 use crate::io::plot::{Figure, Panel, Series};
-use crate::io::{motion_c3d, motion_csv};
+use crate::io::{bvh, glb, midi_performed, motion_c3d, motion_csv};
 use crate::mocap::shipped::DbSource;
 use crate::motion::plan::{self, PlanParams};
 use crate::render::{Progress, RenderParams, Rendering, render, strikes};
@@ -17,7 +18,7 @@ use crate::score::LoadedScore;
 use crate::sound::SoundModel;
 use plotters::style::RGBColor;
 use std::io::{IsTerminal, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Where to write what.
 pub struct Outputs<'a> {
@@ -28,6 +29,42 @@ pub struct Outputs<'a> {
     pub plot: Option<&'a Path>,
     /// A folder for one WAV per drum.
     pub stems: Option<&'a Path>,
+    /// The teaching exports.
+    pub exports: &'a ExportArgs,
+}
+
+/// The teaching exports of `render` (README "Exports"), flattened into its flags.
+#[derive(Clone, Debug, clap::Args)]
+pub struct ExportArgs {
+    /// Also write the simulated performer as BVH (Y up, 11 joints, the sticks ending at
+    /// their tips; for Blender and other animation tools).
+    #[arg(long)]
+    pub bvh: Option<PathBuf>,
+    /// BVH frames per second: every task sample (250) or resampled (120, 60).
+    #[arg(long, value_enum, default_value = "250", requires = "bvh")]
+    pub bvh_rate: BvhRateArg,
+    /// BVH length unit: metres or centimetres.
+    #[arg(long, value_enum, default_value = "m", requires = "bvh")]
+    pub bvh_units: BvhUnitsArg,
+    /// Also write the scene as binary glTF 2.0: the body and sticks as boxes, the drums,
+    /// the performance as node animation (250 Hz).
+    #[arg(long)]
+    pub glb: Option<PathBuf>,
+    /// Sample format of every WAV written (the mix and the stems): 16- or 24-bit integer
+    /// PCM or 32-bit float.
+    #[arg(long, value_enum, default_value = "16")]
+    pub wav_format: WavFormatArg,
+    /// Also write the performed hits as a Standard MIDI File: a note per stroke's contact
+    /// at its simulated time under the score's tempo map, velocity from its peak force.
+    #[arg(long)]
+    pub performed_midi: Option<PathBuf>,
+    /// Also send every contact as an OSC `/timpanist/hit` message over UDP to HOST:PORT
+    /// (drum, hand, x, y, peak force, impact speed, time), in time order.
+    #[arg(long, value_name = "HOST:PORT", value_parser = crate::io::osc::parse_target)]
+    pub osc: Option<(String, u16)>,
+    /// Send the OSC messages as the hits sound (paced in real time) instead of at once.
+    #[arg(long, requires = "osc")]
+    pub osc_realtime: bool,
 }
 
 /// Render `score` and write `outputs`.
@@ -58,6 +95,12 @@ pub fn run(
         stats,
         joint_limits,
     } = *choices;
+    let osc = outputs
+        .exports
+        .osc
+        .as_ref()
+        .map(super::osc::connect)
+        .transpose()?;
     let loaded = LoadedScore::load(score)?;
     for notice in &loaded.notices {
         eprintln!("note: {notice}");
@@ -91,6 +134,12 @@ pub fn run(
         &loaded.score,
         &db,
     ));
+    let ex = outputs.exports;
+    let hits: Vec<_> = rendering
+        .events
+        .iter()
+        .map(strikes::StrikeEvent::hit)
+        .collect();
     let events = outputs
         .events
         .map(|_| serde_json::to_string_pretty(&rendering.events))
@@ -105,21 +154,49 @@ pub fn run(
             &rendering.skeleton(),
         )
     });
+    let bvh = ex
+        .bvh
+        .as_ref()
+        .map(|path| {
+            let options = bvh::Options {
+                rate_hz: ex.bvh_rate.hz(),
+                units: ex.bvh_units.into(),
+            };
+            bvh::to_bvh(&rendering.motion, &rendering.skeleton(), &options)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+        })
+        .transpose()?;
+    let glb = ex
+        .glb
+        .as_ref()
+        .map(|path| {
+            glb::to_glb(&rendering.motion, &rendering.skeleton(), &rendering.kit)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+        })
+        .transpose()?;
     let figure = outputs
         .plot
         .map(|_| figure(&rendering, &loaded.score.title));
+    let duration_s = rendering.audio.frames() as f64 / f64::from(rendering.audio.rate_hz);
+    let recorded = (&rendering.drums, &rendering.touches[..]);
+    let (kit, model) = (&rendering.kit, rendering.params.sound);
     let stems = outputs
         .stems
-        .map(|_| {
-            crate::sound::stems(
-                &rendering.kit,
-                (&rendering.drums, &rendering.touches),
-                rendering.audio.frames() as f64 / f64::from(rendering.audio.rate_hz),
-                rendering.params.sound,
-            )
-        })
+        .map(|_| crate::sound::stems(kit, recorded, duration_s, model))
         .transpose()?;
-    crate::sound::write_wav(outputs.wav, &rendering.audio)?;
+    let hand_stems = outputs
+        .stems
+        .map(|_| crate::sound::hands::hand_stems(kit, recorded, duration_s, model))
+        .transpose()?;
+    let performed_midi = ex.performed_midi.as_ref().map(|_| {
+        let scale = midi_performed::ForceScale {
+            at_silence_n: rendering.params.force_at_silence_n,
+            range_n: rendering.params.force_range_n,
+        };
+        midi_performed::export(&loaded.score, kit, &hits, &scale)
+    });
+    let format = ex.wav_format.into();
+    crate::sound::write_wav_as(outputs.wav, &rendering.audio, format)?;
     if let (Some(dir), Some(stems)) = (outputs.stems, stems) {
         std::fs::create_dir_all(dir).map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
         for (j, (stem, drum)) in stems.iter().zip(&rendering.kit.drums).enumerate() {
@@ -134,8 +211,16 @@ pub fn run(
                     }
                 })
                 .collect();
-            crate::sound::write_wav(&dir.join(format!("{}-{name}.wav", j + 1)), stem)?;
+            crate::sound::write_wav_as(&dir.join(format!("{}-{name}.wav", j + 1)), stem, format)?;
         }
+    }
+    if let (Some(dir), Some(hands)) = (outputs.stems, hand_stems) {
+        for (stem, hand) in hands.iter().zip(["left", "right"]) {
+            crate::sound::write_wav_as(&dir.join(format!("{hand}.wav")), stem, format)?;
+        }
+    }
+    if let (Some(path), Some(bytes)) = (&ex.performed_midi, performed_midi) {
+        ron_file::write_atomic(path, &bytes)?;
     }
     if let (Some(path), Some(figure)) = (outputs.plot, figure) {
         figure.save_png(path)?;
@@ -154,6 +239,12 @@ pub fn run(
     }
     if let (Some(path), Some(text)) = (outputs.events, events) {
         ron_file::write_atomic(path, text.as_bytes())?;
+    }
+    if let (Some(path), Some(text)) = (&ex.bvh, bvh) {
+        ron_file::write_atomic(path, text.as_bytes())?;
+    }
+    if let (Some(path), Some(bytes)) = (&ex.glb, glb) {
+        ron_file::write_atomic(path, &bytes)?;
     }
     let t = &rendering.timing;
     println!(
@@ -174,6 +265,10 @@ pub fn run(
     );
     if stats {
         print_stats(&rendering);
+    }
+    if let Some(socket) = osc {
+        let sent = super::osc::send(&socket, &hits, ex.osc_realtime)?;
+        println!("sent {sent} OSC hits to {}", socket.peer_addr()?);
     }
     Ok(())
 }

@@ -393,6 +393,16 @@ impl DrumSet {
         &self.excitation
     }
 
+    /// A copy whose records (contacts and excitation) hold only `side`'s stick: what that
+    /// hand alone put on the heads, for sound rendered per hand.
+    pub fn only_side(&self, side: Side) -> DrumSet {
+        let mut copy = self.clone();
+        copy.contacts.retain(|c| c.side == side);
+        copy.excitation.retain(|e| e.side == side);
+        copy.open = [None; 2];
+        copy
+    }
+
     /// Membrane displacement (m, +up) of drum `drum` at the performer-frame point
     /// `point` (its height is ignored); 0 off the head or for an unknown drum.
     pub fn displacement_at(&self, drum: usize, point: DVec3) -> f64 {

@@ -74,7 +74,7 @@ pub fn export(score: &Score, kit: &Kit) -> Vec<u8> {
 
 /// An event at an absolute tick; at the same tick, lower `order` comes first (note offs
 /// before everything else), and events of equal order keep the order they were made in.
-type Timed<'a> = (u64, u8, TrackEventKind<'a>);
+pub(crate) type Timed<'a> = (u64, u8, TrackEventKind<'a>);
 
 fn meta(message: MetaMessage<'_>) -> TrackEventKind<'_> {
     TrackEventKind::Meta(message)
@@ -107,7 +107,7 @@ pub(crate) fn to_track<'a>(mut events: Vec<Timed<'a>>) -> Track<'a> {
 }
 
 /// Title, tempo and time signatures.
-fn conductor_events(score: &Score) -> Vec<Timed<'_>> {
+pub(crate) fn conductor_events(score: &Score) -> Vec<Timed<'_>> {
     let mut events = vec![(0, 1, meta(MetaMessage::TrackName(score.title.as_bytes())))];
     events.extend(
         tempo_steps(score)
@@ -188,8 +188,19 @@ fn timpani_events<'a>(score: &Score, kit: &Kit, payloads: &'a [Vec<u8>]) -> Vec<
         );
     }
     strokes.sort_by_key(|s| s.0);
-    let mut events = vec![
-        (0, 1, meta(MetaMessage::TrackName(b"Timpani"))),
+    let notes: Vec<(u64, u8, u8)> = strokes.iter().map(|s| (s.0, s.1, s.2)).collect();
+    let mut events = track_start(b"Timpani");
+    events.extend(note_events(&notes, tpq, |n| {
+        let (_, _, _, beat, first) = strokes[n];
+        first.then(|| meta(MetaMessage::SequencerSpecific(&payloads[beat])))
+    }));
+    events
+}
+
+/// A timpani track's name and its General MIDI program, at tick 0 on channel 1.
+pub(crate) fn track_start(name: &[u8]) -> Vec<Timed<'_>> {
+    vec![
+        (0, 1, meta(MetaMessage::TrackName(name))),
         (
             0,
             1,
@@ -197,16 +208,26 @@ fn timpani_events<'a>(score: &Score, kit: &Kit, payloads: &'a [Vec<u8>]) -> Vec<
                 program: u7::new(GM_TIMPANI),
             }),
         ),
-    ];
-    for (n, &(tick, key, vel, beat, first)) in strokes.iter().enumerate() {
-        let next_same_key = strokes[n + 1..]
+    ]
+}
+
+/// Note on and off events (channel 1) for `notes` (tick, key, velocity) sorted by tick:
+/// each lasts half a quarter (`tpq` ticks per quarter) or until the next note of its key.
+/// `before(n)` may put an event just before note `n`'s note on.
+pub(crate) fn note_events<'a>(
+    notes: &[(u64, u8, u8)],
+    tpq: u64,
+    before: impl Fn(usize) -> Option<TrackEventKind<'a>>,
+) -> Vec<Timed<'a>> {
+    let mut events = Vec::new();
+    for (n, &(tick, key, vel)) in notes.iter().enumerate() {
+        let next_same_key = notes[n + 1..]
             .iter()
             .find(|s| s.1 == key && s.0 > tick)
             .map_or(u64::MAX, |s| s.0 - tick);
         let length = (tpq / 2).min(next_same_key).max(1);
-        if first {
-            let data = meta(MetaMessage::SequencerSpecific(&payloads[beat]));
-            events.push((tick, 2, data));
+        if let Some(event) = before(n) {
+            events.push((tick, 2, event));
         }
         let (key, vel) = (u7::new(key), u7::new(vel));
         events.push((tick, 2, midi(MidiMessage::NoteOn { key, vel })));

@@ -100,6 +100,27 @@ pub fn match_range(
         .collect()
 }
 
+impl StrikeEvent {
+    /// The contact as the hit writers take it (`io::midi_performed`, `io::osc`): primary
+    /// when it is a scored stroke's own contact.
+    pub fn hit(&self) -> crate::base::hit::Hit {
+        crate::base::hit::Hit {
+            time_s: self.contact_s,
+            drum: self.drum,
+            side: if self.hand == "left" {
+                Side::Left
+            } else {
+                Side::Right
+            },
+            x_m: self.x_m,
+            y_m: self.y_m,
+            peak_force_n: self.peak_force_n,
+            impact_speed_mps: self.impact_speed_mps,
+            primary: self.beat.is_some(),
+        }
+    }
+}
+
 /// Every contact as an event, in time order, with its stroke's beat and schedule if it
 /// is one.
 pub fn events(

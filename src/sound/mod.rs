@@ -7,6 +7,7 @@
 pub mod analysis;
 pub mod calibration;
 pub mod fit;
+pub mod hands;
 pub mod modal;
 pub mod partials;
 pub mod radiation;
@@ -18,7 +19,7 @@ pub mod voices;
 pub mod wav;
 
 pub use spectrum::spectrum;
-pub use wav::write_wav;
+pub use wav::{WavFormat, write_wav, write_wav_as};
 
 pub use crate::base::choices::SoundModel;
 use crate::drum::DrumSet;
@@ -210,20 +211,31 @@ pub fn stems(
         .enumerate()
         .map(|(j, ((mono, _, _), drum))| {
             let sympathy = state.sympathy.get(j).map(|s| s.out.as_slice());
-            let (l, r) = pan_gains(drum.placement.x_m);
-            Audio {
-                rate_hz: SAMPLE_RATE_HZ,
-                channels: 2,
-                samples: (0..mono.len())
-                    .flat_map(|n| {
-                        let s = f64::from(radiated(model, mono, sympathy, n)) * mix.gain;
-                        [(s * l) as f32, (s * r) as f32]
-                    })
-                    .collect(),
-                gain: mix.gain,
-            }
+            stem(drum, model, (mono, sympathy), mix.gain)
         })
         .collect())
+}
+
+/// What one drum's synthesis (`mono`, plus its `sympathy` ringing) radiates, panned by its
+/// placement and scaled by the mix's `gain`: its stereo share of the mix.
+fn stem(
+    drum: &crate::kit::Drum,
+    model: SoundModel,
+    (mono, sympathy): (&[f32], Option<&[f32]>),
+    gain: f64,
+) -> Audio {
+    let (l, r) = pan_gains(drum.placement.x_m);
+    Audio {
+        rate_hz: SAMPLE_RATE_HZ,
+        channels: 2,
+        samples: (0..mono.len())
+            .flat_map(|n| {
+                let s = f64::from(radiated(model, mono, sympathy, n)) * gain;
+                [(s * l) as f32, (s * r) as f32]
+            })
+            .collect(),
+        gain,
+    }
 }
 
 /// Render `duration_s` of sound from what `drums` recorded (excitation, contacts).
@@ -328,7 +340,7 @@ pub fn render_calibrated(
                                 head.as_deref(),
                                 (drums, &own),
                                 j,
-                                mono,
+                                (mono, None),
                                 frames,
                                 synth,
                             ))

@@ -65,6 +65,11 @@ fn calibrated(head: &SoundHead) -> Vec<Voice> {
     head.voices.iter().map(calibrated_voice).collect()
 }
 
+/// Index of a hand's share: 0 left, 1 right.
+pub fn side_index(side: crate::kit::Side) -> usize {
+    usize::from(side == crate::kit::Side::Right)
+}
+
 /// Contact points are taken to the centre of a square cell this wide for their mode
 /// shapes, m (the felt ball is ≈ 36 mm across).
 const SHAPE_GRID_M: f64 = 5e-4;
@@ -123,11 +128,17 @@ fn first_change<T: PartialEq>(now: &[T], before: &[T], time: impl Fn(&T) -> f64)
 /// latest saved state before the first frame a changed entry (or the end of the previous
 /// output) reaches; the output before it is kept. Bit for bit a whole render. Returns
 /// whether anything touched the drum and the first frame rewritten.
+///
+/// With `hands`, each hand's share of the sound is rendered too, into `hands[side]`
+/// (`frames` long, from frame 0: pass a fresh `synth`): a bank per hand driven by that
+/// hand's contacts only, damped and retuned with the whole head's glide (the head's
+/// tension is set by everything on it), so the bank is linear in each step and the two
+/// shares sum to the drum's sound to the float rounding.
 pub fn resynthesise(
     head: Option<&SoundHead>,
     (drums, touches): (&DrumSet, &[f64]),
     j: usize,
-    out: &mut Vec<f32>,
+    (out, mut hands): (&mut Vec<f32>, Option<&mut [Vec<f32>; 2]>),
     frames: usize,
     synth: &mut DrumSynth,
 ) -> (bool, usize) {
@@ -179,6 +190,11 @@ pub fn resynthesise(
     synth.voices = voices;
     out.resize(frames, 0.0);
     out[start..].fill(0.0);
+    if let Some(hands) = hands.as_deref_mut() {
+        for h in hands.iter_mut() {
+            *h = vec![0.0; frames];
+        }
+    }
     let Some(head) = head.filter(|_| touched) else {
         synth.saved.clear();
         return (false, start);
@@ -204,6 +220,13 @@ pub fn resynthesise(
     let mut shapes_cell: Option<DVec2> = None;
     let mut row = vec![0.0f32; stride];
     let mut input = vec![0.0f32; BLOCK * stride];
+    // Each hand's bank and input when the hands are rendered too.
+    let mut hand_banks: Vec<(VoiceBank, Vec<f32>)> = match hands {
+        Some(_) => (0..2)
+            .map(|_| (bank.clone(), vec![0.0f32; BLOCK * stride]))
+            .collect(),
+        None => Vec::new(),
+    };
     let mut first = 0;
     for n0 in (start..out.len()).step_by(BLOCK) {
         if n0.is_multiple_of(SAVE_EVERY_BLOCKS * BLOCK) {
@@ -237,9 +260,15 @@ pub fn resynthesise(
             }
             for n in lo..hi {
                 let w = (1.0 - (n as f64 - c).abs() / (dt * fs)).max(0.0) as f32;
-                let dst = &mut input[(n - n0) * stride..(n - n0 + 1) * stride];
-                for (d, r) in dst.iter_mut().zip(&row) {
-                    *d += w * r;
+                let at = (n - n0) * stride..(n - n0 + 1) * stride;
+                let hand = hand_banks.get_mut(side_index(e.side));
+                for input in [Some(&mut input), hand.map(|h| &mut h.1)]
+                    .into_iter()
+                    .flatten()
+                {
+                    for (d, r) in input[at.clone()].iter_mut().zip(&row) {
+                        *d += w * r;
+                    }
                 }
             }
             driven = true;
@@ -250,8 +279,22 @@ pub fn resynthesise(
                 .touches
                 .iter()
                 .any(|&at| at <= t && t < at + super::TOUCH_S);
-            bank.damp(if resting { damping } else { 1.0 });
-            bank.retune(bank.glide());
+            let glide = bank.glide();
+            for b in std::iter::once(&mut bank).chain(hand_banks.iter_mut().map(|h| &mut h.0)) {
+                b.damp(if resting { damping } else { 1.0 });
+                b.retune(glide);
+            }
+        }
+        if let Some(hands) = hands.as_deref_mut() {
+            for ((b, input), h) in hand_banks.iter_mut().zip(hands.iter_mut()) {
+                if driven {
+                    b.render_driven(&input[..(n1 - n0) * stride], &mut h[n0..n1]);
+                    input.fill(0.0);
+                } else if !silent {
+                    b.render_free(&mut h[n0..n1]);
+                    b.flush(FLUSH_FLOOR);
+                }
+            }
         }
         if driven {
             bank.render_driven(&input[..(n1 - n0) * stride], &mut out[n0..n1]);
