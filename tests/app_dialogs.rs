@@ -9,15 +9,26 @@ use eframe::egui;
 use egui_kittest::kittest::Queryable;
 use std::path::Path;
 
+/// The editor on the demo score `name` from `scores/`, settled (no rendering).
+fn settled(dir: &Path, name: &str) -> egui_kittest::Harness<'static, timpanist::app::EditorApp> {
+    let mut h = editor(Some(root().join(format!("scores/{name}.ron"))), dir, false);
+    settle(&mut h);
+    h
+}
+
+/// Save As by its shortcut, settled.
+fn save_as(h: &mut egui_kittest::Harness<'static, timpanist::app::EditorApp>) {
+    h.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::S,
+    );
+    settle(h);
+}
+
 #[test]
 fn ctrl_o_opens_the_in_window_browser_and_it_opens_a_score() {
     let dir = tempfile::tempdir().unwrap();
-    let mut h = editor(
-        Some(root().join("scores/etude-modes.ron")),
-        dir.path(),
-        false,
-    );
-    settle(&mut h);
+    let mut h = settled(dir.path(), "etude-modes");
     assert!(!h.state().is_file_browser_open());
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::O);
     settle(&mut h);
@@ -40,18 +51,9 @@ fn ctrl_o_opens_the_in_window_browser_and_it_opens_a_score() {
 #[test]
 fn save_as_writes_where_the_browser_is_told_and_cancel_changes_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let mut h = editor(
-        Some(root().join("scores/improvisation.ron")),
-        dir.path(),
-        false,
-    );
-    settle(&mut h);
+    let mut h = settled(dir.path(), "improvisation");
     // Cancel: nothing saved, the score still where it was.
-    h.key_press_modifiers(
-        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
-        egui::Key::S,
-    );
-    settle(&mut h);
+    save_as(&mut h);
     assert!(h.state().is_file_browser_open(), "Save As showed no dialog");
     h.get_by_label("Cancel").click();
     settle(&mut h);
@@ -72,11 +74,7 @@ fn save_as_writes_where_the_browser_is_told_and_cancel_changes_nothing() {
     h.state_mut()
         .open_path(&root().join("scores/improvisation.ron"));
     settle(&mut h);
-    h.key_press_modifiers(
-        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
-        egui::Key::S,
-    );
-    settle(&mut h);
+    save_as(&mut h);
     h.get_by_label("lessons").click();
     settle(&mut h);
     h.get_by_label("Save").click();
@@ -93,12 +91,7 @@ fn save_as_writes_where_the_browser_is_told_and_cancel_changes_nothing() {
 #[test]
 fn the_demo_scores_menu_opens_a_built_in_demo() {
     let dir = tempfile::tempdir().unwrap();
-    let mut h = editor(
-        Some(root().join("scores/improvisation.ron")),
-        dir.path(),
-        false,
-    );
-    settle(&mut h);
+    let mut h = settled(dir.path(), "improvisation");
     h.get_by_label("File").click();
     settle(&mut h);
     h.get_by_label("Demo scores").click();
