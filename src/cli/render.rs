@@ -263,6 +263,12 @@ pub fn run(
         },
         wall.as_secs_f64()
     );
+    if ex.bvh.is_some() || ex.glb.is_some() {
+        println!(
+            "motion frame 0 (BVH, glTF) is at {:.3} s of the score, the WAV's start at 0 s",
+            rendering.start_s
+        );
+    }
     if stats {
         print_stats(&rendering);
     }

@@ -57,7 +57,7 @@ pub fn write_wav_as(path: &Path, audio: &Audio, format: WavFormat) -> Result<(),
     let mut bytes = Cursor::new(Vec::new());
     {
         let mut writer = hound::WavWriter::new(&mut bytes, spec).map_err(wav)?;
-        let full_scale = f64::from((1i32 << (format.bits() - 1)) - 1);
+        let full_scale = f64::from((1u32 << (format.bits() - 1)) - 1);
         for &s in &audio.samples {
             match format {
                 WavFormat::Float32 => writer.write_sample(s),
