@@ -58,6 +58,15 @@ fn save_as_writes_where_the_browser_is_told_and_cancel_changes_nothing() {
     h.get_by_label("Cancel").click();
     settle(&mut h);
     assert!(!h.state().is_file_browser_open());
+    // Escape closes it too (the editor's own Escape shortcut waits while it shows).
+    save_as(&mut h);
+    assert!(h.state().is_file_browser_open());
+    h.key_press(egui::Key::Escape);
+    settle(&mut h);
+    assert!(
+        !h.state().is_file_browser_open(),
+        "Escape left the browser open"
+    );
     assert!(
         h.state()
             .path()

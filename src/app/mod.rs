@@ -287,7 +287,9 @@ impl EditorApp {
         if self.restore_offer.is_none() && !self.quitting {
             self.autosave(ctx);
         }
-        if self.confirm.is_none() && self.restore_offer.is_none() {
+        // Shortcuts wait while a modal asks something (its own keys, Escape and Enter, are
+        // its own).
+        if self.confirm.is_none() && self.restore_offer.is_none() && !self.dialogs.is_open() {
             for a in keys::take_actions(ctx) {
                 self.pending.push(Command::Do(a));
             }
