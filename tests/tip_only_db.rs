@@ -370,7 +370,7 @@ fn cli_render_and_compose_tell_the_fallback_and_substitutions() {
     for stderr in [&rendered, &composed] {
         for note in [
             "has no unit of tenuto (French), vertical accent (French), legato (German)",
-            "those come from the synthetic database",
+            "those come from the built-in synthetic database",
             "note: beat 2 (accent, right, ff): no such unit; used accent, left, mf",
         ] {
             assert!(stderr.contains(note), "{note:?} not in\n{stderr}");
