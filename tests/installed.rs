@@ -36,15 +36,28 @@ impl Install {
         }
     }
 
+    /// Run the copied binary. A copy just written may be briefly "busy" (ETXTBSY): a
+    /// process forked by another test thread while the copy was open holds it until that
+    /// process execs; then the run is tried again.
     fn run(&self, args: &[&str]) -> Output {
-        Command::new(self.prefix.join("bin/timpanist"))
-            .current_dir(&self.work)
-            .env("HOME", &self.home)
-            .env_remove("XDG_DATA_HOME")
-            .env_remove("XDG_CONFIG_HOME")
-            .args(args)
-            .output()
-            .unwrap()
+        const TEXT_FILE_BUSY: i32 = 26;
+        let mut tries = 0;
+        loop {
+            let result = Command::new(self.prefix.join("bin/timpanist"))
+                .current_dir(&self.work)
+                .env("HOME", &self.home)
+                .env_remove("XDG_DATA_HOME")
+                .env_remove("XDG_CONFIG_HOME")
+                .args(args)
+                .output();
+            match result {
+                Err(e) if e.raw_os_error() == Some(TEXT_FILE_BUSY) && tries < 50 => {
+                    tries += 1;
+                    std::thread::sleep(std::time::Duration::from_millis(20));
+                }
+                other => return other.unwrap(),
+            }
+        }
     }
 }
 
