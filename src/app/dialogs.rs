@@ -115,8 +115,8 @@ impl Dialogs {
         self.notice.take()
     }
 
-    /// Ask for a file; `places` are folders to offer as starting points (recent files').
-    pub fn ask(&mut self, request: Request, places: &[PathBuf]) -> Asked {
+    /// Ask for a file; the folders of `recent_files` are offered as places to start.
+    pub fn ask(&mut self, request: Request, recent_files: &[PathBuf]) -> Asked {
         if self.kind == Kind::System {
             let asked = Instant::now();
             match system_dialog(&request) {
@@ -132,16 +132,17 @@ impl Dialogs {
                 }
             }
         }
-        self.open_in_window(request, places);
+        self.open_in_window(request, recent_files);
         Asked::InWindow
     }
 
-    fn open_in_window(&mut self, request: Request, recent: &[PathBuf]) {
+    fn open_in_window(&mut self, request: Request, recent_files: &[PathBuf]) {
         let mut places: Vec<PathBuf> = Vec::new();
-        let home = std::env::var_os("HOME").map(PathBuf::from);
+        let home = crate::base::dirs::home().map(PathBuf::from);
         let installed_scores = crate::base::dirs::installed_data_dir().map(|d| d.join("scores"));
-        let candidates = (request.folder.iter().chain(recent))
-            .cloned()
+        let recent_folders = recent_files.iter().filter_map(|f| f.parent());
+        let candidates = (request.folder.iter().cloned())
+            .chain(recent_folders.map(Path::to_path_buf))
             .chain(std::env::current_dir().ok())
             .chain(home)
             .chain(installed_scores);

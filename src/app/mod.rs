@@ -67,7 +67,6 @@ use transport::Transport;
 
 /// The demo score opened when no file is given (compiled in, so it opens anywhere).
 pub const DEMO_SCORE_PATH: &str = "scores/etude-modes.ron";
-const DEMO_SCORE_TEXT: &str = include_str!("../../scores/etude-modes.ron");
 
 /// How the editor starts.
 #[derive(Clone, Debug)]

@@ -9,7 +9,7 @@ use super::export::{self, Export};
 use super::files::{self, FileKind, kind_of};
 use super::jobs::{Done, Finished};
 use super::renderer::Rendered;
-use super::{AfterConfirm, DEMO_SCORE_PATH, DEMO_SCORE_TEXT, EditorApp};
+use super::{AfterConfirm, DEMO_SCORE_PATH, EditorApp};
 use crate::kit::Kit;
 use crate::score::{LoadedScore, Score};
 use eframe::egui;
@@ -21,7 +21,8 @@ impl EditorApp {
         if on_disk.exists() {
             return self.open_path(on_disk);
         }
-        match LoadedScore::parse(on_disk, DEMO_SCORE_TEXT) {
+        let text = crate::score::demos::text("etude-modes").expect("etude-modes is a demo");
+        match LoadedScore::parse(on_disk, text) {
             Ok(loaded) => {
                 self.set_document(loaded, None);
                 self.messages.status = "opened the bundled demo score".into();
@@ -179,13 +180,7 @@ impl EditorApp {
     /// Ask for a file with the system's dialog or the in-window one; the answer, when the
     /// system's gave one.
     pub(super) fn ask_file(&mut self, request: Request) -> Asked {
-        let mut places: Vec<PathBuf> = Vec::new();
-        for folder in self.recent.paths().iter().filter_map(|p| p.parent()) {
-            if !places.iter().any(|p| p == folder) {
-                places.push(folder.to_path_buf());
-            }
-        }
-        let asked = self.dialogs.ask(request, &places);
+        let asked = self.dialogs.ask(request, self.recent.paths());
         if let Some(notice) = self.dialogs.take_notice() {
             self.messages.status = notice;
         }

@@ -19,7 +19,8 @@ fn xdg(var: &str, fallback: &str) -> Option<PathBuf> {
         .map(|base| base.join(APP))
 }
 
-fn home() -> Option<OsString> {
+/// The user's home folder (`$HOME`), if set.
+pub fn home() -> Option<OsString> {
     std::env::var_os("HOME").filter(|h| !h.is_empty())
 }
 

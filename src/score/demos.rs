@@ -42,20 +42,21 @@ pub fn names() -> String {
     DEMOS.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
 }
 
+/// The text of the demo `name` as it is in `scores/`.
+pub fn text(name: &str) -> Option<&'static str> {
+    DEMOS.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
+}
+
 /// The demo `name` as a score standing alone: its kit named by its bundled name when the
 /// kit file is a bundled kit.
 pub fn score(name: &str) -> Result<Score, FileError> {
-    let text = DEMOS
-        .iter()
-        .find(|(n, _)| *n == name)
-        .map(|(_, t)| *t)
-        .ok_or_else(|| {
-            FileError::invalid(
-                &label(name),
-                "name",
-                format!("no such demo score (demos: {})", names()),
-            )
-        })?;
+    let text = text(name).ok_or_else(|| {
+        FileError::invalid(
+            &label(name),
+            "name",
+            format!("no such demo score (demos: {})", names()),
+        )
+    })?;
     let mut score = Score::parse(&label(name), text)?;
     let stem = Path::new(&score.kit)
         .file_stem()
@@ -70,7 +71,7 @@ pub fn score(name: &str) -> Result<Score, FileError> {
 
 /// The demo `name` loaded with its kit and checked, as the editor opens it.
 pub fn load(name: &str) -> Result<LoadedScore, FileError> {
-    LoadedScore::parse(&label(name), &score(name)?.to_ron())
+    LoadedScore::from_score(&label(name), score(name)?)
 }
 
 #[cfg(test)]

@@ -305,7 +305,12 @@ impl LoadedScore {
     /// Parse score text (with `path` for errors and kit lookup), find its kit and check the
     /// score against it.
     pub fn parse(path: &Path, text: &str) -> Result<LoadedScore, FileError> {
-        let score = Score::parse(path, text)?;
+        LoadedScore::from_score(path, Score::parse(path, text)?)
+    }
+
+    /// `score` (read from `path`, which names it in errors and places its kit) with its
+    /// kit found and the score checked against it.
+    pub fn from_score(path: &Path, score: Score) -> Result<LoadedScore, FileError> {
         let (kit, kit_source, notices) = score.resolve_kit(path)?;
         if let Some(p) = score.problems(&kit).into_iter().next() {
             return Err(FileError::invalid(path, p.place, p.message));
