@@ -19,7 +19,7 @@ pub fn stroke(
         anyhow::bail!("--seconds {seconds} is outside 0.1-60 s");
     }
     let kit = fit::kit_for(pitch.hz());
-    let mono = fit::stroke(&kit, dynamic, Calibration::shipped(), seconds)?;
+    let (mono, contact) = fit::struck(&kit, dynamic, Calibration::shipped(), seconds)?;
     let audio = crate::sound::Audio {
         rate_hz: crate::sound::SAMPLE_RATE_HZ,
         channels: 1,
@@ -33,6 +33,14 @@ pub fn stroke(
         kit.drums[0].name,
         dynamic
     );
+    if let Some(c) = contact {
+        println!(
+            "  contact {:.1} ms, peak force {:.1} N, impact speed {:.2} m/s",
+            c.duration_s() * 1e3,
+            c.peak_force_n,
+            c.impact_speed_mps
+        );
+    }
     Ok(())
 }
 

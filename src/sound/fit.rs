@@ -17,7 +17,7 @@ use crate::base::pitch::Pitch;
 use crate::drum::strike::{
     PLAYING_SPOT_FRACTION, SIM_RATE_HZ, aimed_force_n, scripted, speed_for_force,
 };
-use crate::drum::{DrumSet, ModeConfig};
+use crate::drum::{ContactEvent, DrumSet, ModeConfig};
 use crate::kit::{Kit, Side};
 
 /// Rounds of the band fit.
@@ -126,6 +126,16 @@ pub fn stroke(
     calibration: &Calibration,
     duration_s: f64,
 ) -> Result<Vec<f32>, SoundError> {
+    Ok(struck(kit, dynamic, calibration, duration_s)?.0)
+}
+
+/// [`stroke`], with the stick's first contact (its duration, peak force and impact speed).
+pub fn struck(
+    kit: &Kit,
+    dynamic: Dynamic,
+    calibration: &Calibration,
+    duration_s: f64,
+) -> Result<(Vec<f32>, Option<ContactEvent>), SoundError> {
     let (drum, mallet) = (&kit.drums[0], &kit.mallets[0]);
     let config = ModeConfig::default();
     let mut drums =
@@ -148,7 +158,7 @@ pub fn stroke(
         (SoundModel::Modal, calibration),
         None,
     )?;
-    Ok(audio.mono())
+    Ok((audio.mono(), drums.contacts().first().cloned()))
 }
 
 /// The recordings embedded for the sample model, as notes to fit to.

@@ -28,9 +28,9 @@ pub const HEAD_POISSON: f64 = 0.38;
 /// The share of the stretch that tensions the playing area: the film is not clamped at
 /// the rim but wraps a flesh hoop over the kettle's bearing edge, and the collar and hoop
 /// take up the rest. An estimate, not a measurement: chosen so an ff stroke on the 26-inch
-/// drum in D3 glides ≈ 0.7 % and a p stroke ≈ 0.1 % (`timpanist sound analyse`, 10–70 ms
-/// against 0.5–0.6 s; a clamped film, share 1, glided several %).
-pub const HEAD_STRETCH_SHARE: f64 = 0.15;
+/// drum in D3 (3890 N/m) glides ≈ 0.7 % and a p stroke ≈ 0.15 % (`timpanist sound analyse`,
+/// 10–70 ms against 0.5–0.6 s; a clamped film, share 1, glided several %).
+pub const HEAD_STRETCH_SHARE: f64 = 0.45;
 
 /// Highest mode frequency that sounds, Hz.
 pub const SOUND_MAX_HZ: f64 = 6000.0;
@@ -98,15 +98,13 @@ impl SoundHead {
         }
         chosen.sort_by_key(|c| c.0);
         // Tension modulation (module docs): δ = κ·Σ (j_k/a)²·N_k·⟨q_k²⟩ with
-        // ⟨q²⟩ = (x1² + x2²)/(2ω²) and N_k = ∫Φ_k² dA = M_k/σ_eff.
+        // ⟨q²⟩ = (x1² + x2²)/(2ω²) and N_k = ∫Φ_k² dA.
         let (a, mem) = (drum.radius_m(), &drum.membrane);
         let kappa = HEAD_STRETCH_SHARE * HEAD_YOUNG_PA * HEAD_THICKNESS_M
             / (4.0 * (1.0 - HEAD_POISSON) * std::f64::consts::PI * a * a * mem.tension_n_per_m);
-        let sigma_eff = mem.areal_density_kg_per_m2 / mem.air_loading.powi(2);
-        let glide_per_state = kappa / sigma_eff;
         let stretch = |mode: &crate::drum::HeadMode| {
             let omega = std::f64::consts::TAU * mode.freq_hz;
-            (mode.bessel_zero() / a).powi(2) * mode.modal_mass_kg / (2.0 * omega * omega)
+            (mode.bessel_zero() / a).powi(2) * mode.area_m2 / (2.0 * omega * omega)
         };
         let f11 = drum.tuning.hz();
         let voices = chosen
@@ -134,7 +132,7 @@ impl SoundHead {
                     } else {
                         t60_s
                     },
-                    glide: glide_per_state * stretch(mode),
+                    glide: kappa * stretch(mode),
                     // Over ω_k: the mix differentiates (the head radiates its
                     // acceleration), giving w at the mode's own frequency.
                     gain: radiated / (std::f64::consts::TAU * mode.freq_hz),
