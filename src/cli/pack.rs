@@ -24,11 +24,12 @@ pub fn run(
         eprintln!("pack: {step}...");
     })?;
     println!(
-        "{} -> {}: {} files, {} phrases, {} contacts, {:.1} s of audio (rendered in {:.1} s); open {}",
+        "{} -> {}: {} files, {} phrase{}, {} contacts, {:.1} s of audio (rendered in {:.1} s); open {}",
         score.display(),
         written.dir.display(),
         written.files.len(),
         written.phrases,
+        if written.phrases == 1 { "" } else { "s" },
         rendering.events.len(),
         performance.duration_s(),
         wall.as_secs_f64(),

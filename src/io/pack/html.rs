@@ -9,7 +9,7 @@
 
 use super::phrases::Phrase;
 use crate::io::performance::{Contact, Performance};
-use crate::score::{Beat, Dynamic, Hand};
+use crate::score::{BarBeat, Beat, Dynamic, Hand};
 use std::fmt::Write;
 
 /// One file of the pack as the page lists it.
@@ -61,6 +61,7 @@ h1 { margin-bottom: 0.2em; }
 nav a { margin-right: 1em; }
 table { border-collapse: collapse; margin: 0.5em 0 1.5em; font-size: 0.92em; }
 th, td { border-bottom: 1px solid #ddd; padding: 0.25em 0.6em; text-align: left; vertical-align: middle; }
+td { white-space: nowrap; }
 th { background: #f3f3f3; position: sticky; top: 0; }
 td.n { text-align: right; font-variant-numeric: tabular-nums; }
 tr.rebound td { color: #888; }
@@ -151,11 +152,7 @@ fn score_table(out: &mut String, p: &Performance) {
             let quarters = d as f64 / f64::from(p.score.ticks_per_quarter);
             extra.push(format!("secco after {quarters:.2} quarters"));
         }
-        let at = if pos.tick == 0 {
-            format!("{}:{}", pos.bar, pos.beat)
-        } else {
-            format!("{}:{}+{}", pos.bar, pos.beat, pos.tick)
-        };
+        let at = bar_beat(pos);
         let _ = writeln!(
             out,
             "<tr><td class=\"n\">{i}</td><td class=\"n\">{:.3}</td><td>{at}</td><td>{}</td>\
@@ -200,23 +197,34 @@ fn phrase_table(out: &mut String, page: &Page) {
     out.push_str("</table>\n");
 }
 
+/// "bar:beat", with "+ticks" into the beat when off it.
+fn bar_beat(pos: BarBeat) -> String {
+    if pos.tick == 0 {
+        format!("{}:{}", pos.bar, pos.beat)
+    } else {
+        format!("{}:{}+{}", pos.bar, pos.beat, pos.tick)
+    }
+}
+
+/// [`bar_beat`] of score time `t_s` (a roll's strokes each at their own).
+fn bar_beat_at(p: &Performance, t_s: f64) -> String {
+    let tick = p.score.tempo_map().tick_at(t_s).round().max(0.0) as u64;
+    bar_beat(p.score.meter_map().position(tick))
+}
+
 fn contact_row(out: &mut String, p: &Performance, c: &Contact) {
-    let meter = p.score.meter_map();
     let drum = p
         .kit
         .drums
         .get(c.hit.drum)
         .map_or(format!("drum {}", c.hit.drum), |d| d.name.clone());
     let (beat, at, scheduled, error) = match (c.beat, c.scheduled_s, c.timing_error_s()) {
-        (Some(b), Some(s), Some(e)) => {
-            let pos = p.score.beats.get(b).map(|beat| meter.position(beat.tick));
-            (
-                b.to_string(),
-                pos.map_or(String::new(), |p| format!("{}:{}", p.bar, p.beat)),
-                format!("{s:.3}"),
-                format!("{:+.2}", e * 1e3),
-            )
-        }
+        (Some(b), Some(s), Some(e)) => (
+            b.to_string(),
+            bar_beat_at(p, s),
+            format!("{s:.3}"),
+            format!("{:+.2}", e * 1e3),
+        ),
         _ => (
             "rebound".into(),
             String::new(),
@@ -257,7 +265,7 @@ fn contacts_table(out: &mut String, p: &Performance) {
     let _ = writeln!(
         out,
         "<p>{} contacts: {played} of the {} scheduled strokes found their contact \
-         (median timing error {:.2} ms, worst {:.2} ms); the others are rebounds and \
+         (median timing error {:.2} ms, worst {:.2} ms), {} rebounds and \
          re-contacts. Timing error is the contact's time minus the stroke's scheduled time \
          (positive: late); contact time is how long the felt touched the head; the MIDI \
          velocity is the one the performed MIDI file gives the stroke, from its peak \
@@ -265,7 +273,8 @@ fn contacts_table(out: &mut String, p: &Performance) {
         p.contacts.len(),
         p.strokes.len(),
         median * 1e3,
-        worst * 1e3
+        worst * 1e3,
+        p.contacts.len() - played
     );
     out.push_str(
         "<table id=\"contacts\">\n<tr><th>beat</th><th>bar:beat</th><th>hand</th><th>drum</th>\
@@ -303,7 +312,7 @@ pub fn page(p: &Performance, page: &Page) -> String {
     let _ = writeln!(
         out,
         "<header>\n<h1>{title}</h1>\n<p class=\"meta\">{} beats on the {} kit ({} drums), \
-         {meter} at {bpm:.0} bpm{}, {:?} grip; {:.1} s of sound at {} Hz, {} channels. \
+         {meter} at {bpm:.0} bpm{}, {:?} grip; {:.1} s of sound ({} Hz, {} channels). \
          Performed by timpanist {}'s simulated timpanist.</p>\n</header>",
         s.beats.len(),
         escape(kit_name(&s.kit)),
