@@ -6,7 +6,8 @@
 //! simulation (`body`, `drum`) → sound and motion (`render`, `sound`); `io` reads and
 //! writes files. The modules are layered, each importing only those below it:
 //! `base` → `kit` → `score` → {`body`, `drum`} → {`mocap`, `sound`} → `motion` →
-//! {`render`, `io`} → `app` → `cli` (ARCHITECTURE.md; `tests/architecture.rs` checks it).
+//! {`render`, `io`} → `exports` → `app` → `cli` (ARCHITECTURE.md; `tests/architecture.rs`
+//! checks it).
 
 #[cfg(feature = "editor")]
 pub mod app;
@@ -14,6 +15,7 @@ pub mod base;
 pub mod body;
 pub mod cli;
 pub mod drum;
+pub mod exports;
 pub mod io;
 pub mod kit;
 pub mod mocap;

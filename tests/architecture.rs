@@ -18,8 +18,9 @@ const FLOORS: &[(&str, u8)] = &[
     ("motion", 5),
     ("render", 6),
     ("io", 6),
-    ("app", 7),
-    ("cli", 8),
+    ("exports", 7),
+    ("app", 8),
+    ("cli", 9),
 ];
 
 fn floor(module: &str) -> Option<u8> {

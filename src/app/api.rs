@@ -224,6 +224,12 @@ impl EditorApp {
         self.export_to(Export::Glb, path);
     }
 
+    /// Export the current rendering as a lesson pack into the new folder `path` (File >
+    /// Export lesson pack).
+    pub fn export_pack_to(&mut self, path: &Path) {
+        self.export_to(Export::Pack, path);
+    }
+
     /// Aim the live OSC output at `host`:`port` (the inspector's "Live OSC output" fields;
     /// its checkbox turns it on).
     pub fn set_osc_target(&mut self, host: &str, port: u16) {

@@ -197,9 +197,11 @@ fn no_portal_reason() -> Option<String> {
 }
 
 fn system_dialog(request: &Request) -> Option<PathBuf> {
-    let mut dialog = rfd::FileDialog::new()
-        .set_title(request.title)
-        .add_filter(request.filter.0, request.filter.1);
+    let mut dialog = rfd::FileDialog::new().set_title(request.title);
+    // A filter with no extension (a folder to create, e.g. the lesson pack) adds none.
+    if !request.filter.1.is_empty() {
+        dialog = dialog.add_filter(request.filter.0, request.filter.1);
+    }
     if let Some(folder) = &request.folder {
         dialog = dialog.set_directory(folder);
     }

@@ -4,14 +4,18 @@
 //! tips for motion-capture tools), as BVH (`io::bvh`, the skeleton animated for Blender:
 //! 250 Hz, metres, as `timpanist render --bvh`), as glTF (`io::glb`, the scene animated,
 //! as `timpanist render --glb`); and the score itself as a Standard MIDI File
-//! (`io::midi_export`, as `timpanist export-midi`). Each is written atomically (a
-//! temporary file beside the target, renamed over it). The rendered exports are refused,
-//! with the reason, while the only rendering is of an older version of the score or there
-//! is none.
+//! (`io::midi_export`, as `timpanist export-midi`); and the lesson pack (`io::pack`, as
+//! `timpanist export-pack`: a new folder with the audio, motion, MIDI, plots and an
+//! `index.html` handout). The rendered exports come through `crate::exports`, the same
+//! code as the command line's. Each is written atomically (a temporary file or folder
+//! beside the target, renamed over it). The rendered exports are refused, with the
+//! reason, while the only rendering is of an older version of the score or there is none.
 
 use super::dialogs::{Purpose, Request};
 use crate::base::ron_file::{self, FileError};
-use crate::io::{bvh, glb, midi_export, motion_c3d, motion_csv};
+use crate::exports;
+use crate::io::pack::{self, PackError};
+use crate::io::{bvh, glb, midi_export};
 use crate::kit::Kit;
 use crate::render::Rendering;
 use crate::score::Score;
@@ -33,17 +37,20 @@ pub enum Export {
     Glb,
     /// The score (no rendering needed).
     Midi,
+    /// The lesson pack: a new folder with everything above and an HTML handout.
+    Pack,
 }
 
 impl Export {
     /// Every export, in menu order.
-    pub const ALL: [Export; 6] = [
+    pub const ALL: [Export; 7] = [
         Export::Wav,
         Export::Motion,
         Export::MotionC3d,
         Export::Bvh,
         Export::Glb,
         Export::Midi,
+        Export::Pack,
     ];
 
     /// The File menu item.
@@ -55,6 +62,7 @@ impl Export {
             Export::Bvh => "Export motion BVH...",
             Export::Glb => "Export scene glTF...",
             Export::Midi => "Export MIDI...",
+            Export::Pack => "Export lesson pack...",
         }
     }
 
@@ -67,6 +75,8 @@ impl Export {
             Export::Bvh => ("BVH animation", &["bvh"]),
             Export::Glb => ("binary glTF", &["glb"]),
             Export::Midi => ("Standard MIDI File", &["mid"]),
+            // A new folder: no file extension, so the dialogs list folders only.
+            Export::Pack => ("lesson pack folder", &[]),
         }
     }
 
@@ -79,6 +89,7 @@ impl Export {
             Export::Bvh => format!("{stem}.bvh"),
             Export::Glb => format!("{stem}.glb"),
             Export::Midi => format!("{stem}.mid"),
+            Export::Pack => format!("{stem}-lesson"),
         }
     }
 
@@ -148,6 +159,8 @@ pub enum ExportError {
         #[source]
         source: SoundError,
     },
+    #[error("cannot export the lesson pack: {0}")]
+    Pack(#[from] PackError),
 }
 
 /// Write `what` of the score (played on `kit`) or of its `rendering` to `path`; a line
@@ -177,46 +190,36 @@ pub fn write(
             path: path.to_path_buf(),
         });
     };
-    let samples = |r: &Rendering| {
-        format!(
-            "exported {} ({} samples at {} Hz)",
-            path.display(),
-            r.motion.poses.len(),
-            r.motion.rate_hz
-        )
-    };
+    let performance = exports::performance(rendering, score);
+    let samples = format!(
+        "exported {} ({} samples at {} Hz)",
+        path.display(),
+        rendering.motion.poses.len(),
+        rendering.motion.rate_hz
+    );
     match what {
         Export::Midi => unreachable!("written from the score above"),
         Export::MotionC3d => {
-            let bytes = motion_c3d::to_c3d(
-                &rendering.motion,
-                &rendering.reference,
-                &rendering.skeleton(),
-            );
-            ron_file::write_atomic(path, &bytes).map_err(failed)?;
-            Ok(samples(rendering))
+            ron_file::write_atomic(path, &performance.c3d()).map_err(failed)?;
+            Ok(samples)
         }
         Export::Bvh => {
-            let text = bvh::to_bvh(
-                &rendering.motion,
-                &rendering.skeleton(),
-                &bvh::Options::default(),
-            )
-            .map_err(|e| ExportError::Bvh {
-                path: path.to_path_buf(),
-                source: e,
-            })?;
-            ron_file::write_atomic(path, text.as_bytes()).map_err(failed)?;
-            Ok(samples(rendering))
-        }
-        Export::Glb => {
-            let bytes = glb::to_glb(&rendering.motion, &rendering.skeleton(), &rendering.kit)
-                .map_err(|e| ExportError::Glb {
+            let text = performance
+                .bvh(&bvh::Options::default())
+                .map_err(|e| ExportError::Bvh {
                     path: path.to_path_buf(),
                     source: e,
                 })?;
+            ron_file::write_atomic(path, text.as_bytes()).map_err(failed)?;
+            Ok(samples)
+        }
+        Export::Glb => {
+            let bytes = performance.glb().map_err(|e| ExportError::Glb {
+                path: path.to_path_buf(),
+                source: e,
+            })?;
             ron_file::write_atomic(path, &bytes).map_err(failed)?;
-            Ok(samples(rendering))
+            Ok(samples)
         }
         Export::Wav => {
             crate::sound::write_wav(path, &rendering.audio).map_err(|source| {
@@ -235,10 +238,17 @@ pub fn write(
             ))
         }
         Export::Motion => {
-            let text =
-                motion_csv::to_csv(&rendering.motion, &rendering.reference, rendering.start_s);
-            ron_file::write_atomic(path, text.as_bytes()).map_err(failed)?;
-            Ok(samples(rendering))
+            ron_file::write_atomic(path, performance.motion_csv().as_bytes()).map_err(failed)?;
+            Ok(samples)
+        }
+        Export::Pack => {
+            let written = pack::write(&performance, path, &pack::Options::default(), &mut |_| {})?;
+            Ok(format!(
+                "exported the lesson pack {} ({} files, {} phrases; open index.html)",
+                written.dir.display(),
+                written.files.len(),
+                written.phrases
+            ))
         }
     }
 }

@@ -6,7 +6,7 @@
 //! beats played with a unit of other labels than asked are told ([`print_substitutions`]).
 
 use crate::base::ron_file;
-use crate::io::plot::{Figure, Panel, Series};
+use crate::io::plot::{Figure, HAND_COLOURS, Panel, Series};
 use crate::io::tips_csv;
 use crate::kit::Side;
 use crate::mocap::db::MotionDb;
@@ -16,11 +16,7 @@ use crate::motion::perform;
 use crate::motion::plan::{self, PlanParams, Substitution};
 use crate::score::LoadedScore;
 use crate::score::{Grip, PlayingMode};
-use plotters::style::RGBColor;
 use std::path::Path;
-
-/// Colour of each hand in figures.
-pub const HAND_COLOURS: [RGBColor; 2] = [RGBColor(31, 119, 180), RGBColor(230, 120, 20)];
 
 /// Compose `score` with the database from `source`; write CSV to `output` and a plot.
 pub fn run(

@@ -11,14 +11,14 @@ mod midi;
 mod mocap;
 mod musicxml;
 mod osc;
+mod pack;
 mod render;
 mod sound;
 mod sticking;
 
 use crate::io::open::OpenAction;
 use args::{
-    ControlArg, DynamicArg, GripArg, LocationArg, ModeArg, SideArg, SoundArg, UpArg, parse_format,
-    parse_tips, parse_vec3,
+    DynamicArg, GripArg, LocationArg, ModeArg, SideArg, UpArg, parse_format, parse_tips, parse_vec3,
 };
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -162,32 +162,36 @@ pub enum Command {
         /// head radiates, panned and scaled as in the mix (the stems sum to the mix).
         #[arg(long)]
         stems: Option<PathBuf>,
-        /// The control pipeline driving the body [default: the score's settings, himc].
-        #[arg(long, value_enum)]
-        control: Option<ControlArg>,
-        /// The sound model [default: the score's settings, modal].
-        #[arg(long, value_enum)]
-        sound: Option<SoundArg>,
         /// Print simulated seconds per wall second and where the time went.
         #[arg(long)]
         stats: bool,
-        /// The motion database folder [default: the first of ./mocap,
-        /// ~/.local/share/timpanist/mocap, <prefix>/share/timpanist/mocap holding an
-        /// index.ron, else the database built into the program].
-        #[arg(long)]
-        db: Option<PathBuf>,
-        /// Seed of the choice among near-equal motion units.
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// Hold the body within the database performer's ranges of motion (seed 000
-        /// Alg. 1 joint limits, each axis widened to a floor within published human
-        /// ranges): the IK keeps its postures inside them and the simulator's stops hold
-        /// the body. Strokes at the edge of the ranges (outer drums, across the body) may
-        /// then fail to render.
-        #[arg(long)]
-        joint_limits: bool,
+        #[command(flatten)]
+        how: render::RenderArgs,
         #[command(flatten)]
         exports: render::ExportArgs,
+    },
+    /// Render a score and write a lesson pack into a new folder: the audio (whole and per
+    /// phrase), the motion (BVH, glTF, C3D, CSV), the performed and scored MIDI, plots
+    /// (SVG), each contact's numbers (CSV) and a self-contained index.html handout.
+    ExportPack {
+        /// The score (.ron).
+        score: PathBuf,
+        /// The folder to write (created; refused if it exists and holds anything).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Replace the folder if it exists and holds files (the old one is removed only
+        /// once the new pack is complete).
+        #[arg(long)]
+        force: bool,
+        /// Most bars in a phrase (a bar of rest also ends a phrase); each phrase gets its
+        /// own WAV and player.
+        #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=64))]
+        phrase_bars: u32,
+        /// Sample format of every WAV: 16- or 24-bit integer PCM or 32-bit float.
+        #[arg(long, value_enum, default_value = "16")]
+        wav_format: args::WavFormatArg,
+        #[command(flatten)]
+        how: render::RenderArgs,
     },
     /// Compare the IK, ID and HIMC control pipelines on captured strokes of each playing
     /// mode (seed 000 §3.3): tip RMS error per mode with its spread across trials.
@@ -519,16 +523,12 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             events,
             plot,
             stems,
-            control,
-            sound,
             stats,
-            db,
-            seed,
-            joint_limits,
+            how,
             exports,
         }) => render::run(
             &score,
-            &db_or_default(db),
+            &db_or_default(how.db.clone()),
             &render::Outputs {
                 wav: &wav,
                 motion: motion.as_deref(),
@@ -538,13 +538,26 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 stems: stems.as_deref(),
                 exports: &exports,
             },
-            &render::Choices {
-                control: control.map(Into::into),
-                sound: sound.map(Into::into),
-                seed,
-                stats,
-                joint_limits,
+            &how.choices(stats),
+        )
+        .map(|()| ExitCode::SUCCESS),
+        Some(Command::ExportPack {
+            score,
+            output,
+            force,
+            phrase_bars,
+            wav_format,
+            how,
+        }) => pack::run(
+            &score,
+            &db_or_default(how.db.clone()),
+            &output,
+            &crate::io::pack::Options {
+                phrase_bars,
+                wav_format: wav_format.into(),
+                replace: force,
             },
+            &how.choices(false),
         )
         .map(|()| ExitCode::SUCCESS),
         Some(Command::Evaluate {

@@ -5,20 +5,19 @@
 //! playing mode is completed from the shipped synthetic one, and the beats played with a
 //! unit of other labels than asked are told as notes (`super::compose`).
 
-use super::args::{BvhRateArg, BvhUnitsArg, WavFormatArg};
-use super::compose::HAND_COLOURS;
+use super::args::{BvhRateArg, BvhUnitsArg, ControlArg, SoundArg, WavFormatArg};
 use crate::base::ron_file;
 use crate::body::sim::Pipeline;
-use crate::io::plot::{Figure, Panel, Series};
-use crate::io::{bvh, glb, midi_performed, motion_c3d, motion_csv};
+use crate::exports;
+use crate::io::{bvh, figures};
 use crate::mocap::shipped::DbSource;
 use crate::motion::plan::{self, PlanParams};
 use crate::render::{Progress, RenderParams, Rendering, render, strikes};
 use crate::score::LoadedScore;
 use crate::sound::SoundModel;
-use plotters::style::RGBColor;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 /// Where to write what.
 pub struct Outputs<'a> {
@@ -67,7 +66,45 @@ pub struct ExportArgs {
     pub osc_realtime: bool,
 }
 
-/// Render `score` and write `outputs`.
+/// How to render, as `render` and `export-pack` take it on the command line.
+#[derive(Clone, Debug, clap::Args)]
+pub struct RenderArgs {
+    /// The control pipeline driving the body [default: the score's settings, himc].
+    #[arg(long, value_enum)]
+    pub control: Option<ControlArg>,
+    /// The sound model [default: the score's settings, modal].
+    #[arg(long, value_enum)]
+    pub sound: Option<SoundArg>,
+    /// The motion database folder [default: the first of ./mocap,
+    /// ~/.local/share/timpanist/mocap, <prefix>/share/timpanist/mocap holding an
+    /// index.ron, else the database built into the program].
+    #[arg(long)]
+    pub db: Option<PathBuf>,
+    /// Seed of the choice among near-equal motion units.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Hold the body within the database performer's ranges of motion (seed 000
+    /// Alg. 1 joint limits, each axis widened to a floor within published human
+    /// ranges): the IK keeps its postures inside them and the simulator's stops hold
+    /// the body. Strokes at the edge of the ranges (outer drums, across the body) may
+    /// then fail to render.
+    #[arg(long)]
+    pub joint_limits: bool,
+}
+
+impl RenderArgs {
+    /// The choices these flags make, printing statistics if `stats`.
+    pub fn choices(&self, stats: bool) -> Choices {
+        Choices {
+            control: self.control.map(Into::into),
+            sound: self.sound.map(Into::into),
+            seed: self.seed,
+            stats,
+            joint_limits: self.joint_limits,
+        }
+    }
+}
+
 /// How to render, as asked on the command line.
 pub struct Choices {
     /// The control pipeline (default: the score's settings).
@@ -82,12 +119,14 @@ pub struct Choices {
     pub joint_limits: bool,
 }
 
-pub fn run(
+/// Load and render `score` as `choices` ask, with the progress bar on stderr; the notes
+/// of loading and the substituted motion units printed. The score, its rendering and the
+/// wall time it took.
+pub fn rendered(
     score: &Path,
     source: &DbSource,
-    outputs: &Outputs,
     choices: &Choices,
-) -> anyhow::Result<()> {
+) -> anyhow::Result<(LoadedScore, Rendering, Duration)> {
     let Choices {
         control,
         sound,
@@ -95,12 +134,6 @@ pub fn run(
         stats,
         joint_limits,
     } = *choices;
-    let osc = outputs
-        .exports
-        .osc
-        .as_ref()
-        .map(super::osc::connect)
-        .transpose()?;
     let loaded = LoadedScore::load(score)?;
     for notice in &loaded.notices {
         eprintln!("note: {notice}");
@@ -134,26 +167,32 @@ pub fn run(
         &loaded.score,
         &db,
     ));
+    Ok((loaded, rendering, wall))
+}
+
+/// Render `score` and write `outputs`.
+pub fn run(
+    score: &Path,
+    source: &DbSource,
+    outputs: &Outputs,
+    choices: &Choices,
+) -> anyhow::Result<()> {
+    let osc = outputs
+        .exports
+        .osc
+        .as_ref()
+        .map(super::osc::connect)
+        .transpose()?;
+    let (loaded, rendering, wall) = rendered(score, source, choices)?;
     let ex = outputs.exports;
-    let hits: Vec<_> = rendering
-        .events
-        .iter()
-        .map(strikes::StrikeEvent::hit)
-        .collect();
+    let performance = exports::performance(&rendering, &loaded.score);
+    let hits = performance.hits();
     let events = outputs
         .events
         .map(|_| serde_json::to_string_pretty(&rendering.events))
         .transpose()?;
-    let motion = outputs
-        .motion
-        .map(|_| motion_csv::to_csv(&rendering.motion, &rendering.reference, rendering.start_s));
-    let c3d = outputs.c3d.map(|_| {
-        motion_c3d::to_c3d(
-            &rendering.motion,
-            &rendering.reference,
-            &rendering.skeleton(),
-        )
-    });
+    let motion = outputs.motion.map(|_| performance.motion_csv());
+    let c3d = outputs.c3d.map(|_| performance.c3d());
     let bvh = ex
         .bvh
         .as_ref()
@@ -162,21 +201,17 @@ pub fn run(
                 rate_hz: ex.bvh_rate.hz(),
                 units: ex.bvh_units.into(),
             };
-            bvh::to_bvh(&rendering.motion, &rendering.skeleton(), &options)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+            (performance.bvh(&options)).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
         })
         .transpose()?;
     let glb = ex
         .glb
         .as_ref()
-        .map(|path| {
-            glb::to_glb(&rendering.motion, &rendering.skeleton(), &rendering.kit)
-                .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
-        })
+        .map(|path| (performance.glb()).map_err(|e| anyhow::anyhow!("{}: {e}", path.display())))
         .transpose()?;
     let figure = outputs
         .plot
-        .map(|_| figure(&rendering, &loaded.score.title));
+        .map(|_| figures::performance_figure(&performance));
     let duration_s = rendering.audio.frames() as f64 / f64::from(rendering.audio.rate_hz);
     let recorded = (&rendering.drums, &rendering.touches[..]);
     let (kit, model) = (&rendering.kit, rendering.params.sound);
@@ -188,13 +223,10 @@ pub fn run(
         .stems
         .map(|_| crate::sound::hands::hand_stems(kit, recorded, duration_s, model))
         .transpose()?;
-    let performed_midi = ex.performed_midi.as_ref().map(|_| {
-        let scale = midi_performed::ForceScale {
-            at_silence_n: rendering.params.force_at_silence_n,
-            range_n: rendering.params.force_range_n,
-        };
-        midi_performed::export(&loaded.score, kit, &hits, &scale)
-    });
+    let performed_midi = ex
+        .performed_midi
+        .as_ref()
+        .map(|_| performance.performed_midi());
     let format = ex.wav_format.into();
     crate::sound::write_wav_as(outputs.wav, &rendering.audio, format)?;
     if let (Some(dir), Some(stems)) = (outputs.stems, stems) {
@@ -229,7 +261,8 @@ pub fn run(
             path.file_stem()
                 .map_or("plot".into(), |s| s.to_string_lossy())
         ));
-        super::sound::spectra_figure(first_strokes(&rendering)).save_png(&spectra)?;
+        let panels = figures::first_stroke_spectra(&performance);
+        figures::spectra_figure(panels).save_png(&spectra)?;
     }
     if let (Some(path), Some(text)) = (outputs.motion, motion) {
         ron_file::write_atomic(path, text.as_bytes())?;
@@ -269,7 +302,7 @@ pub fn run(
             rendering.start_s
         );
     }
-    if stats {
+    if choices.stats {
         print_stats(&rendering);
     }
     if let Some(socket) = osc {
@@ -277,87 +310,6 @@ pub fn run(
         println!("sent {sent} OSC hits to {}", socket.peer_addr()?);
     }
     Ok(())
-}
-
-/// Tip heights, target (pale) against simulated, with each contact marked at its peak
-/// force; scheduled strokes as guides.
-fn figure(r: &Rendering, title: &str) -> Figure {
-    let time = |k: usize| r.start_s + k as f64 / r.motion.rate_hz;
-    let pale = |c: RGBColor| RGBColor(c.0 / 2 + 127, c.1 / 2 + 127, c.2 / 2 + 127);
-    let mut series = Vec::new();
-    for (h, hand) in ["left", "right"].into_iter().enumerate() {
-        let colour = HAND_COLOURS[h];
-        series.push(Series {
-            label: format!("{hand} target"),
-            colour: pale(colour),
-            points: r.reference.tips[h]
-                .iter()
-                .enumerate()
-                .map(|(k, p)| (time(k), p.z))
-                .collect(),
-        });
-        series.push(Series {
-            label: format!("{hand} simulated"),
-            colour,
-            points: r.motion.tips[h]
-                .iter()
-                .enumerate()
-                .map(|(k, p)| (time(k), p.z))
-                .collect(),
-        });
-    }
-    let colour_of = |hand: &str| HAND_COLOURS[usize::from(hand == "right")];
-    Figure {
-        title: format!("{title}: rendered performance"),
-        x_label: "time (s)".into(),
-        panels: vec![
-            Panel {
-                y_label: "stick tip height z (m)".into(),
-                series,
-                markers: Vec::new(),
-            },
-            Panel {
-                y_label: "peak contact force (N)".into(),
-                series: Vec::new(),
-                markers: r
-                    .events
-                    .iter()
-                    .map(|e| (e.contact_s, e.peak_force_n, colour_of(e.hand)))
-                    .collect(),
-            },
-        ],
-        guides: r.composition.strokes.iter().map(|s| s.time_s).collect(),
-        size: (1400, 800),
-    }
-}
-
-/// Per drum struck, its first scored stroke's spectrum (one second of the mix from 10 ms
-/// before the contact: later strokes within it are heard too) over the recorded note
-/// nearest its (1,1): `--plot`'s second figure.
-fn first_strokes(r: &Rendering) -> Vec<crate::io::plot::Panel> {
-    let mono = r.audio.mono();
-    let rate = r.audio.rate_hz;
-    let mut seen = Vec::new();
-    r.events
-        .iter()
-        .filter(|e| e.beat.is_some())
-        .filter(|e| {
-            let new = !seen.contains(&e.drum);
-            seen.push(e.drum);
-            new
-        })
-        .filter_map(|e| {
-            let from = ((e.contact_s - 0.01).max(0.0) * f64::from(rate)) as usize;
-            let name = r.kit.drums.get(e.drum).map_or("drum", |d| d.name.as_str());
-            (from < mono.len()).then(|| {
-                super::sound::spectrum_panel(
-                    &format!("{name} at {:.2} s", e.contact_s),
-                    &mono[from..(from + rate as usize).min(mono.len())],
-                    rate,
-                )
-            })
-        })
-        .collect()
 }
 
 /// `--stats` lists the strokes whose peak force is off its aim by more than this fraction.

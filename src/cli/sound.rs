@@ -1,10 +1,9 @@
 //! `timpanist sound …`: measure notes ([`crate::sound::analysis`]).
 
-use crate::io::plot::{Figure, Panel, Series};
+use crate::io::figures::{spectra_figure, spectrum_panel};
 use crate::sound::analysis::{self, OCTAVE_CENTRES_HZ};
 use crate::sound::calibration::{Calibration, Residual};
 use crate::sound::fit::{self, Note};
-use plotters::style::RGBColor;
 use std::path::{Path, PathBuf};
 
 /// Render one scripted stroke at `pitch` and `dynamic` to a mono WAV.
@@ -134,67 +133,6 @@ pub fn analyse(files: &[PathBuf], at: &[f64], plot: Option<&Path>) -> anyhow::Re
         println!("spectra -> {}", path.display());
     }
     Ok(())
-}
-
-/// A figure of spectrum panels ([`spectrum_panel`]), one above the other.
-pub fn spectra_figure(panels: Vec<Panel>) -> Figure {
-    let count = panels.len() as u32;
-    Figure {
-        title: "Spectra (first 0.5 s) against recorded timpani".into(),
-        x_label: "frequency: log10 Hz (2 = 100 Hz, 3 = 1 kHz)".into(),
-        panels,
-        guides: Vec::new(),
-        size: (1200, 120 + 300 * count.max(1)),
-    }
-}
-
-/// Span of a plotted spectrum, s, and its frequency range, Hz.
-const PLOT_SPAN_S: f64 = 0.5;
-const PLOT_HZ: (f64, f64) = (30.0, 10_000.0);
-/// Points per plotted spectrum (the loudest bin of each log-frequency bucket).
-const PLOT_POINTS: usize = 1200;
-
-/// A note's spectrum (dB re its peak, floored at −90) on a log10 frequency axis, with the
-/// recorded note nearest its (1,1) pitched to it.
-pub fn spectrum_panel(name: &str, samples: &[f32], rate: u32) -> Panel {
-    let bucketed = |points: Vec<(f64, f64)>| -> Vec<(f64, f64)> {
-        let (lo, hi) = (PLOT_HZ.0.log10(), PLOT_HZ.1.log10());
-        let mut buckets = vec![f64::NEG_INFINITY; PLOT_POINTS];
-        for (f, d) in points {
-            let x = (f.max(1e-9).log10() - lo) / (hi - lo);
-            if (0.0..1.0).contains(&x) {
-                let b = &mut buckets[(x * PLOT_POINTS as f64) as usize];
-                *b = b.max(d.max(-90.0));
-            }
-        }
-        buckets
-            .into_iter()
-            .enumerate()
-            .filter(|(_, d)| d.is_finite())
-            .map(|(k, d)| (lo + (k as f64 + 0.5) / PLOT_POINTS as f64 * (hi - lo), d))
-            .collect()
-    };
-    let mut series = Vec::new();
-    if let Some((label, points)) = analysis::profile(samples, rate)
-        .and_then(|p| p.principal_hz)
-        .and_then(|f| analysis::recorded_reference(f, PLOT_SPAN_S))
-    {
-        series.push(Series {
-            label,
-            colour: RGBColor(120, 160, 220),
-            points: bucketed(points),
-        });
-    }
-    series.push(Series {
-        label: "this note".into(),
-        colour: RGBColor(200, 120, 30),
-        points: bucketed(analysis::note_spectrum_db(samples, rate, PLOT_SPAN_S)),
-    });
-    Panel {
-        y_label: format!("{name}: dB re peak"),
-        series,
-        markers: Vec::new(),
-    }
 }
 
 /// Print one note's measurements.

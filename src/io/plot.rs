@@ -1,10 +1,15 @@
-//! PNG figures of time series (for `compose --plot` and other reports): stacked panels
-//! sharing an x axis (time, or frequency for spectra), lines per series, point markers and vertical guide lines, drawn
-//! with plotters and the font egui ships (no system fonts needed); written atomically.
+//! Figures of time series (for `compose --plot`, `render --plot` and the lesson pack):
+//! stacked panels sharing an x axis (time, or frequency for spectra), lines per series,
+//! point markers and vertical guide lines, drawn with plotters as a PNG (the font egui
+//! ships, so no system fonts are needed; written atomically) or as SVG text (one drawing
+//! code for both).
 
 use plotters::prelude::*;
 use std::path::Path;
 use std::sync::Once;
+
+/// Colours of the left and right hand's lines and markers, [left, right].
+pub const HAND_COLOURS: [RGBColor; 2] = [RGBColor(31, 119, 180), RGBColor(230, 120, 20)];
 
 /// One line of a panel.
 pub struct Series {
@@ -74,6 +79,9 @@ pub enum PlotError {
         path: std::path::PathBuf,
         message: String,
     },
+    /// Plotters could not draw the figure as SVG.
+    #[error("cannot draw the figure \"{title}\" as SVG: {message}")]
+    Svg { title: String, message: String },
 }
 
 impl Figure {
@@ -92,7 +100,8 @@ impl Figure {
                 path: path.to_path_buf(),
                 source,
             })?;
-        self.draw(tmp.path()).map_err(|e| PlotError::Draw {
+        let root = BitMapBackend::new(tmp.path(), self.size).into_drawing_area();
+        self.draw(root).map_err(|e| PlotError::Draw {
             path: path.to_path_buf(),
             message: e.to_string(),
         })?;
@@ -103,14 +112,41 @@ impl Figure {
         Ok(())
     }
 
-    fn draw(&self, file: &Path) -> Result<(), Box<dyn std::error::Error>> {
-        let root = BitMapBackend::new(file, self.size).into_drawing_area();
+    /// The figure as the text of an SVG document (`width` and `height` in pixels of
+    /// [`Figure::size`]; text as `<text>` in the viewer's sans-serif font).
+    pub fn to_svg(&self) -> Result<String, PlotError> {
+        register_font();
+        let mut text = String::new();
+        {
+            let root = SVGBackend::with_string(&mut text, self.size).into_drawing_area();
+            self.draw(root).map_err(|e| PlotError::Svg {
+                title: self.title.clone(),
+                message: e.to_string(),
+            })?;
+        }
+        Ok(text)
+    }
+
+    /// Draw on `root`, whatever the backend (PNG file or SVG text).
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: DrawingArea<DB, plotters::coord::Shift>,
+    ) -> Result<(), Box<dyn std::error::Error>>
+    where
+        DB::ErrorType: 'static,
+    {
         root.fill(&WHITE)?;
         let root = root.titled(&self.title, ("sans-serif", 22))?;
+        // The time axis spans the lines, the markers and the guides (a panel of markers
+        // alone, e.g. forces per stroke, still gets its times).
         let (t0, t1) = range(
             self.panels
                 .iter()
-                .flat_map(|p| p.series.iter().flat_map(|s| s.points.iter().map(|p| p.0))),
+                .flat_map(|p| {
+                    let lines = p.series.iter().flat_map(|s| s.points.iter().map(|p| p.0));
+                    lines.chain(p.markers.iter().map(|m| m.0))
+                })
+                .chain(self.guides.iter().copied()),
         );
         let areas = root.split_evenly((self.panels.len().max(1), 1));
         for (panel, area) in self.panels.iter().zip(&areas) {
@@ -152,11 +188,14 @@ impl Figure {
                     .iter()
                     .map(|&(t, v, c)| Circle::new((t, v), 4, c.filled())),
             )?;
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.8))
-                .border_style(BLACK.mix(0.3))
-                .draw()?;
+            // A panel of markers alone has no legend (an empty box otherwise).
+            if !panel.series.is_empty() {
+                chart
+                    .configure_series_labels()
+                    .background_style(WHITE.mix(0.8))
+                    .border_style(BLACK.mix(0.3))
+                    .draw()?;
+            }
         }
         root.present()?;
         Ok(())
