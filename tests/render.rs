@@ -109,10 +109,10 @@ fn assert_timing(what: &str, mut all: Vec<f64>, recontacts: usize) {
 /// and the body stays within the limits — shoulders, elbows and wrists within 1.05 of
 /// their ellipsoids (0.91 measured; rendered without the limits they reach 2–4), every
 /// limited joint within 1.3 (the released grips' rebound: 1.06 measured). Fails if
-/// renders asked to stop applying the limits. Not the other two: with the felt's loss
-/// and the kettle (this round's contact) the minute study diverges at beat 90 and the
-/// tempo-change study re-strikes 25 of its 33 strokes with the limits on (README
-/// "Physics (HIMC)").
+/// renders asked to stop applying the limits. Not the other two: they render with the
+/// limits on (every stroke sounds, no re-contact since a released grip has no stop), but
+/// the minute study's neck reaches 1.41 of its ellipsoid and the tempo-change study's
+/// released right grip 1.71 (README "Physics (HIMC)").
 #[test]
 fn demo_scores_hold_the_joint_limits() {
     let db = db();

@@ -585,10 +585,15 @@ impl Simulator {
                     self.params.limit_stiffness,
                 );
                 if let Some(held) = held {
-                    // A released grip holds the stick loosely: its stop gives as its
-                    // PD does, so the stick rebounds freely about the fulcrum.
+                    // A released grip holds the stick loosely: the fingers are open, so
+                    // the stick rebounds freely about the fulcrum and has no stop until
+                    // the grip is firm again. (A stop scaled with the closing grip found
+                    // the stick far outside it, 25–50 ms after the impact, and flung it
+                    // back onto the head: 25 re-strikes of 33 on the tempo-change study.)
                     for (side, fraction) in [Side::Left, Side::Right].into_iter().zip(held) {
-                        stops[Joint::arm(side)[3].index()] *= fraction;
+                        if fraction < 1.0 {
+                            stops[Joint::arm(side)[3].index()] = DVec3::ZERO;
+                        }
                     }
                 }
                 for (t, stop) in tau.iter_mut().zip(stops) {
