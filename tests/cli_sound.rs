@@ -32,6 +32,16 @@ fn stroke_then_analyse() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // It reports its contact: 2–8 ms (5.9 measured), peaking at the force aimed for ff.
+    let said = String::from_utf8_lossy(&out.stdout).to_string();
+    let number_after = |key: &str| -> f64 {
+        let rest = said.split(key).nth(1).unwrap_or_else(|| panic!("{said}"));
+        rest.split_whitespace().next().unwrap().parse().unwrap()
+    };
+    let (contact_ms, peak_n) = (number_after("contact "), number_after("peak force "));
+    assert!((2.0..=8.0).contains(&contact_ms), "{said}");
+    let aim = timpanist::drum::strike::aimed_force_n(timpanist::score::Dynamic::Ff);
+    assert!((peak_n / aim - 1.0).abs() < 0.02, "{said}");
     let spec = hound::WavReader::open(&wav).unwrap().spec();
     assert_eq!((spec.sample_rate, spec.channels), (48_000, 1));
     let png = dir.path().join("spectra.png");
