@@ -425,6 +425,40 @@ mod tests {
         assert!((ratio(1, 2) / 2.09 - 1.0).abs() < 0.05, "{}", ratio(1, 2));
     }
 
+    /// A full-band head below a frequency holds every mode a counted head has below it,
+    /// although air loading lowers each mode by its own share (the search bound
+    /// x·√(1 + share(x)) of [`HeadModes::below_hz`]), and the air's share falls with the
+    /// mode's zero: modes above the (1,1) sit nearer their in-vacuo frequency.
+    #[test]
+    fn full_band_heads_miss_no_mode() {
+        let d = standard_26();
+        let counted = HeadModes::new(
+            &d,
+            &ModeConfig {
+                count: 200,
+                ..ModeConfig::default()
+            },
+        )
+        .unwrap();
+        let max_hz = 1000.0;
+        let full = HeadModes::below_hz(&d, FrequencySource::Measured, max_hz).unwrap();
+        let key = |k: &HeadMode| (k.m, k.n, k.orientation);
+        let below: Vec<_> = counted
+            .modes()
+            .iter()
+            .filter(|k| k.freq_hz < max_hz)
+            .map(key)
+            .collect();
+        assert!(below.len() > 40, "{}", below.len());
+        for k in &below {
+            assert!(full.modes().iter().any(|f| key(f) == *k), "{k:?} missing");
+        }
+        assert!(full.modes().iter().all(|k| k.freq_hz < max_hz));
+        let al = d.membrane.air_loading;
+        assert!((air_share(al, crate::kit::BESSEL_J11) - (1.0 / (al * al) - 1.0)).abs() < 1e-12);
+        assert!(air_share(al, 10.0) < air_share(al, 5.0));
+    }
+
     /// With 200 modes the unlisted ones with nodal diameters come in rising frequency (the
     /// kettle moves the axisymmetric ones), all finite and positive.
     #[test]
