@@ -6,7 +6,7 @@
 //! simulation (`body`, `drum`) → sound and motion (`render`, `sound`); `io` reads and
 //! writes files. The modules are layered, each importing only those below it:
 //! `base` → `kit` → `score` → {`body`, `drum`} → {`mocap`, `sound`} → `motion` →
-//! {`render`, `io`} → `exports` → `app` → `cli` (ARCHITECTURE.md; `tests/architecture.rs`
+//! {`render`, `io`, `scene`} → `exports` → `app` → `cli` (ARCHITECTURE.md; `tests/architecture.rs`
 //! checks it).
 
 #[cfg(feature = "editor")]
@@ -21,5 +21,6 @@ pub mod kit;
 pub mod mocap;
 pub mod motion;
 pub mod render;
+pub mod scene;
 pub mod score;
 pub mod sound;

@@ -7,45 +7,19 @@
 
 mod common;
 
-use common::{root, settle};
-use egui_kittest::kittest::{NodeT, Queryable};
-use std::path::{Path, PathBuf};
-use std::sync::Arc;
-use timpanist::mocap::db::MotionDb;
-use timpanist::render::{RenderParams, render};
-use timpanist::score::LoadedScore;
-
-/// A copy of the improvisation score in `dir` (so the browser starts there, not in the
-/// repository).
-fn score_in(dir: &Path) -> PathBuf {
-    let path = dir.join("improvisation.ron");
-    std::fs::copy(root().join("scores/improvisation.ron"), &path).unwrap();
-    path
-}
+use common::settle;
+use egui_kittest::kittest::Queryable;
 
 #[test]
 fn file_menu_exports_a_lesson_pack_into_a_new_folder() {
     let dir = tempfile::tempdir().unwrap();
-    let score = score_in(dir.path());
-    let mut h = common::editor(Some(score.clone()), dir.path(), false);
-    settle(&mut h);
+    let (mut h, score) = common::editor_on_improvisation(dir.path());
     // Without a rendering the item is there but disabled.
-    h.get_by_label("File").click();
-    settle(&mut h);
     assert!(
-        h.get_by_label("Export lesson pack...")
-            .accesskit_node()
-            .is_disabled(),
+        common::file_item_disabled(&mut h, "Export lesson pack..."),
         "exportable with no rendering"
     );
-    h.get_by_label("File").click();
-    settle(&mut h);
-
-    let loaded = LoadedScore::load(&score).unwrap();
-    let db = MotionDb::load(&root().join("mocap")).unwrap();
-    let rendering = render(&loaded, &db, &RenderParams::default(), &mut |_| true).unwrap();
-    h.state_mut().set_rendering(Arc::new(rendering));
-    settle(&mut h);
+    common::give_rendering(&mut h, &score);
 
     h.get_by_label("File").click();
     settle(&mut h);

@@ -18,6 +18,7 @@ const FLOORS: &[(&str, u8)] = &[
     ("motion", 5),
     ("render", 6),
     ("io", 6),
+    ("scene", 6),
     ("exports", 7),
     ("app", 8),
     ("cli", 9),

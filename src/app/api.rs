@@ -224,6 +224,18 @@ impl EditorApp {
         self.export_to(Export::Glb, path);
     }
 
+    /// Film the current rendering into the video `path` (File > Export video): the 3D
+    /// view from the viewport's camera over the timeline, with the mix, through ffmpeg.
+    pub fn export_video_to(&mut self, path: &Path) {
+        self.export_to(Export::Video, path);
+    }
+
+    /// The video's frames as PNGs with the mix into the new folder `path` (File > Export
+    /// video frames).
+    pub fn export_video_frames_to(&mut self, path: &Path) {
+        self.export_to(Export::VideoFrames, path);
+    }
+
     /// Export the current rendering as a lesson pack into the new folder `path` (File >
     /// Export lesson pack).
     pub fn export_pack_to(&mut self, path: &Path) {

@@ -6,7 +6,9 @@
 //! as `timpanist render --glb`); and the score itself as a Standard MIDI File
 //! (`io::midi_export`, as `timpanist export-midi`); and the lesson pack (`io::pack`, as
 //! `timpanist export-pack`: a new folder with the audio, motion, MIDI, plots and an
-//! `index.html` handout). The rendered exports come through `crate::exports`, the same
+//! `index.html` handout); and the video (`exports::video`, as `render --video`: the 3D
+//! view from the viewport's camera over the timeline, with the mix, through ffmpeg) or
+//! its frames as PNGs with the mix (as `render --video-frames`, when there is no ffmpeg). The rendered exports come through `crate::exports`, the same
 //! code as the command line's. Each is written atomically (a temporary file or folder
 //! beside the target, renamed over it). The rendered exports are refused, with the
 //! reason, while the only rendering is of an older version of the score or there is none.
@@ -14,10 +16,13 @@
 use super::dialogs::{Purpose, Request};
 use crate::base::ron_file::{self, FileError};
 use crate::exports;
+use crate::exports::video::{self, VideoOptions};
 use crate::io::pack::{self, PackError};
+use crate::io::video::VideoError;
 use crate::io::{bvh, glb, midi_export};
 use crate::kit::Kit;
 use crate::render::Rendering;
+use crate::scene::camera::Camera;
 use crate::score::Score;
 use crate::sound::SoundError;
 use std::path::{Path, PathBuf};
@@ -39,17 +44,23 @@ pub enum Export {
     Midi,
     /// The lesson pack: a new folder with everything above and an HTML handout.
     Pack,
+    /// The 3D view over the timeline, with the mix, as video through ffmpeg.
+    Video,
+    /// The same frames as numbered PNGs in a new folder, with the mix (no ffmpeg needed).
+    VideoFrames,
 }
 
 impl Export {
     /// Every export, in menu order.
-    pub const ALL: [Export; 7] = [
+    pub const ALL: [Export; 9] = [
         Export::Wav,
         Export::Motion,
         Export::MotionC3d,
         Export::Bvh,
         Export::Glb,
         Export::Midi,
+        Export::Video,
+        Export::VideoFrames,
         Export::Pack,
     ];
 
@@ -63,6 +74,8 @@ impl Export {
             Export::Glb => "Export scene glTF...",
             Export::Midi => "Export MIDI...",
             Export::Pack => "Export lesson pack...",
+            Export::Video => "Export video...",
+            Export::VideoFrames => "Export video frames (PNG + WAV)...",
         }
     }
 
@@ -77,6 +90,8 @@ impl Export {
             Export::Midi => ("Standard MIDI File", &["mid"]),
             // A new folder: no file extension, so the dialogs list folders only.
             Export::Pack => ("lesson pack folder", &[]),
+            Export::Video => ("video", &["mp4", "mov", "mkv"]),
+            Export::VideoFrames => ("video frames folder", &[]),
         }
     }
 
@@ -90,6 +105,8 @@ impl Export {
             Export::Glb => format!("{stem}.glb"),
             Export::Midi => format!("{stem}.mid"),
             Export::Pack => format!("{stem}-lesson"),
+            Export::Video => format!("{stem}.mp4"),
+            Export::VideoFrames => format!("{stem}-frames"),
         }
     }
 
@@ -161,15 +178,22 @@ pub enum ExportError {
     },
     #[error("cannot export the lesson pack: {0}")]
     Pack(#[from] PackError),
+    #[error("cannot export to {}: {source}", path.display())]
+    Video {
+        path: PathBuf,
+        #[source]
+        source: VideoError,
+    },
 }
 
-/// Write `what` of the score (played on `kit`) or of its `rendering` to `path`; a line
-/// for the status bar, or why it failed.
+/// Write `what` of the score (played on `kit`) or of its `rendering` to `path` (a video
+/// seen from `camera`); a line for the status bar, or why it failed.
 pub fn write(
     what: Export,
     (score, kit): (&Score, &Kit),
     rendering: Option<&Rendering>,
     path: &Path,
+    camera: Camera,
 ) -> Result<String, ExportError> {
     let failed = |source| ExportError::File {
         path: path.to_path_buf(),
@@ -240,6 +264,38 @@ pub fn write(
         Export::Motion => {
             ron_file::write_atomic(path, performance.motion_csv().as_bytes()).map_err(failed)?;
             Ok(samples)
+        }
+        Export::Video | Export::VideoFrames => {
+            let options = VideoOptions {
+                camera,
+                ..VideoOptions::default()
+            };
+            let failed = |source| ExportError::Video {
+                path: path.to_path_buf(),
+                source,
+            };
+            let mut go_on = |_, _| true;
+            if what == Export::Video {
+                let spec = video::write_video(rendering, score, options, path, &mut go_on)
+                    .map_err(failed)?;
+                Ok(format!(
+                    "exported {} ({} frames at {} fps, {:.1} s, with the mix)",
+                    path.display(),
+                    spec.frames,
+                    spec.fps,
+                    spec.duration_s()
+                ))
+            } else {
+                let (dir, spec) =
+                    video::write_frames(rendering, score, options, path, false, &mut go_on)
+                        .map_err(failed)?;
+                Ok(format!(
+                    "exported {} PNG frames at {} fps, audio.wav and join.sh into {}",
+                    spec.frames,
+                    spec.fps,
+                    dir.display()
+                ))
+            }
         }
         Export::Pack => {
             let written = pack::write(&performance, path, &pack::Options::default(), &mut |_| {})?;

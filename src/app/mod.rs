@@ -9,7 +9,6 @@
 
 mod actions;
 mod api;
-mod camera;
 mod chrome;
 mod clipboard;
 mod command;
@@ -44,7 +43,7 @@ mod transport;
 mod viewport;
 mod worker;
 
-pub use camera::Camera;
+pub use crate::scene::camera::Camera;
 pub use export::Export;
 pub use files::{FileKind, kind_of};
 pub use keys::Action;

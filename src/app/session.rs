@@ -235,8 +235,9 @@ impl EditorApp {
         let rendering = self.pipeline.rendering().map(|(r, _)| r.clone());
         let target = path.to_path_buf();
         let label = format!("exporting {}", path.display());
+        let camera = self.views.viewport.camera;
         self.jobs.spawn(label, Done::Exported, move || {
-            export::write(what, (&score, &kit), rendering.as_deref(), &target)
+            export::write(what, (&score, &kit), rendering.as_deref(), &target, camera)
         });
     }
 

@@ -6,35 +6,30 @@
 //! drag a handle to move it (in the view plane, or along x/y/z while X/Y/Z is held),
 //! right-click removes it; drag an impact to pin it on the head (right-click unpins).
 
-use super::camera::{Camera, Projector};
 use super::command::Command;
 use super::picking::{drag_along_axis, drag_in_plane, pick_polyline};
 use super::selection::Selection;
 use crate::body::model::BodyModel;
-use crate::body::skeleton::{JOINT_COUNT, Joint, Pose};
+use crate::body::skeleton::Pose;
 use crate::drum::DrumSet;
-use crate::kit::{Drum, Side};
+use crate::kit::Side;
 use crate::mocap::db::side_index;
 use crate::motion::compose::Composition;
+use crate::scene::camera::{Camera, Projector};
+use crate::scene::marks::{Anchor, HAND_COLOURS, Mark, Rgba};
+use crate::scene::stage;
 use crate::score::edit::ScoreEdit;
 use crate::score::{Handle, ImpactPin, LoadedScore};
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::{DVec2, DVec3};
 
 /// Colour of each hand's composed (target) trajectory, [left, right].
-pub const TARGET_COLOURS: [Color32; 2] = [
-    Color32::from_rgb(60, 150, 230),
-    Color32::from_rgb(240, 140, 40),
-];
+pub const TARGET_COLOURS: [Color32; 2] = [colour32(HAND_COLOURS[0]), colour32(HAND_COLOURS[1])];
 /// Colour of each hand's simulated trajectory, [left, right].
 pub const SIMULATED_COLOURS: [Color32; 2] = [
     Color32::from_rgb(120, 230, 230),
     Color32::from_rgb(250, 220, 90),
 ];
-
-/// How much the membranes' motion is magnified in the view (a loud strike moves the
-/// head a millimetre or two).
-pub const MEMBRANE_MAGNIFICATION: f64 = 150.0;
 
 /// Vertical displacement of drum `index`'s head at `point` (performer frame) at score
 /// time `time_s`, m, as recorded by the rendering in `drums`; zero without one.
@@ -154,17 +149,19 @@ impl Viewport {
 
         let proj = self.camera.projector(size);
         let painter = ui.painter_at(rect);
-        painter.rect_filled(rect, 4.0, Color32::from_rgb(28, 30, 36));
-        draw_floor(&painter, rect, &proj);
+        painter.rect_filled(rect, 4.0, colour32(stage::BACKGROUND));
+        let mut marks = Vec::new();
+        stage::floor(&proj, &mut marks);
         // Drums first: the body and sticks are above the heads, which are translucent.
         let kit = input.doc.score.settings.kit(&input.doc.kit);
         for (index, drum) in kit.drums.iter().enumerate() {
             let membrane = |p: DVec3| head_displacement(input.drums, index, input.time_s, p);
-            draw_drum(&painter, rect, &proj, drum, &membrane);
+            stage::drum(&proj, drum, &membrane, &mut marks);
         }
         if let Some(pose) = input.pose {
-            self.draw_body(&painter, rect, &proj, pose);
+            stage::body(&proj, &self.body, pose, &mut marks);
         }
+        paint_marks(&painter, rect, &marks);
         if let Some(comp) = input.composition {
             self.update_cache(comp, input.generation, size, &proj);
             self.draw_trajectories(&painter, rect, &proj, comp, input);
@@ -314,41 +311,6 @@ impl Viewport {
                     painter.circle_filled(to_pos(rect, q), 5.0, TARGET_COLOURS[h]);
                 }
             }
-        }
-    }
-
-    fn draw_body(&self, painter: &egui::Painter, rect: Rect, proj: &Projector, pose: &Pose) {
-        let frames = self.body.skeleton.forward(pose);
-        let mut capsules: Vec<(f64, Pos2, Pos2, f32, Color32)> = Vec::with_capacity(JOINT_COUNT);
-        for j in Joint::ALL {
-            let seg = &self.body.segments[j.index()];
-            let a = frames.position[j.index()];
-            let b = a + frames.rotation[j.index()] * seg.axis_m;
-            let (Some((pa, za)), Some((pb, zb))) = (proj.project(a), proj.project(b)) else {
-                continue;
-            };
-            let depth = 0.5 * (za + zb);
-            let width = (2.0 * seg.radius_m * proj.scale_at(depth)) as f32;
-            let stick = matches!(j, Joint::GripL | Joint::GripR);
-            let colour = if stick {
-                Color32::from_rgb(190, 150, 100)
-            } else {
-                let shade = (215.0 - 25.0 * depth).clamp(120.0, 210.0) as u8;
-                Color32::from_rgb(shade, shade.saturating_sub(20), shade.saturating_sub(35))
-            };
-            capsules.push((
-                depth,
-                to_pos(rect, pa),
-                to_pos(rect, pb),
-                width.max(1.5),
-                colour,
-            ));
-        }
-        capsules.sort_by(|a, b| b.0.total_cmp(&a.0));
-        for (_, a, b, w, colour) in capsules {
-            painter.line_segment([a, b], Stroke::new(w, colour));
-            painter.circle_filled(a, 0.5 * w, colour);
-            painter.circle_filled(b, 0.5 * w, colour);
         }
     }
 
@@ -607,96 +569,63 @@ fn pick_impact(comp: &Composition, proj: &Projector, p: DVec2, time_s: f64) -> O
         .map(|(s, _)| s)
 }
 
-fn draw_floor(painter: &egui::Painter, rect: Rect, proj: &Projector) {
-    let stroke = Stroke::new(0.6, Color32::from_gray(60));
-    let line = |a: DVec3, b: DVec3| {
-        if let (Some((pa, _)), Some((pb, _))) = (proj.project(a), proj.project(b)) {
-            painter.line_segment([to_pos(rect, pa), to_pos(rect, pb)], stroke);
-        }
-    };
-    for k in 0..=12 {
-        let x = -1.5 + 0.25 * f64::from(k);
-        line(DVec3::new(x, -0.75, 0.0), DVec3::new(x, 1.75, 0.0));
-    }
-    for k in 0..=10 {
-        let y = -0.75 + 0.25 * f64::from(k);
-        line(DVec3::new(-1.5, y, 0.0), DVec3::new(1.5, y, 0.0));
-    }
-}
-
-/// A drum: kettle, head (translucent) and, on the head, rings and spokes lifted by
-/// `membrane` (the head's displacement at a point, m, magnified).
-fn draw_drum(
-    painter: &egui::Painter,
-    rect: Rect,
-    proj: &Projector,
-    drum: &Drum,
-    membrane: &dyn Fn(DVec3) -> f64,
-) {
-    const N: usize = 48;
-    let centre = DVec3::new(
-        drum.placement.x_m,
-        drum.placement.y_m,
-        drum.placement.head_height_m,
-    );
-    let r = 0.5 * drum.diameter_m;
-    let on_head = |a: f64, scale: f64| {
-        let mut p = centre + DVec3::new(a.cos(), a.sin(), 0.0) * r * scale;
-        p.z += (MEMBRANE_MAGNIFICATION * membrane(p)).clamp(-0.05, 0.05);
-        proj.project(p).map(|(q, _)| to_pos(rect, q))
-    };
-    let ring = |z_drop: f64, scale: f64| -> Option<Vec<Pos2>> {
-        (0..N)
-            .map(|k| {
-                let a = std::f64::consts::TAU * k as f64 / N as f64;
-                let p = centre + DVec3::new(a.cos(), a.sin(), 0.0) * r * scale - DVec3::Z * z_drop;
-                proj.project(p).map(|(q, _)| to_pos(rect, q))
-            })
-            .collect()
-    };
-    let kettle = Color32::from_rgb(150, 110, 60);
-    if let Some(bowl) = ring(0.55 * drum.diameter_m, 0.45) {
-        painter.add(Shape::closed_line(bowl.clone(), Stroke::new(1.0, kettle)));
-        if let Some(head) = ring(0.0, 1.0) {
-            for k in (0..N).step_by(6) {
-                painter.line_segment(
-                    [head[k], bowl[k]],
-                    Stroke::new(1.0, kettle.gamma_multiply(0.7)),
+/// Paint scene marks (pixels from the viewport's corner) with egui.
+pub fn paint_marks(painter: &egui::Painter, rect: Rect, marks: &[Mark]) {
+    for mark in marks {
+        match mark {
+            Mark::Line {
+                points,
+                closed,
+                width,
+                colour,
+            } => {
+                let pts: Vec<Pos2> = points.iter().map(|p| to_pos(rect, *p)).collect();
+                let stroke = Stroke::new(*width, colour32(*colour));
+                painter.add(if *closed {
+                    Shape::closed_line(pts, stroke)
+                } else {
+                    Shape::line(pts, stroke)
+                });
+            }
+            Mark::Fill { points, colour } => {
+                let pts: Vec<Pos2> = points.iter().map(|p| to_pos(rect, *p)).collect();
+                painter.add(Shape::convex_polygon(pts, colour32(*colour), Stroke::NONE));
+            }
+            Mark::Disc {
+                centre,
+                radius,
+                colour,
+            } => {
+                painter.circle_filled(to_pos(rect, *centre), *radius, colour32(*colour));
+            }
+            Mark::Label {
+                at,
+                anchor,
+                text,
+                size,
+                colour,
+            } => {
+                let align = match anchor {
+                    Anchor::LeftTop => egui::Align2::LEFT_TOP,
+                    Anchor::LeftCentre => egui::Align2::LEFT_CENTER,
+                    Anchor::Centre => egui::Align2::CENTER_CENTER,
+                    Anchor::RightTop => egui::Align2::RIGHT_TOP,
+                    Anchor::LeftBottom => egui::Align2::LEFT_BOTTOM,
+                };
+                painter.text(
+                    to_pos(rect, *at),
+                    align,
+                    text,
+                    egui::FontId::proportional(*size),
+                    colour32(*colour),
                 );
             }
         }
     }
-    if let Some(head) = ring(0.0, 1.0) {
-        painter.add(Shape::convex_polygon(
-            head,
-            Color32::from_rgba_unmultiplied(225, 215, 190, 170),
-            Stroke::new(1.5, kettle),
-        ));
-    }
-    // The membrane: three rings and eight spokes over the head (the rim is fixed).
-    let grid = Stroke::new(1.0, Color32::from_rgba_unmultiplied(120, 100, 70, 150));
-    for scale in [0.25, 0.5, 0.75] {
-        let points: Option<Vec<Pos2>> = (0..N)
-            .map(|k| on_head(std::f64::consts::TAU * k as f64 / N as f64, scale))
-            .collect();
-        if let Some(points) = points {
-            painter.add(Shape::closed_line(points, grid));
-        }
-    }
-    for k in 0..8 {
-        let a = std::f64::consts::TAU * f64::from(k) / 8.0;
-        let points: Option<Vec<Pos2>> = (0..=8).map(|i| on_head(a, f64::from(i) / 8.0)).collect();
-        if let Some(points) = points {
-            painter.add(Shape::line(points, grid));
-        }
-    }
-    if let Some((q, _)) = proj.project(centre) {
-        painter.text(
-            to_pos(rect, q),
-            egui::Align2::CENTER_CENTER,
-            &drum.name,
-            egui::FontId::proportional(10.0),
-            Color32::from_gray(60),
-        );
-    }
+}
+
+/// A scene colour as egui's.
+pub const fn colour32(c: Rgba) -> Color32 {
+    let [r, g, b, a] = c.0;
+    Color32::from_rgba_unmultiplied_const(r, g, b, a)
 }

@@ -87,6 +87,25 @@ arg_enum!(SoundArg => crate::sound::SoundModel {
     Signal => crate::sound::SoundModel::Signal,
 });
 
+/// `render --video-fps`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum VideoFpsArg {
+    #[value(name = "30")]
+    Fps30,
+    #[value(name = "60")]
+    Fps60,
+}
+
+impl VideoFpsArg {
+    /// Frames per second.
+    pub fn fps(self) -> u32 {
+        match self {
+            VideoFpsArg::Fps30 => 30,
+            VideoFpsArg::Fps60 => 60,
+        }
+    }
+}
+
 /// `render --bvh-rate`: the task rate or a video rate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum BvhRateArg {

@@ -5,11 +5,11 @@
 //! playing mode is completed from the shipped synthetic one, and the beats played with a
 //! unit of other labels than asked are told as notes (`super::compose`).
 
-use super::args::{BvhRateArg, BvhUnitsArg, ControlArg, SoundArg, WavFormatArg};
+use super::args::{BvhRateArg, BvhUnitsArg, ControlArg, SoundArg, VideoFpsArg, WavFormatArg};
 use crate::base::ron_file;
 use crate::body::sim::Pipeline;
 use crate::exports;
-use crate::io::{bvh, figures};
+use crate::io::{bvh, figures, video};
 use crate::mocap::shipped::DbSource;
 use crate::motion::plan::{self, PlanParams};
 use crate::render::{Progress, RenderParams, Rendering, render, strikes};
@@ -64,6 +64,61 @@ pub struct ExportArgs {
     /// Send the OSC messages as the hits sound (paced in real time) instead of at once.
     #[arg(long, requires = "osc")]
     pub osc_realtime: bool,
+    /// Also film the performance: the 3D view over the timeline with its playhead, with
+    /// the mix, as H.264/AAC video (.mp4, .mov or .mkv) through the system's ffmpeg.
+    #[arg(long)]
+    pub video: Option<PathBuf>,
+    /// Without ffmpeg: write the video's frames as numbered PNGs into this new folder,
+    /// with the mix as audio.wav and join.sh, the ffmpeg command that joins them.
+    #[arg(long, value_name = "DIR")]
+    pub video_frames: Option<PathBuf>,
+    /// Video frames per second.
+    #[arg(long, value_enum, default_value = "30")]
+    pub video_fps: VideoFpsArg,
+    /// Video frame size, WIDTHxHEIGHT px (even sides, 64–4096).
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    pub video_size: (u32, u32),
+}
+
+/// `--video-size`: "WIDTHxHEIGHT".
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("{s:?}: give WIDTHxHEIGHT, e.g. 1280x720"))?;
+    let side = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|v| (64..=4096).contains(v) && v.is_multiple_of(2))
+            .ok_or_else(|| format!("{v:?}: each side must be an even number of px, 64-4096"))
+    };
+    Ok((side(w)?, side(h)?))
+}
+
+impl ExportArgs {
+    /// How a video is to look.
+    fn video_options(&self) -> exports::video::VideoOptions {
+        exports::video::VideoOptions {
+            width: self.video_size.0,
+            height: self.video_size.1,
+            fps: self.video_fps.fps(),
+            ..Default::default()
+        }
+    }
+
+    /// Refuse, before rendering, a video that could not be written (no ffmpeg, an
+    /// unknown container, a frames folder that holds something).
+    fn check_video(&self) -> anyhow::Result<()> {
+        if let Some(path) = &self.video {
+            video::check_target(path)?;
+            let version = video::ffmpeg_version()?;
+            eprintln!("video through {version}");
+        }
+        if let Some(dir) = &self.video_frames {
+            crate::io::pack::folder::check(dir, false)?;
+        }
+        Ok(())
+    }
 }
 
 /// How to render, as `render` and `export-pack` take it on the command line.
@@ -183,6 +238,7 @@ pub fn run(
         .as_ref()
         .map(super::osc::connect)
         .transpose()?;
+    outputs.exports.check_video()?;
     let (loaded, rendering, wall) = rendered(score, source, choices)?;
     let ex = outputs.exports;
     let performance = exports::performance(&rendering, &loaded.score);
@@ -302,6 +358,7 @@ pub fn run(
             rendering.start_s
         );
     }
+    film(&rendering, &loaded.score, ex)?;
     if choices.stats {
         print_stats(&rendering);
     }
@@ -309,6 +366,45 @@ pub fn run(
         let sent = super::osc::send(&socket, &hits, ex.osc_realtime)?;
         println!("sent {sent} OSC hits to {}", socket.peer_addr()?);
     }
+    Ok(())
+}
+
+/// `--video` and `--video-frames`, with a progress bar.
+fn film(rendering: &Rendering, score: &crate::score::Score, ex: &ExportArgs) -> anyhow::Result<()> {
+    let options = ex.video_options();
+    let mut bar = ProgressBar::new();
+    let mut progress = |done: u64, total: u64| {
+        bar.show(Progress {
+            stage: "filming the video",
+            fraction: done as f64 / total.max(1) as f64,
+        });
+        true
+    };
+    if let Some(path) = &ex.video {
+        let spec = exports::video::write_video(rendering, score, options, path, &mut progress)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        println!(
+            "{}: {} frames at {} fps ({:.2} s), {}x{}, with the mix",
+            path.display(),
+            spec.frames,
+            spec.fps,
+            spec.duration_s(),
+            spec.width,
+            spec.height
+        );
+    }
+    if let Some(dir) = &ex.video_frames {
+        let (written, spec) =
+            exports::video::write_frames(rendering, score, options, dir, false, &mut progress)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", dir.display()))?;
+        println!(
+            "{}: {} PNG frames at {} fps, audio.wav and join.sh (ffmpeg joins them)",
+            written.display(),
+            spec.frames,
+            spec.fps
+        );
+    }
+    bar.finish();
     Ok(())
 }
 

@@ -3,7 +3,10 @@
 //! from which every rendered export and the lesson pack (`io::pack`) are written. `io`
 //! sits beside `render` and never names a rendering; `timpanist render`, `timpanist
 //! export-pack` and the editor's File > Export all come through here, so each file is
-//! made by one code path (the methods of `Performance`, and `io::pack::write`).
+//! made by one code path (the methods of `Performance`, and `io::pack::write`). The video
+//! (`video`) is filmed here too: it draws the rendering through `scene`.
+
+pub mod video;
 
 use crate::io::midi_performed::ForceScale;
 use crate::io::performance::{Contact, Performance};

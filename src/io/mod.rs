@@ -23,4 +23,5 @@ pub mod pack;
 pub mod performance;
 pub mod plot;
 pub mod tips_csv;
+pub mod video;
 pub mod y_up;

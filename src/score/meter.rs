@@ -83,6 +83,11 @@ impl MeterMap {
         }
     }
 
+    /// Ticks per quarter note of the score it maps.
+    pub fn ticks_per_quarter(&self) -> u32 {
+        self.ticks_per_quarter
+    }
+
     /// The tick where `bar` (from 1) starts.
     pub fn bar_start(&self, bar: u64) -> u64 {
         let i = self.spans.partition_point(|s| s.0 <= bar).saturating_sub(1);

@@ -7,6 +7,9 @@ use eframe::egui;
 use egui_kittest::{Harness, HarnessBuilder};
 use std::path::{Path, PathBuf};
 use timpanist::app::{EditorApp, EditorOptions};
+use timpanist::mocap::db::MotionDb;
+use timpanist::render::{RenderParams, render};
+use timpanist::score::LoadedScore;
 
 /// The repository (the tests run from it: the motion database is found there).
 pub fn root() -> &'static Path {
@@ -80,4 +83,34 @@ pub fn steady_timeline_point(
         point = now;
     }
     point.expect("the timeline has been drawn")
+}
+
+/// The editor on a copy of the improvisation score in `dir` (so the file browser starts
+/// there), not rendering by itself, and that copy's path.
+pub fn editor_on_improvisation(dir: &Path) -> (Harness<'static, EditorApp>, PathBuf) {
+    let score = dir.join("improvisation.ron");
+    std::fs::copy(root().join("scores/improvisation.ron"), &score).unwrap();
+    let mut h = editor(Some(score.clone()), dir, false);
+    settle(&mut h);
+    (h, score)
+}
+
+/// Render `score` with the defaults and hand the rendering to the editor.
+pub fn give_rendering(h: &mut Harness<'static, EditorApp>, score: &Path) {
+    let loaded = LoadedScore::load(score).unwrap();
+    let db = MotionDb::load(&root().join("mocap")).unwrap();
+    let rendering = render(&loaded, &db, &RenderParams::default(), &mut |_| true).unwrap();
+    h.state_mut().set_rendering(std::sync::Arc::new(rendering));
+    settle(h);
+}
+
+/// Whether the File menu item `label` is disabled (opens and closes the menu).
+pub fn file_item_disabled(h: &mut Harness<'static, EditorApp>, label: &str) -> bool {
+    use egui_kittest::kittest::{NodeT, Queryable};
+    h.get_by_label("File").click();
+    settle(h);
+    let disabled = h.get_by_label(label).accesskit_node().is_disabled();
+    h.get_by_label("File").click();
+    settle(h);
+    disabled
 }
