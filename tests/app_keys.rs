@@ -152,3 +152,33 @@ fn drag_impact_pins_it() {
     assert!((pins[0].point_m[0] - impact.x).abs() > 0.005);
     assert_eq!(h.state().undo_steps(), 1);
 }
+
+/// F7 moves the 3D camera to the side view over a few frames (between on the way, exactly
+/// there at the end); the View menu's "Camera: top" item does the same for the top view.
+#[test]
+fn camera_views_from_keys_and_menu() {
+    use timpanist::app::Camera;
+    use timpanist::scene::camera::View;
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(dir.path());
+    let start = h.state().camera();
+    assert_eq!(start, Camera::default());
+    h.key_press(egui::Key::F7);
+    let side = Camera::of_view(View::Side);
+    let mut seen = Vec::new();
+    for _ in 0..4 {
+        h.step();
+        seen.push(h.state().camera());
+    }
+    assert!(
+        seen.iter().any(|c| *c != start && *c != side),
+        "the move was a jump: {seen:?}"
+    );
+    h.run();
+    assert_eq!(h.state().camera(), side);
+    h.get_by_label("View").click();
+    h.run();
+    h.get_by_label("Camera: top  (F8)").click();
+    h.run();
+    assert_eq!(h.state().camera(), Camera::of_view(View::Top));
+}

@@ -53,13 +53,20 @@ fn field<'a>(probe: &'a str, key: &str) -> Vec<&'a str> {
 fn render_video_probes_with_rate_size_duration_and_audio() {
     let dir = tempfile::tempdir().unwrap();
     let (wav, mp4) = (dir.path().join("mix.wav"), dir.path().join("etude.mp4"));
-    for (fps, size) in [("30", "640x360"), ("60", "320x180")] {
+    for (fps, size, camera) in [("30", "640x360", "editor"), ("60", "320x180", "side")] {
         let out = timpanist()
             .args(["render", "scores/improvisation.ron", "--wav"])
             .arg(&wav)
             .arg("--video")
             .arg(&mp4)
-            .args(["--video-fps", fps, "--video-size", size])
+            .args([
+                "--video-fps",
+                fps,
+                "--video-size",
+                size,
+                "--video-camera",
+                camera,
+            ])
             .output()
             .unwrap();
         let stdout = String::from_utf8_lossy(&out.stdout);

@@ -59,6 +59,10 @@ impl EditorApp {
                 self.save(true);
             }
             Action::ToggleHelp => self.views.show_help = !self.views.show_help,
+            Action::CameraView(view) => {
+                let now = self.ctx.as_ref().map_or(0.0, |c| c.input(|i| i.time));
+                self.views.viewport.go_to(view, now);
+            }
             Action::TogglePreferences => self.settings.window_open = !self.settings.window_open,
             Action::ClearSelection => {
                 if let Some(d) = &mut self.doc {

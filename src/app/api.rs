@@ -7,7 +7,7 @@ use super::export::{self, Export};
 use super::playback::{Playback, PlaybackError};
 use super::renderer::Rendered;
 use super::selection::{self, Selection};
-use super::{EditorApp, PlotTab, Simulated, tape};
+use super::{Camera, EditorApp, PlotTab, Simulated, tape};
 use crate::motion::compose::Composition;
 use crate::render::Rendering;
 use crate::score::{Hand, LoadedScore};
@@ -222,6 +222,11 @@ impl EditorApp {
     /// Export the current rendering as a glTF scene at `path` (File > Export scene glTF).
     pub fn export_glb_to(&mut self, path: &Path) {
         self.export_to(Export::Glb, path);
+    }
+
+    /// The 3D view's camera as it is now.
+    pub fn camera(&self) -> Camera {
+        self.views.viewport.camera
     }
 
     /// Film the current rendering into the video `path` (File > Export video): the 3D

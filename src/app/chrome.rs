@@ -122,6 +122,15 @@ impl EditorApp {
                 if ui.button("Reset the 3D camera").clicked() {
                     self.views.viewport.camera = Camera::default();
                 }
+                for shortcut in super::keys::SHORTCUTS {
+                    if let Action::CameraView(view) = shortcut.action
+                        && ui
+                            .button(format!("Camera: {}  ({})", view.name(), shortcut.label))
+                            .clicked()
+                    {
+                        self.pending.push(Command::Do(shortcut.action));
+                    }
+                }
                 ui.checkbox(&mut self.views.timeline.snap, "Snap to grid");
             });
             ui.menu_button("Help", |ui| {

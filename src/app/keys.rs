@@ -1,6 +1,7 @@
 //! Keyboard shortcuts: one table from key chords to editor actions, read both by the
 //! frame's input handling and by the help overlay (so the overlay never lies).
 
+use crate::scene::camera::View;
 use crate::score::PlayingMode;
 use eframe::egui::{self, Key, Modifiers};
 
@@ -27,6 +28,8 @@ pub enum Action {
     ToggleHelp,
     TogglePreferences,
     ClearSelection,
+    /// Move the 3D camera to a named view.
+    CameraView(View),
 }
 
 /// A key chord and what it does; `label` is how the help overlay shows it.
@@ -60,6 +63,34 @@ const NONE: Modifiers = Modifiers::NONE;
 
 /// Every shortcut. More specific chords (with Shift) come before their plain forms.
 pub const SHORTCUTS: &[Shortcut] = &[
+    chord(
+        NONE,
+        Key::F5,
+        Action::CameraView(View::Player),
+        "F5",
+        "3D view: over the player's shoulder",
+    ),
+    chord(
+        NONE,
+        Key::F6,
+        Action::CameraView(View::Front),
+        "F6",
+        "3D view: from the front",
+    ),
+    chord(
+        NONE,
+        Key::F7,
+        Action::CameraView(View::Side),
+        "F7",
+        "3D view: from the side",
+    ),
+    chord(
+        NONE,
+        Key::F8,
+        Action::CameraView(View::Top),
+        "F8",
+        "3D view: from above",
+    ),
     chord(
         NONE,
         Key::Space,

@@ -15,7 +15,7 @@ use crate::drum::DrumSet;
 use crate::kit::Side;
 use crate::mocap::db::side_index;
 use crate::motion::compose::Composition;
-use crate::scene::camera::{Camera, Projector};
+use crate::scene::camera::{Camera, MOVE_S, Projector, View};
 use crate::scene::marks::{Anchor, HAND_COLOURS, Mark, Rgba};
 use crate::scene::stage;
 use crate::score::edit::ScoreEdit;
@@ -80,6 +80,8 @@ struct Projected {
 #[derive(Default)]
 pub struct Viewport {
     pub camera: Camera,
+    /// A move to a named view in progress: from, to, and when it started (egui time, s).
+    moving: Option<(Camera, Camera, f64)>,
     body: BodyModel,
     drag: Option<Drag>,
     cache: Option<Projected>,
@@ -111,6 +113,24 @@ fn sample_of(comp: &Composition, t: f64) -> usize {
 }
 
 impl Viewport {
+    /// Move the camera to `view` over [`MOVE_S`], starting at egui time `now_s`.
+    pub fn go_to(&mut self, view: View, now_s: f64) {
+        self.moving = Some((self.camera, Camera::of_view(view), now_s));
+    }
+
+    /// Advance a move in progress to egui time `now_s`; whether it is still moving.
+    pub fn animate(&mut self, now_s: f64) -> bool {
+        let Some((from, to, start)) = self.moving else {
+            return false;
+        };
+        let s = (now_s - start) / MOVE_S;
+        self.camera = from.toward(&to, s);
+        if s >= 1.0 {
+            self.moving = None;
+        }
+        self.moving.is_some()
+    }
+
     /// The body model drawn.
     pub fn body(&self) -> &BodyModel {
         &self.body
@@ -132,6 +152,9 @@ impl Viewport {
         out: &mut Vec<Command>,
     ) {
         self.rect = Some(rect);
+        if self.animate(ui.input(|i| i.time)) {
+            ui.ctx().request_repaint();
+        }
         let resp = ui.interact(
             rect,
             ui.make_persistent_id("viewport-3d"),
@@ -141,6 +164,7 @@ impl Viewport {
         if resp.hovered() {
             let scroll = ui.input(|i| i.smooth_scroll_delta.y + (i.zoom_delta() - 1.0) * 200.0);
             if scroll != 0.0 {
+                self.moving = None;
                 self.camera.zoom((-f64::from(scroll) * 0.002).exp());
             }
         }
@@ -359,8 +383,14 @@ impl Viewport {
             });
             let camera = self.camera;
             match &mut self.drag {
-                Some(Drag::Orbit) => self.camera.orbit(d),
-                Some(Drag::Pan) => self.camera.pan(d, size.y),
+                Some(Drag::Orbit) => {
+                    self.moving = None;
+                    self.camera.orbit(d);
+                }
+                Some(Drag::Pan) => {
+                    self.moving = None;
+                    self.camera.pan(d, size.y);
+                }
                 Some(Drag::Handle {
                     index,
                     anchor,

@@ -106,6 +106,32 @@ impl VideoFpsArg {
     }
 }
 
+/// `render --video-camera`: the editor's default camera or a named view.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum VideoCameraArg {
+    /// The editor's default camera (in front, to the right, above).
+    Editor,
+    /// Over the player's shoulder.
+    Player,
+    Front,
+    Side,
+    Top,
+}
+
+impl VideoCameraArg {
+    /// The camera.
+    pub fn camera(self) -> crate::scene::camera::Camera {
+        use crate::scene::camera::{Camera, View};
+        match self {
+            VideoCameraArg::Editor => Camera::default(),
+            VideoCameraArg::Player => Camera::of_view(View::Player),
+            VideoCameraArg::Front => Camera::of_view(View::Front),
+            VideoCameraArg::Side => Camera::of_view(View::Side),
+            VideoCameraArg::Top => Camera::of_view(View::Top),
+        }
+    }
+}
+
 /// `render --bvh-rate`: the task rate or a video rate.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum BvhRateArg {

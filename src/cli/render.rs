@@ -5,7 +5,9 @@
 //! playing mode is completed from the shipped synthetic one, and the beats played with a
 //! unit of other labels than asked are told as notes (`super::compose`).
 
-use super::args::{BvhRateArg, BvhUnitsArg, ControlArg, SoundArg, VideoFpsArg, WavFormatArg};
+use super::args::{
+    BvhRateArg, BvhUnitsArg, ControlArg, SoundArg, VideoCameraArg, VideoFpsArg, WavFormatArg,
+};
 use crate::base::ron_file;
 use crate::body::sim::Pipeline;
 use crate::exports;
@@ -78,6 +80,9 @@ pub struct ExportArgs {
     /// Video frame size, WIDTHxHEIGHT px (even sides, 64–4096).
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub video_size: (u32, u32),
+    /// Where the video looks from: the editor's default camera or a named view.
+    #[arg(long, value_enum, default_value = "editor")]
+    pub video_camera: VideoCameraArg,
 }
 
 /// `--video-size`: "WIDTHxHEIGHT".
@@ -102,7 +107,7 @@ impl ExportArgs {
             width: self.video_size.0,
             height: self.video_size.1,
             fps: self.video_fps.fps(),
-            ..Default::default()
+            camera: self.video_camera.camera(),
         }
     }
 

@@ -3,6 +3,7 @@
 //! viewport's pixels and the inverse (a pixel's viewing ray) — pure math, no egui.
 
 use glam::{DVec2, DVec3};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// An orbit camera.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -110,6 +111,75 @@ impl Camera {
     }
 }
 
+/// The named views the camera can jump to (a teacher's usual angles on the player).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum View {
+    /// Over the player's shoulder, looking at the drums as they see them.
+    Player,
+    /// In front of the player, across the drums.
+    Front,
+    /// From the player's right.
+    Side,
+    /// From above.
+    Top,
+}
+
+impl View {
+    /// Every view, in menu order.
+    pub const ALL: [View; 4] = [View::Player, View::Front, View::Side, View::Top];
+
+    /// The view's name in menus and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            View::Player => "player's view",
+            View::Front => "front",
+            View::Side => "side",
+            View::Top => "top",
+        }
+    }
+}
+
+/// How long a move to a named view takes in the editor, s.
+pub const MOVE_S: f64 = 0.4;
+
+impl Camera {
+    /// The camera of a named view (the default target and field of view).
+    pub fn of_view(view: View) -> Camera {
+        let (yaw, pitch, distance, target) = match view {
+            View::Player => (PI - 0.45, 0.85, 1.9, DVec3::new(0.0, 0.5, 0.75)),
+            View::Front => (0.0, 0.3, 2.8, Camera::default().target),
+            View::Side => (FRAC_PI_2, 0.2, 2.8, Camera::default().target),
+            View::Top => (0.0, 1.45, 2.8, DVec3::new(0.0, 0.35, 0.8)),
+        };
+        Camera {
+            target,
+            yaw,
+            pitch,
+            distance,
+            ..Camera::default()
+        }
+    }
+
+    /// The camera a fraction `s` (0–1) of the way from `self` to `to`, eased in and out:
+    /// target and distance straight, yaw the shorter way round.
+    pub fn toward(&self, to: &Camera, s: f64) -> Camera {
+        if s >= 1.0 {
+            return *to;
+        }
+        let s = s.max(0.0);
+        let e = s * s * (3.0 - 2.0 * s);
+        let turn = (to.yaw - self.yaw + PI).rem_euclid(TAU) - PI;
+        let mix = |a: f64, b: f64| a + (b - a) * e;
+        Camera {
+            target: self.target.lerp(to.target, e),
+            yaw: self.yaw + turn * e,
+            pitch: mix(self.pitch, to.pitch),
+            distance: mix(self.distance, to.distance),
+            fov_y: mix(self.fov_y, to.fov_y),
+        }
+    }
+}
+
 /// Projection with a precomputed basis.
 #[derive(Clone, Copy, Debug)]
 pub struct Projector {
@@ -145,6 +215,38 @@ mod tests {
     use super::*;
 
     const SIZE: DVec2 = DVec2::new(800.0, 600.0);
+
+    /// Each named view sees the player's hands (in front of the body, at drum height), and
+    /// the side view looks along −x; a move ends exactly on its view and turns the short
+    /// way round.
+    #[test]
+    fn named_views_and_moves() {
+        let hands = DVec3::new(0.0, 0.35, 0.9);
+        for view in View::ALL {
+            let cam = Camera::of_view(view);
+            let (px, _) = cam.project(hands, SIZE).unwrap();
+            assert!(
+                px.x > 0.0 && px.x < SIZE.x && px.y > 0.0 && px.y < SIZE.y,
+                "{view:?}"
+            );
+        }
+        assert!(Camera::of_view(View::Side).basis().forward.x < -0.9);
+        let from = Camera {
+            yaw: 3.0,
+            ..Camera::default()
+        };
+        let to = Camera {
+            yaw: -3.0,
+            ..Camera::default()
+        };
+        let half = from.toward(&to, 0.5);
+        assert!((half.yaw - PI).abs() < 1e-9, "the short way: {}", half.yaw);
+        let end = from.toward(&Camera::of_view(View::Top), 1.0);
+        assert_eq!(
+            end.project(hands, SIZE),
+            Camera::of_view(View::Top).project(hands, SIZE)
+        );
+    }
 
     /// The target projects to the viewport centre at the orbit distance.
     #[test]
