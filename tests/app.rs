@@ -209,6 +209,47 @@ fn drag_handle_in_3d_is_one_step() {
     assert!(h.state().loaded().unwrap().score.handles.is_empty());
 }
 
+/// With the trajectories shown only near the playhead (View menu), a part of a trajectory
+/// far from it is not drawn and cannot be grabbed: dragging there orbits and adds no
+/// handle; the menu's checkbox turns the window on and off.
+#[test]
+fn trajectory_window_hides_far_parts() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(Some(demo()), dir.path());
+    h.get_by_label("View").click();
+    settle(&mut h);
+    h.get_by_label("Trajectories near the playhead only")
+        .click();
+    settle(&mut h);
+    assert_eq!(h.state().trajectory_window(), Some(2.0));
+    h.state_mut().set_trajectory_window(Some(0.25));
+    let comp = h.state().composition().unwrap().clone();
+    let k = comp.impact_samples[2] + (comp.impact_samples[3] - comp.impact_samples[2]) / 2;
+    assert!(
+        comp.time(k) > 0.5,
+        "the point is far from the playhead at 0"
+    );
+    let world = comp.tip(comp.strokes[2].hand)[k];
+    let start = h.state().viewport_point(world).expect("visible");
+    let camera = h.state().camera();
+    h.hover_at(start);
+    settle(&mut h);
+    h.drag_at(start);
+    settle(&mut h);
+    h.hover_at(start + egui::vec2(0.0, -24.0));
+    settle(&mut h);
+    h.drop_at(start + egui::vec2(0.0, -24.0));
+    settle(&mut h);
+    assert!(h.state().loaded().unwrap().score.handles.is_empty());
+    assert_ne!(h.state().camera(), camera, "the drag orbits instead");
+    h.get_by_label("View").click();
+    settle(&mut h);
+    h.get_by_label("Trajectories near the playhead only")
+        .click();
+    settle(&mut h);
+    assert_eq!(h.state().trajectory_window(), None);
+}
+
 /// Save As into a temp dir, reopen: the same score, recorded in the recent list (kept in
 /// the injected location, which persists it).
 #[test]

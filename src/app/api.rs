@@ -7,7 +7,7 @@ use super::export::{self, Export};
 use super::playback::{Playback, PlaybackError};
 use super::renderer::Rendered;
 use super::selection::{self, Selection};
-use super::{Camera, EditorApp, PlotTab, Simulated, tape};
+use super::{Camera, EditorApp, PlotTab, Simulated, tape, viewport};
 use crate::motion::compose::Composition;
 use crate::render::Rendering;
 use crate::score::{Hand, LoadedScore};
@@ -222,6 +222,18 @@ impl EditorApp {
     /// Export the current rendering as a glTF scene at `path` (File > Export scene glTF).
     pub fn export_glb_to(&mut self, path: &Path) {
         self.export_to(Export::Glb, path);
+    }
+
+    /// How far either side of the playhead the 3D view shows the composed trajectories,
+    /// s (`None`: all of them; View > Trajectories near the playhead only).
+    pub fn trajectory_window(&self) -> Option<f64> {
+        self.views.viewport.trajectory_window_s
+    }
+
+    /// Set [`EditorApp::trajectory_window`].
+    pub fn set_trajectory_window(&mut self, window_s: Option<f64>) {
+        self.views.viewport.trajectory_window_s =
+            window_s.map(|w| w.clamp(0.25, viewport::MAX_WINDOW_S));
     }
 
     /// The 3D view's camera as it is now.

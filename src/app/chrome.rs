@@ -132,6 +132,19 @@ impl EditorApp {
                     }
                 }
                 ui.checkbox(&mut self.views.timeline.snap, "Snap to grid");
+                let viewport = &mut self.views.viewport;
+                let mut windowed = viewport.trajectory_window_s.is_some();
+                if ui
+                    .checkbox(&mut windowed, "Trajectories near the playhead only")
+                    .changed()
+                {
+                    viewport.trajectory_window_s = windowed.then_some(2.0);
+                }
+                if let Some(w) = &mut viewport.trajectory_window_s {
+                    ui.add(
+                        egui::Slider::new(w, 0.25..=viewport::MAX_WINDOW_S).text("s either side"),
+                    );
+                }
             });
             ui.menu_button("Help", |ui| {
                 if ui.button("Keyboard and mouse  (F1)").clicked() {

@@ -82,6 +82,9 @@ pub struct Viewport {
     pub camera: Camera,
     /// A move to a named view in progress: from, to, and when it started (egui time, s).
     moving: Option<(Camera, Camera, f64)>,
+    /// Show the composed trajectories only this far either side of the playhead, s,
+    /// fading toward the ends (`None`: all of them).
+    pub trajectory_window_s: Option<f64>,
     body: BodyModel,
     drag: Option<Drag>,
     cache: Option<Projected>,
@@ -104,6 +107,18 @@ fn camera_key(c: &Camera) -> [u64; 8] {
         c.fov_y.to_bits(),
         0,
     ]
+}
+
+/// Longest trajectory window the View menu offers, s.
+pub const MAX_WINDOW_S: f64 = 8.0;
+
+/// The samples of `comp` shown with a trajectory window of `window_s` either side of
+/// `time_s` (all of them without one).
+fn shown_samples(comp: &Composition, time_s: f64, window_s: Option<f64>) -> std::ops::Range<usize> {
+    match window_s {
+        Some(w) => sample_of(comp, time_s - w)..(sample_of(comp, time_s + w) + 1).min(comp.len()),
+        None => 0..comp.len(),
+    }
 }
 
 /// Sample index of time `t` in `comp`, clamped.
@@ -253,24 +268,41 @@ impl Viewport {
         input: &ViewportInput,
     ) {
         let Some(cache) = &self.cache else { return };
-        for (h, tips) in cache.tips.iter().enumerate() {
-            let mut run: Vec<Pos2> = Vec::new();
-            for q in tips {
-                match q {
-                    Some(q) => run.push(to_pos(rect, *q)),
-                    None if !run.is_empty() => {
-                        painter.add(Shape::line(
-                            std::mem::take(&mut run),
-                            Stroke::new(1.5, TARGET_COLOURS[h]),
-                        ));
-                    }
-                    None => {}
-                }
+        let shown = shown_samples(comp, input.time_s, self.trajectory_window_s);
+        // Pieces of a few samples, each as opaque as its distance from the playhead
+        // allows (all opaque without a window).
+        const PIECE: usize = 8;
+        let fade = |k: usize| match self.trajectory_window_s {
+            Some(w) => {
+                let d = ((comp.time(k) - input.time_s).abs() / w.max(1e-3)).min(1.0);
+                1.0 - 0.85 * d * d
             }
-            painter.add(Shape::line(run, Stroke::new(1.5, TARGET_COLOURS[h])));
+            None => 1.0,
+        };
+        for (h, tips) in cache.tips.iter().enumerate() {
+            let mut start = shown.start;
+            while start + 1 < shown.end {
+                let end = (start + PIECE).min(shown.end - 1);
+                let stroke = Stroke::new(1.5, TARGET_COLOURS[h].gamma_multiply(fade(start) as f32));
+                let mut run: Vec<Pos2> = Vec::new();
+                for q in &tips[start..=end] {
+                    match q {
+                        Some(q) => run.push(to_pos(rect, *q)),
+                        None if !run.is_empty() => {
+                            painter.add(Shape::line(std::mem::take(&mut run), stroke));
+                        }
+                        None => {}
+                    }
+                }
+                painter.add(Shape::line(run, stroke));
+                start = end;
+            }
         }
         let score = &input.doc.score;
         for (stroke, &k) in comp.strokes.iter().zip(&comp.impact_samples) {
+            if !shown.contains(&k) {
+                continue;
+            }
             let h = side_index(stroke.hand);
             if let Some(q) = cache.tips[h].get(k).copied().flatten() {
                 let pinned = score
@@ -463,7 +495,13 @@ impl Viewport {
                     removed: None,
                 }));
                 out.push(Command::Select(Selection::default()));
-            } else if let Some(s) = pick_impact(comp, &proj, p, input.time_s) {
+            } else if let Some(s) = pick_impact(
+                comp,
+                &proj,
+                p,
+                input.time_s,
+                &shown_samples(comp, input.time_s, self.trajectory_window_s),
+            ) {
                 let stroke = &comp.strokes[s];
                 if score
                     .pins
@@ -511,7 +549,8 @@ impl Viewport {
                 current: h,
             });
         }
-        if let Some(s) = pick_impact(comp, &proj, p, input.time_s) {
+        let shown = shown_samples(comp, input.time_s, self.trajectory_window_s);
+        if let Some(s) = pick_impact(comp, &proj, p, input.time_s, &shown) {
             let stroke = &comp.strokes[s];
             let anchor = comp.tips[side_index(stroke.hand)][comp.impact_samples[s]];
             out.push(Command::Gesture);
@@ -524,7 +563,10 @@ impl Viewport {
         }
         let cache = self.cache.as_ref()?;
         let best = (0..2)
-            .filter_map(|h| pick_polyline(&cache.tips[h], p, 6.0).map(|(k, d)| (h, k, d)))
+            .filter_map(|h| {
+                pick_polyline(&cache.tips[h][shown.clone()], p, 6.0)
+                    .map(|(k, d)| (h, shown.start + k, d))
+            })
             .min_by(|a, b| a.2.total_cmp(&b.2))?;
         let (h, k, _) = best;
         let hand = if h == 0 { Side::Left } else { Side::Right };
@@ -582,11 +624,18 @@ fn pick_handle(
 
 /// The stroke whose impact marker is within 7 px of `p` (of several, the nearest in time
 /// to the playhead at `time_s`: strokes on one spot share a marker).
-fn pick_impact(comp: &Composition, proj: &Projector, p: DVec2, time_s: f64) -> Option<usize> {
+fn pick_impact(
+    comp: &Composition,
+    proj: &Projector,
+    p: DVec2,
+    time_s: f64,
+    shown: &std::ops::Range<usize>,
+) -> Option<usize> {
     comp.strokes
         .iter()
         .zip(&comp.impact_samples)
         .enumerate()
+        .filter(|(_, (_, k))| shown.contains(k))
         .filter_map(|(s, (stroke, &k))| {
             proj.project(comp.tips[side_index(stroke.hand)][k])
                 .map(|(q, _)| (s, q.distance(p)))
