@@ -200,6 +200,9 @@ impl Viewport {
         if let Some(pose) = input.pose {
             stage::body(&proj, &self.body, pose, &mut marks);
         }
+        if let Some(drums) = input.drums {
+            stage::contacts(&proj, drums.contacts(), input.time_s, &mut marks);
+        }
         paint_marks(&painter, rect, &marks);
         if let Some(comp) = input.composition {
             self.update_cache(comp, input.generation, size, &proj);

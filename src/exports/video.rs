@@ -1,6 +1,7 @@
 //! A rendering filmed: each frame is the 3D view (the editor's stage: floor, drums with
 //! their membranes moving, the simulated body and sticks, each tip's last second as a
-//! trail) over the timeline strip (lanes per drum, bars, strokes, contacts, playhead),
+//! trail, each contact as an arrow as long as its force for a moment) over the timeline
+//! strip (lanes per drum, bars, strokes, contacts, playhead),
 //! drawn by `scene` and rasterised without a GPU, from score time 0 to the end of the mix.
 //! `io::video` encodes the frames with the mix through ffmpeg, or writes them as PNGs.
 
@@ -130,6 +131,7 @@ impl<'a> Filmer<'a> {
             }
             stage::body(&proj, &self.model, &motion.poses[now], marks);
         }
+        stage::contacts(&proj, r.drums.contacts(), t, marks);
         marks.push(Mark::Label {
             at: DVec2::new(12.0, 10.0),
             anchor: Anchor::LeftTop,

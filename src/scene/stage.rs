@@ -7,6 +7,7 @@ use super::camera::Projector;
 use super::marks::{Anchor, Mark, Rgba};
 use crate::body::model::BodyModel;
 use crate::body::skeleton::{JOINT_COUNT, Joint, Pose};
+use crate::drum::ContactEvent;
 use crate::kit::Drum;
 use glam::{DVec2, DVec3};
 use std::f64::consts::TAU;
@@ -166,6 +167,50 @@ pub fn body(proj: &Projector, model: &BodyModel, pose: &Pose, out: &mut Vec<Mark
     }
 }
 
+/// How long a contact's force arrow stays after the contact starts, fading, s.
+pub const CONTACT_SHOW_S: f64 = 0.6;
+/// Length of the arrow of a [`FULL_ARROW_N`] contact, m.
+const FULL_ARROW_M: f64 = 0.2;
+const FULL_ARROW_N: f64 = 110.0;
+
+/// Each contact of the last [`CONTACT_SHOW_S`] before `time_s` as an arrow pressing down
+/// on the head at the point the felt touched, as long as its peak force asks (0.2 m for
+/// 110 N), in its hand's colour, with the force written beside it, fading as it ages.
+pub fn contacts(proj: &Projector, contacts: &[ContactEvent], time_s: f64, out: &mut Vec<Mark>) {
+    for c in contacts {
+        let age = (time_s - c.start_s) / CONTACT_SHOW_S;
+        if !(0.0..1.0).contains(&age) || !c.peak_force_n.is_finite() {
+            continue;
+        }
+        let colour = super::strip::hand_colour(c.side).with_alpha((255.0 * (1.0 - age)) as u8);
+        let length = FULL_ARROW_M * (c.peak_force_n / FULL_ARROW_N).clamp(0.05, 1.5);
+        let (Some((tip, _)), Some((tail, _))) = (
+            proj.project(c.point),
+            proj.project(c.point + DVec3::Z * length),
+        ) else {
+            continue;
+        };
+        out.push(Mark::segment(tail, tip, 3.0, colour));
+        let back = (tail - tip).try_normalize().unwrap_or(DVec2::Y);
+        let side = back.perp();
+        for s in [-1.0, 1.0] {
+            out.push(Mark::segment(
+                tip,
+                tip + 9.0 * back + 5.0 * s * side,
+                3.0,
+                colour,
+            ));
+        }
+        out.push(Mark::Label {
+            at: tail + DVec2::new(6.0, 0.0),
+            anchor: Anchor::LeftCentre,
+            text: format!("{:.0} N", c.peak_force_n),
+            size: 12.0,
+            colour,
+        });
+    }
+}
+
 /// A 3D polyline (a trajectory) as marks: the projected points, split where a point is
 /// behind the camera.
 pub fn path(proj: &Projector, points: &[DVec3], width: f32, colour: Rgba, out: &mut Vec<Mark>) {
@@ -219,6 +264,36 @@ mod tests {
             &mut marks,
         );
         assert_eq!(marks.len(), 3 * JOINT_COUNT);
+    }
+
+    /// A contact shows as an arrow (shaft and two barbs) with its force for 0.6 s after
+    /// it starts, the later the fainter; not before it, not after.
+    #[test]
+    fn contact_arrows_fade_out() {
+        let c = ContactEvent {
+            side: crate::kit::Side::Right,
+            drum: 0,
+            start_s: 1.0,
+            end_s: 1.006,
+            peak_force_n: 82.0,
+            impact_speed_mps: 3.0,
+            point: DVec3::new(0.1, 0.5, 0.8),
+        };
+        let at = |t: f64| {
+            let mut marks = Vec::new();
+            contacts(&projector(), std::slice::from_ref(&c), t, &mut marks);
+            marks
+        };
+        assert!(at(0.99).is_empty());
+        assert!(at(1.61).is_empty());
+        let early = at(1.01);
+        assert_eq!(early.len(), 4);
+        assert!(matches!(&early[3], Mark::Label { text, .. } if text == "82 N"));
+        let alpha = |m: &Mark| match m {
+            Mark::Line { colour, .. } => colour.0[3],
+            _ => 0,
+        };
+        assert!(alpha(&early[0]) > alpha(&at(1.5)[0]));
     }
 
     /// A path behind the camera splits into the visible runs.
