@@ -273,8 +273,12 @@ impl Viewport {
         let Some(cache) = &self.cache else { return };
         let shown = shown_samples(comp, input.time_s, self.trajectory_window_s);
         // Pieces of a few samples, each as opaque as its distance from the playhead
-        // allows (all opaque without a window).
-        const PIECE: usize = 8;
+        // allows (without a window: one piece, opaque).
+        let piece = if self.trajectory_window_s.is_some() {
+            8
+        } else {
+            usize::MAX / 2
+        };
         let fade = |k: usize| match self.trajectory_window_s {
             Some(w) => {
                 let d = ((comp.time(k) - input.time_s).abs() / w.max(1e-3)).min(1.0);
@@ -285,7 +289,7 @@ impl Viewport {
         for (h, tips) in cache.tips.iter().enumerate() {
             let mut start = shown.start;
             while start + 1 < shown.end {
-                let end = (start + PIECE).min(shown.end - 1);
+                let end = (start + piece).min(shown.end - 1);
                 let stroke = Stroke::new(1.5, TARGET_COLOURS[h].gamma_multiply(fade(start) as f32));
                 let mut run: Vec<Pos2> = Vec::new();
                 for q in &tips[start..=end] {
