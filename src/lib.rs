@@ -24,3 +24,4 @@ pub mod render;
 pub mod scene;
 pub mod score;
 pub mod sound;
+pub mod transcribe;

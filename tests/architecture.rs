@@ -16,6 +16,7 @@ const FLOORS: &[(&str, u8)] = &[
     ("mocap", 4),
     ("sound", 4),
     ("motion", 5),
+    ("transcribe", 5),
     ("render", 6),
     ("io", 6),
     ("scene", 6),

@@ -81,6 +81,10 @@ arg_enum!(ControlArg => crate::body::sim::Pipeline {
     Id => crate::body::sim::Pipeline::Id,
     Ik => crate::body::sim::Pipeline::Ik,
 });
+arg_enum!(LevelsArg => crate::transcribe::Levels {
+    Absolute => crate::transcribe::Levels::Absolute,
+    Relative => crate::transcribe::Levels::Relative,
+});
 arg_enum!(SoundArg => crate::sound::SoundModel {
     Modal => crate::sound::SoundModel::Modal,
     Sample => crate::sound::SoundModel::Sample,

@@ -15,6 +15,7 @@ mod pack;
 mod render;
 mod sound;
 mod sticking;
+mod transcribe;
 
 use crate::io::open::OpenAction;
 use args::{
@@ -89,6 +90,27 @@ pub enum Command {
         /// Title of the score (default: the movement or work title, else the file name).
         #[arg(long)]
         title: Option<String>,
+    },
+    /// Transcribe a timpani recording (WAV) into a score: strokes, drums and pitches,
+    /// dynamics, a tempo map and rolls.
+    Transcribe {
+        /// The recording (.wav: PCM 8-32 bit or float, any rate, channels mixed to mono).
+        input: PathBuf,
+        /// The score to write (.ron).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// The kit whose drums and ranges the pitches go to (default: the bundled standard
+        /// kit).
+        #[arg(long)]
+        kit: Option<PathBuf>,
+        /// Title of the score (default: the file name).
+        #[arg(long)]
+        title: Option<String>,
+        /// How stroke energies become dynamics: against timpanist's own calibrated strokes
+        /// (absolute), or with the median stroke taken as mf (relative, for recordings at an
+        /// unknown gain).
+        #[arg(long, value_enum, default_value = "absolute")]
+        levels: args::LevelsArg,
     },
     /// Export a score as a type 1 Standard MIDI File (tempo map, GM Timpani, velocities).
     ExportMidi {
@@ -498,6 +520,14 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             kit,
             title,
         }) => musicxml::import(&input, &output, part, kit.as_deref(), title)
+            .map(|()| ExitCode::SUCCESS),
+        Some(Command::Transcribe {
+            input,
+            output,
+            kit,
+            title,
+            levels,
+        }) => transcribe::run(&input, &output, kit.as_deref(), title, levels.into())
             .map(|()| ExitCode::SUCCESS),
         Some(Command::Demos { output }) => {
             demos::run(output.as_deref()).map(|()| ExitCode::SUCCESS)

@@ -172,19 +172,9 @@ fn timpani_events<'a>(score: &Score, kit: &Kit, payloads: &'a [Vec<u8>]) -> Vec<
     for (i, beat) in score.beats.iter().enumerate() {
         let key = beat.sounding_pitch(kit).0;
         let vel = beat.dynamic.midi_velocity();
-        let offsets: Vec<u64> = match beat.roll {
-            Some(r) => {
-                let spacing = (tpq / u64::from(r.strokes_per_quarter.max(1))).max(1);
-                (0..r.length_ticks.max(1))
-                    .step_by(spacing as usize)
-                    .collect()
-            }
-            None => vec![0],
-        };
         strokes.extend(
-            offsets
-                .iter()
-                .map(|&o| (beat.tick + o, key, vel, i, o == 0)),
+            beat.stroke_ticks(score.ticks_per_quarter)
+                .map(|t| (t, key, vel, i, t == beat.tick)),
         );
     }
     strokes.sort_by_key(|s| s.0);

@@ -273,16 +273,10 @@ pub fn plan(
                 unit: 0,
             });
         };
-        match beat.roll {
-            None => push(beat.tick, side),
-            Some(roll) => {
-                let step = u64::from(score.ticks_per_quarter / roll.strokes_per_quarter).max(1);
-                let mut hand = side;
-                for k in 0..roll.length_ticks.div_ceil(step) {
-                    push(beat.tick + k * step, hand);
-                    hand = hand.other();
-                }
-            }
+        let mut hand = side;
+        for tick in beat.stroke_ticks(score.ticks_per_quarter) {
+            push(tick, hand);
+            hand = hand.other();
         }
     }
     strokes.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));

@@ -88,7 +88,21 @@ impl Beat {
         self.pitch.unwrap_or(kit.drums[self.drum].tuning)
     }
 
-    /// Tick of the last stroke (the beat itself, or the end of its roll).
+    /// Ticks of the beat's strokes: the beat itself, or each stroke of its roll, one every
+    /// quarter / strokes-per-quarter ticks from the beat up to (not at) the roll's end.
+    pub fn stroke_ticks(&self, ticks_per_quarter: u32) -> impl Iterator<Item = u64> + use<> {
+        let tick = self.tick;
+        let (step, count) = match self.roll {
+            None => (1, 1),
+            Some(r) => {
+                let step = u64::from(ticks_per_quarter / r.strokes_per_quarter.max(1)).max(1);
+                (step, r.length_ticks.div_ceil(step).max(1))
+            }
+        };
+        (0..count).map(move |k| tick + k * step)
+    }
+
+    /// Tick where the beat ends (the beat itself, or the end of its roll).
     pub fn end_tick(&self) -> u64 {
         self.tick + self.roll.map_or(0, |r| r.length_ticks)
     }

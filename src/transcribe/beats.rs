@@ -1,0 +1,245 @@
+//! The beat of a recording and a tempo map that follows it. The beat period comes from the
+//! autocorrelation of the onset strength, weighted towards 100 bpm (a log-Gaussian prior
+//! one octave wide); beats are then tracked by dynamic programming (Ellis 2007: each beat
+//! rewards onset strength and pays for departing from the period), so tempo changes are
+//! followed; beats within 25 ms of a stroke move onto it. The tempo map is the fewest
+//! steps of constant tempo that keep every beat within 4 ms.
+
+use super::onsets::Strength;
+use crate::score::{TempoChange, TempoPoint};
+
+/// The prior's centre, bpm, and its width (standard deviation in octaves).
+const PRIOR_BPM: f64 = 100.0;
+const PRIOR_OCTAVES: f64 = 1.0;
+/// Periods considered, bpm.
+const BPM_SPAN: (f64, f64) = (40.0, 220.0);
+/// How strongly a beat holds to the period (Ellis's α, with the strength normalised).
+const TIGHTNESS: f64 = 30.0;
+/// A beat this close to a stroke moves onto it, s.
+const SNAP_S: f64 = 0.025;
+/// Largest error a constant-tempo step may leave at a beat, s.
+pub const TEMPO_TOLERANCE_S: f64 = 0.004;
+
+/// The beat period, s: the lag in [`BPM_SPAN`] where the prior-weighted autocorrelation of
+/// the onset strength (mean removed) is largest. `None` for a signal too short for two
+/// beats.
+pub fn period_s(strength: &Strength) -> Option<f64> {
+    let v = &strength.values;
+    let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
+    let x: Vec<f64> = v.iter().map(|s| s - mean).collect();
+    let lag_of = |bpm: f64| (60.0 / bpm / strength.hop_s).round() as usize;
+    let (shortest, longest) = (lag_of(BPM_SPAN.1).max(1), lag_of(BPM_SPAN.0));
+    if x.len() <= 2 * shortest {
+        return None;
+    }
+    (shortest..=longest.min(x.len() / 2).max(shortest))
+        .map(|lag| {
+            let ac: f64 = x.iter().zip(&x[lag..]).map(|(a, b)| a * b).sum();
+            let bpm = 60.0 / (lag as f64 * strength.hop_s);
+            let octaves = (bpm / PRIOR_BPM).log2() / PRIOR_OCTAVES;
+            (lag, ac * (-0.5 * octaves * octaves).exp())
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(lag, _)| lag as f64 * strength.hop_s)
+}
+
+/// Beat times, s, tracked through the onset strength with period `period_s`, from the
+/// first beat to the last, extended by whole periods to cover `[first_s, last_s]` (the
+/// first and last strokes).
+pub fn track(strength: &Strength, period_s: f64, first_s: f64, last_s: f64) -> Vec<f64> {
+    let v = &strength.values;
+    let sd = {
+        let mean = v.iter().sum::<f64>() / v.len().max(1) as f64;
+        (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / v.len().max(1) as f64)
+            .sqrt()
+            .max(1e-12)
+    };
+    let p = period_s / strength.hop_s;
+    let (near, far) = ((p / 2.0).round() as usize, (2.0 * p).round() as usize);
+    let mut score = vec![0.0; v.len()];
+    let mut back: Vec<Option<usize>> = vec![None; v.len()];
+    for n in 0..v.len() {
+        let own = v[n] / sd;
+        let candidates = match n.checked_sub(near.max(1)) {
+            Some(latest) => n.saturating_sub(far)..latest + 1,
+            None => 0..0,
+        };
+        let best = candidates
+            .map(|m| {
+                let ratio = ((n - m) as f64 / p).ln();
+                (m, score[m] - TIGHTNESS * ratio * ratio)
+            })
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        match best {
+            Some((m, s)) if s > 0.0 => {
+                score[n] = own + s;
+                back[n] = Some(m);
+            }
+            _ => score[n] = own,
+        }
+    }
+    let tail = v.len().saturating_sub(p.round() as usize)..v.len();
+    let Some(mut n) = tail.max_by(|&a, &b| score[a].total_cmp(&score[b])) else {
+        return Vec::new();
+    };
+    let mut frames = vec![n];
+    while let Some(m) = back[n] {
+        frames.push(m);
+        n = m;
+    }
+    frames.reverse();
+    let mut beats: Vec<f64> = frames.iter().map(|&f| strength.time_s(f)).collect();
+    extend(&mut beats, period_s, first_s, last_s);
+    beats
+}
+
+/// Add whole periods before the first beat and after the last until they cover
+/// `[first_s, last_s]`, keeping every beat at or after 0.
+fn extend(beats: &mut Vec<f64>, period_s: f64, first_s: f64, last_s: f64) {
+    if beats.is_empty() {
+        beats.push(first_s);
+    }
+    while beats[0] > first_s + SNAP_S && beats[0] - period_s >= -SNAP_S {
+        beats.insert(0, (beats[0] - period_s).max(0.0));
+    }
+    while *beats.last().expect("not empty") < last_s - SNAP_S {
+        let last = *beats.last().expect("not empty");
+        beats.push(last + period_s);
+    }
+    beats.dedup_by(|b, a| *b - *a < 0.5 * period_s);
+}
+
+/// Move each beat within [`SNAP_S`] of a stroke onto the nearest stroke (`strokes_s`
+/// sorted), keeping the beats in order.
+pub fn snap(beats: &mut [f64], strokes_s: &[f64]) {
+    for b in beats.iter_mut() {
+        let i = strokes_s.partition_point(|&s| s < *b);
+        let nearest = [i.checked_sub(1), Some(i)]
+            .into_iter()
+            .flatten()
+            .filter_map(|j| strokes_s.get(j))
+            .min_by(|x, y| (*x - *b).abs().total_cmp(&(*y - *b).abs()));
+        if let Some(&s) = nearest
+            && (s - *b).abs() <= SNAP_S
+        {
+            *b = s;
+        }
+    }
+    for i in 1..beats.len() {
+        if beats[i] <= beats[i - 1] {
+            beats[i] = beats[i - 1] + 1e-3;
+        }
+    }
+}
+
+/// A tempo map in which beat `k` of `beats` (s, rising, each a quarter note) falls at
+/// tick `first_tick + k·tpq`, score time 0 at tick 0: the fewest constant-tempo steps that
+/// keep every beat within [`TEMPO_TOLERANCE_S`]. The span before the first beat is one
+/// step of `first_tick` ticks.
+pub fn tempo_map(beats: &[f64], tpq: u32, first_tick: u64) -> Vec<TempoPoint> {
+    let q = f64::from(tpq);
+    let mut points = Vec::new();
+    let mut start = 0;
+    if first_tick > 0 {
+        let bpm = 60.0 * first_tick as f64 / q / beats[0].max(1e-3);
+        points.push(step(0, bpm));
+    }
+    while start + 1 < beats.len() {
+        let mut end = start + 1;
+        while end + 1 < beats.len() && fits(&beats[start..=end + 1]) {
+            end += 1;
+        }
+        let beat_s = (beats[end] - beats[start]) / (end - start) as f64;
+        points.push(step(
+            first_tick + start as u64 * u64::from(tpq),
+            60.0 / beat_s,
+        ));
+        start = end;
+    }
+    if points.is_empty() {
+        points.push(step(0, PRIOR_BPM));
+    }
+    points.dedup_by(|b, a| (a.bpm - b.bpm).abs() < 1e-9);
+    points
+}
+
+fn step(tick: u64, bpm: f64) -> TempoPoint {
+    TempoPoint {
+        tick,
+        bpm,
+        change: TempoChange::Step,
+    }
+}
+
+/// Whether one constant tempo through the first and last beat keeps every beat between
+/// within the tolerance.
+fn fits(beats: &[f64]) -> bool {
+    let n = beats.len() - 1;
+    let slope = (beats[n] - beats[0]) / n as f64;
+    beats
+        .iter()
+        .enumerate()
+        .all(|(k, b)| (beats[0] + slope * k as f64 - b).abs() <= TEMPO_TOLERANCE_S)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::score::TempoMap;
+
+    fn pulses(times: &[f64], seconds: f64) -> Strength {
+        let hop = 0.005;
+        let mut values = vec![0.01; (seconds / hop) as usize];
+        for t in times {
+            values[(t / hop).round() as usize] = 1.0;
+        }
+        Strength {
+            hop_s: hop,
+            frame_s: 0.046,
+            values,
+        }
+    }
+
+    /// Quarter notes at 90 bpm give a 90 bpm period, with eighths sprinkled in too.
+    #[test]
+    fn finds_the_period() {
+        let mut times: Vec<f64> = (0..24).map(|k| 0.3 + k as f64 * 60.0 / 90.0).collect();
+        times.extend((0..6).map(|k| 0.3 + (2 * k + 1) as f64 * 30.0 / 90.0));
+        let p = period_s(&pulses(&times, 18.0)).unwrap();
+        assert!((60.0 / p - 90.0).abs() < 2.0, "{} bpm", 60.0 / p);
+    }
+
+    /// Beats slowing from 120 to 80 bpm are tracked; the tempo map puts each within 4 ms.
+    #[test]
+    fn follows_a_tempo_change() {
+        let mut t = 0.5;
+        let mut times = Vec::new();
+        for k in 0..32 {
+            times.push(t);
+            let bpm = 120.0 - 40.0 * (f64::from(k) / 31.0);
+            t += 60.0 / bpm;
+        }
+        let s = pulses(&times, t + 1.0);
+        let p = period_s(&s).unwrap();
+        let mut beats = track(&s, p, times[0], *times.last().unwrap());
+        snap(&mut beats, &times);
+        for x in &times {
+            assert!(
+                beats.iter().any(|b| (b - x).abs() < 1e-9),
+                "{x} not a beat: {beats:?}"
+            );
+        }
+        let first = beats[0];
+        let first_tick = (first / p).round() as u64 * 960;
+        let points = tempo_map(&beats, 960, first_tick);
+        let map = TempoMap::new(&points, 960);
+        for (k, b) in beats.iter().enumerate() {
+            let at = map.seconds_at((first_tick + k as u64 * 960) as f64);
+            assert!(
+                (at - b).abs() <= TEMPO_TOLERANCE_S + 1e-9,
+                "beat {k}: {at} vs {b}"
+            );
+        }
+        assert!(points.len() < beats.len(), "{} points", points.len());
+    }
+}

@@ -1,0 +1,286 @@
+//! Audio → score: a recording of timpani (ours or a real one) transcribed into a gesture
+//! score on a kit. Onsets ([`onsets`]), what each stroke added and its pitch
+//! ([`notes`]), the beat and a tempo map that follows it ([`beats`]), and the strokes as
+//! beats — drums, ticks, rolls, dynamics ([`notate`]). Dynamics are read against the
+//! levels of timpanist's own calibrated modal strokes at each marking, so a rendering
+//! reads back at its own dynamics; [`Levels::Relative`] instead takes the median stroke as
+//! mf, for recordings at an unknown gain. Hands are left to the sticking, modes legato.
+
+pub mod beats;
+pub mod notate;
+pub mod notes;
+pub mod onsets;
+
+use crate::base::limits::MAX_SCORE_S;
+use crate::base::pitch::Pitch;
+use crate::kit::Kit;
+use crate::score::{Dynamic, MeterChange, Score, TempoMap};
+use crate::sound::analysis::{self, ReadError};
+use crate::sound::calibration::Calibration;
+use crate::sound::fit;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// How stroke energies become dynamics.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Levels {
+    /// Against timpanist's calibrated strokes at each marking (renders read back at
+    /// their own dynamics).
+    #[default]
+    Absolute,
+    /// Shifted so the median stroke reads mf (a recording at an unknown gain).
+    Relative,
+}
+
+/// How to transcribe.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// The kit reference written into the score (`"standard"` or a path).
+    pub kit_ref: String,
+    /// Title of the score (default: the file name).
+    pub title: Option<String>,
+    pub levels: Levels,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            kit_ref: "standard".into(),
+            title: None,
+            levels: Levels::Absolute,
+        }
+    }
+}
+
+/// What a transcription found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Report {
+    /// The file or signal transcribed, for messages.
+    pub source: String,
+    /// Strokes heard (a chord counts once).
+    pub strokes: usize,
+    /// Runs of strokes written as rolls.
+    pub rolls: usize,
+    /// The beat found, bpm (the first tempo of the map).
+    pub bpm: f64,
+    /// The recording's tuning against A4 = 440 Hz, cents.
+    pub tuning_cents: f64,
+    /// Where each stroke was heard, s (for checks and plots).
+    pub onsets_s: Vec<f64>,
+    /// Things the user should know.
+    pub notices: Vec<String>,
+}
+
+/// Why audio could not be transcribed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum TranscribeError {
+    #[error(transparent)]
+    Read(#[from] ReadError),
+    #[error("{file}: no strokes were heard (silence, or no clear attacks)")]
+    Silent { file: String },
+    #[error("{file}: sample {frame} is not a finite number")]
+    NonFinite { file: String, frame: usize },
+    #[error("{file}: {seconds:.0} s of audio is longer than a score may last ({max:.0} s)")]
+    TooLong {
+        file: String,
+        seconds: f64,
+        max: f64,
+    },
+    #[error("the kit has no drums to put the strokes on")]
+    NoDrums,
+}
+
+/// Transcribe the WAV file `path` onto `kit`.
+pub fn transcribe_file(
+    path: &Path,
+    kit: &Kit,
+    options: &Options,
+) -> Result<(Score, Report), TranscribeError> {
+    let (samples, rate) = analysis::read_mono(path)?;
+    let mut options = options.clone();
+    if options.title.is_none() {
+        options.title = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .filter(|s| !s.is_empty());
+    }
+    transcribe(&samples, rate, kit, &path.display().to_string(), &options)
+}
+
+/// Transcribe mono `samples` at `rate_hz` (named `source` in messages) onto `kit`.
+pub fn transcribe(
+    samples: &[f32],
+    rate_hz: u32,
+    kit: &Kit,
+    source: &str,
+    options: &Options,
+) -> Result<(Score, Report), TranscribeError> {
+    let source = source.to_string();
+    if kit.drums.is_empty() {
+        return Err(TranscribeError::NoDrums);
+    }
+    if let Some(frame) = samples.iter().position(|s| !s.is_finite()) {
+        return Err(TranscribeError::NonFinite {
+            file: source,
+            frame,
+        });
+    }
+    let seconds = samples.len() as f64 / f64::from(rate_hz.max(1));
+    if seconds > MAX_SCORE_S {
+        return Err(TranscribeError::TooLong {
+            file: source,
+            seconds,
+            max: MAX_SCORE_S,
+        });
+    }
+    let strength = onsets::strength(samples, rate_hz);
+    let found: Vec<f64> = onsets::pick(&strength)
+        .into_iter()
+        .map(|f| onsets::place(samples, rate_hz, &strength, f))
+        .collect();
+    let times = dedup_sorted(found);
+    if times.is_empty() {
+        return Err(TranscribeError::Silent { file: source });
+    }
+    let band = pitch_band(kit);
+    let strokes: Vec<notate::Stroke> = times
+        .iter()
+        .enumerate()
+        .map(|(i, &t)| {
+            let heard = notes::hear(samples, rate_hz, t, times.get(i + 1).copied(), band);
+            notate::Stroke {
+                time_s: t,
+                principal_hz: heard.principal_hz,
+                level_db: heard.level_db,
+            }
+        })
+        .collect();
+
+    let mut score = Score::new(options.title.as_deref().unwrap_or("Transcription"));
+    score.kit = options.kit_ref.clone();
+    let tpq = score.ticks_per_quarter;
+    let period = beats::period_s(&strength).unwrap_or(0.6);
+    let (first, last) = (times[0], *times.last().expect("not empty"));
+    let mut beat_times = beats::track(&strength, period, first, last);
+    beats::snap(&mut beat_times, &times);
+    let first_tick = lead_in_ticks(beat_times[0], period, tpq);
+    score.tempo = beats::tempo_map(&beat_times, tpq, first_tick);
+    score.meter = vec![MeterChange {
+        bar: 1,
+        numerator: 4,
+        denominator: 4,
+    }];
+    let map = TempoMap::new(&score.tempo, tpq);
+
+    let shift = match options.levels {
+        Levels::Absolute => 0.0,
+        Levels::Relative => relative_shift(&strokes, kit),
+    };
+    let mut table = MarkLevels::default();
+    let mut marks = |p: Pitch| table.at(p).map(|l| l - shift);
+    let (placed, found_notes) = notate::place(&strokes, kit, &map, tpq, &mut marks);
+    let (beats, rolls) = notate::beats(&placed, kit, tpq);
+    score.beats = beats;
+    score.sort_beats();
+
+    let mut notices = Vec::new();
+    if found_notes.octave_moves > 0 {
+        notices.push(format!(
+            "{} strokes were moved by octaves into a drum's range",
+            found_notes.octave_moves
+        ));
+    }
+    if found_notes.unpitched > 0 {
+        notices.push(format!(
+            "{} strokes had no clear pitch and were put on the previous stroke's drum",
+            found_notes.unpitched
+        ));
+    }
+    let report = Report {
+        source,
+        strokes: placed.len(),
+        rolls,
+        bpm: score.tempo.last().map_or(0.0, |p| p.bpm),
+        tuning_cents: notate::tuning_offset_cents(&strokes),
+        onsets_s: times,
+        notices,
+    };
+    Ok((score, report))
+}
+
+/// Sorted times with any two closer than half the onset gap merged.
+fn dedup_sorted(mut times: Vec<f64>) -> Vec<f64> {
+    times.sort_by(f64::total_cmp);
+    times.dedup_by(|b, a| *b - *a < onsets::MIN_GAP_S / 2.0);
+    times
+}
+
+/// Principal partials are sought from a fifth below the kit's lowest pitch to a fifth
+/// above its highest, Hz (pitches outside the drums' ranges are then moved by octaves).
+fn pitch_band(kit: &Kit) -> (f64, f64) {
+    let lo = kit
+        .drums
+        .iter()
+        .map(|d| d.lowest.hz())
+        .fold(f64::MAX, f64::min);
+    let hi = kit.drums.iter().map(|d| d.highest.hz()).fold(0.0, f64::max);
+    (lo / 1.5, hi * 1.5)
+}
+
+/// Ticks from score time 0 to the first beat at `first_s`: whole beats of about
+/// `period_s`, or the exact fraction when the first beat comes within half a beat.
+fn lead_in_ticks(first_s: f64, period_s: f64, tpq: u32) -> u64 {
+    if first_s <= 1e-4 {
+        return 0;
+    }
+    let beats = (first_s / period_s).round();
+    let ticks = if beats >= 1.0 {
+        beats * f64::from(tpq)
+    } else {
+        (first_s / period_s * f64::from(tpq)).round().max(1.0)
+    };
+    ticks as u64
+}
+
+/// How much louder than timpanist's strokes the recording is, dB: its median stroke
+/// against an mf stroke at the median pitch.
+fn relative_shift(strokes: &[notate::Stroke], kit: &Kit) -> f64 {
+    let mut levels: Vec<f64> = strokes.iter().map(|s| s.level_db).collect();
+    levels.sort_by(f64::total_cmp);
+    let mut hz: Vec<f64> = strokes.iter().filter_map(|s| s.principal_hz).collect();
+    hz.sort_by(f64::total_cmp);
+    let pitch = hz.get(hz.len() / 2).map_or(kit.drums[0].tuning, |&f| {
+        Pitch(notate::midi_of(f).round().clamp(0.0, 127.0) as u8)
+    });
+    let mf = MarkLevels::default().at(pitch)[3];
+    levels[levels.len() / 2] - mf
+}
+
+/// The level (dB, as [`notes::added_level_db`] measures it) of timpanist's calibrated
+/// modal stroke at each marking pp…ff on a drum tuned to a pitch, computed once per pitch.
+#[derive(Default)]
+struct MarkLevels {
+    by_pitch: BTreeMap<Pitch, [f64; 6]>,
+}
+
+/// Length of each reference stroke rendered, s.
+const REFERENCE_STROKE_S: f64 = 0.1;
+
+impl MarkLevels {
+    fn at(&mut self, pitch: Pitch) -> [f64; 6] {
+        *self.by_pitch.entry(pitch).or_insert_with(|| {
+            let kit = fit::kit_for(pitch.hz());
+            let rate = crate::sound::SAMPLE_RATE_HZ;
+            Dynamic::MARKS.map(|(dynamic, _, _)| {
+                fit::struck(&kit, dynamic, Calibration::shipped(), REFERENCE_STROKE_S)
+                    .ok()
+                    .and_then(|(mono, _)| {
+                        let at = analysis::onset(&mono, rate)? as f64 / f64::from(rate);
+                        Some(notes::added_level_db(&mono, rate, at))
+                    })
+                    .unwrap_or(f64::NEG_INFINITY)
+            })
+        })
+    }
+}

@@ -1,0 +1,367 @@
+//! Heard strokes as beats of a score: each principal partial rounded to a pitch (after the
+//! recording's own tuning offset), the pitch given to the drum tuned to it or the nearest
+//! drum whose range holds it (which is then retuned), times quantised to the coarsest
+//! musical grid that keeps them within 8 ms, fast even runs on one drum written as rolls,
+//! and each stroke's added energy mapped to the nearest dynamic marking.
+
+use crate::base::pitch::Pitch;
+use crate::kit::Kit;
+use crate::score::{Beat, Dynamic, Hand, ImpactLocation, PlayingMode, Roll, TempoMap};
+
+/// Grids tried, coarsest first, as divisions of a quarter note.
+const GRIDS: [u32; 10] = [1, 2, 4, 3, 8, 6, 16, 12, 32, 24];
+/// A quantised stroke may move at most this far, s.
+pub const QUANTISE_TOLERANCE_S: f64 = 0.008;
+/// A roll: at least this many strokes on one drum…
+const ROLL_MIN_STROKES: usize = 6;
+/// …each at most this long after the previous, s…
+const ROLL_MAX_GAP_S: f64 = 0.13;
+/// …within this share of the run's median gap.
+const ROLL_EVENNESS: f64 = 0.35;
+
+/// One stroke as heard: when, which pitches (two for a chord), how much energy it added.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stroke {
+    pub time_s: f64,
+    /// The principal (1,1) frequency heard, Hz.
+    pub principal_hz: Option<f64>,
+    /// Added energy, dB re a full-scale sine.
+    pub level_db: f64,
+}
+
+/// A stroke placed on a drum: its tick and pitch, its drum, and its dynamic.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Placed {
+    pub time_s: f64,
+    pub tick: u64,
+    /// (drum, pitch) per drum struck.
+    pub drums: Vec<(usize, Pitch)>,
+    pub dynamic: Dynamic,
+}
+
+/// What notation decided that the user should hear about.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Notes {
+    /// Strokes whose pitch no drum reaches, moved by octaves into a drum's range.
+    pub octave_moves: usize,
+    /// Strokes whose pitch was not heard (no kettledrum pattern): put on the drum of the
+    /// previous stroke.
+    pub unpitched: usize,
+}
+
+/// The fractional MIDI note of `hz` (A4 = 440 Hz).
+pub fn midi_of(hz: f64) -> f64 {
+    69.0 + 12.0 * (hz / 440.0).log2()
+}
+
+/// The recording's tuning offset, cents: the median deviation of the principal partials
+/// from equal temperament (A4 = 440 Hz).
+pub fn tuning_offset_cents(strokes: &[Stroke]) -> f64 {
+    let mut devs: Vec<f64> = strokes
+        .iter()
+        .filter_map(|s| s.principal_hz)
+        .map(|f| {
+            let m = midi_of(f);
+            100.0 * (m - m.round())
+        })
+        .collect();
+    if devs.is_empty() {
+        return 0.0;
+    }
+    devs.sort_by(f64::total_cmp);
+    devs[devs.len() / 2]
+}
+
+/// Which drum plays `pitch`: one tuned to it now, else the one in range whose present
+/// tuning is nearest (it is retuned), else, moved by octaves, the nearest such. Not
+/// `exclude` (the other drum of a chord). Returns the drum, the pitch it plays, and
+/// whether an octave move was needed; `None` for a kit without drums.
+fn drum_for(
+    kit: &Kit,
+    tunings: &mut [Pitch],
+    pitch: Pitch,
+    exclude: Option<usize>,
+) -> Option<(usize, Pitch, bool)> {
+    let usable = |i: &usize| Some(*i) != exclude;
+    if let Some(i) = (0..kit.drums.len())
+        .filter(usable)
+        .find(|&i| tunings[i] == pitch)
+    {
+        return Some((i, pitch, false));
+    }
+    let nearest_in_range = |p: Pitch, tunings: &[Pitch]| {
+        (0..kit.drums.len())
+            .filter(usable)
+            .filter(|&i| kit.drums[i].in_range(p))
+            .min_by_key(|&i| (i32::from(tunings[i].0) - i32::from(p.0)).abs())
+    };
+    if let Some(i) = nearest_in_range(pitch, tunings) {
+        tunings[i] = pitch;
+        return Some((i, pitch, false));
+    }
+    for octaves in 1..=4 {
+        for p in [
+            pitch.transposed(-12 * octaves),
+            pitch.transposed(12 * octaves),
+        ]
+        .into_iter()
+        .flatten()
+        {
+            if let Some(i) = nearest_in_range(p, tunings) {
+                tunings[i] = p;
+                return Some((i, p, true));
+            }
+        }
+    }
+    (0..kit.drums.len())
+        .find(usable)
+        .map(|i| (i, tunings[i], true))
+}
+
+/// The nearest dynamic marking to `level_db`, given each marking's level (pp…ff).
+fn dynamic_for(level_db: f64, marks_db: &[f64; 6]) -> Dynamic {
+    let i = (0..6)
+        .min_by(|&a, &b| {
+            (marks_db[a] - level_db)
+                .abs()
+                .total_cmp(&(marks_db[b] - level_db).abs())
+        })
+        .unwrap_or(3);
+    Dynamic::MARKS[i].0
+}
+
+/// The tick of `time_s` on the coarsest grid of [`GRIDS`] that keeps it within
+/// [`QUANTISE_TOLERANCE_S`], else the nearest tick; never at or before `after`.
+pub fn quantise(map: &TempoMap, tpq: u32, time_s: f64, after: Option<u64>) -> u64 {
+    let exact = map.tick_at(time_s).max(0.0);
+    let fits = |t: u64| {
+        (map.seconds_at(t as f64) - time_s).abs() <= QUANTISE_TOLERANCE_S
+            && after.is_none_or(|a| t > a)
+    };
+    GRIDS
+        .iter()
+        .filter(|&&g| tpq.is_multiple_of(g))
+        .map(|&g| {
+            let step = f64::from(tpq / g);
+            ((exact / step).round() * step) as u64
+        })
+        .find(|&t| fits(t))
+        .unwrap_or_else(|| {
+            let t = exact.round() as u64;
+            after.map_or(t, |a| t.max(a + 1))
+        })
+}
+
+/// Place every stroke: pitch, drum, tick, dynamic. `marks_db(pitch)` gives the levels of
+/// the six markings on a drum tuned to `pitch`.
+pub fn place(
+    strokes: &[Stroke],
+    kit: &Kit,
+    map: &TempoMap,
+    tpq: u32,
+    marks_db: &mut dyn FnMut(Pitch) -> [f64; 6],
+) -> (Vec<Placed>, Notes) {
+    let offset = tuning_offset_cents(strokes) / 100.0;
+    let mut tunings: Vec<Pitch> = kit.drums.iter().map(|d| d.tuning).collect();
+    let mut notes = Notes::default();
+    let mut placed: Vec<Placed> = Vec::new();
+    for s in strokes {
+        let mut drums: Vec<(usize, Pitch)> = Vec::new();
+        if let Some(f) = s.principal_hz {
+            let p = Pitch((midi_of(f) - offset).round().clamp(0.0, 127.0) as u8);
+            if let Some((i, p, moved)) = drum_for(kit, &mut tunings, p, None) {
+                notes.octave_moves += usize::from(moved);
+                drums.push((i, p));
+            }
+        }
+        if drums.is_empty() {
+            notes.unpitched += 1;
+            let i = placed.last().map_or(0, |p: &Placed| p.drums[0].0);
+            if i < kit.drums.len() {
+                drums.push((i, tunings[i]));
+            }
+        }
+        let Some(&(_, pitch)) = drums.first() else {
+            continue;
+        };
+        let tick = quantise(map, tpq, s.time_s, placed.last().map(|p| p.tick));
+        placed.push(Placed {
+            time_s: s.time_s,
+            tick,
+            drums,
+            dynamic: dynamic_for(s.level_db, &marks_db(pitch)),
+        });
+    }
+    (placed, notes)
+}
+
+/// Runs of strokes to write as rolls: (first, last) index, inclusive.
+pub fn roll_runs(placed: &[Placed]) -> Vec<(usize, usize)> {
+    let same_drum = |a: &Placed, b: &Placed| a.drums.len() == 1 && a.drums == b.drums;
+    let mut runs = Vec::new();
+    let mut i = 0;
+    while i < placed.len() {
+        let mut j = i;
+        while j + 1 < placed.len()
+            && same_drum(&placed[j], &placed[j + 1])
+            && placed[j + 1].time_s - placed[j].time_s <= ROLL_MAX_GAP_S
+        {
+            j += 1;
+        }
+        if j + 1 - i >= ROLL_MIN_STROKES && even(&placed[i..=j]) {
+            runs.push((i, j));
+        }
+        i = j + 1;
+    }
+    runs
+}
+
+/// Whether the gaps of a run are all within [`ROLL_EVENNESS`] of their median.
+fn even(run: &[Placed]) -> bool {
+    let mut gaps: Vec<f64> = run.windows(2).map(|w| w[1].time_s - w[0].time_s).collect();
+    gaps.sort_by(f64::total_cmp);
+    let median = gaps[gaps.len() / 2];
+    gaps.iter()
+        .all(|g| (g / median - 1.0).abs() <= ROLL_EVENNESS)
+}
+
+/// A roll over `run`: strokes per quarter the divisor of `tpq` (1–32) nearest the run's
+/// rate, one stroke-step of length per stroke (a roll's strokes run up to, not at, its
+/// end; see [`crate::score::Beat::stroke_ticks`]).
+pub fn roll_of(run: &[Placed], tpq: u32) -> Roll {
+    let first = run[0].tick;
+    let last = run[run.len() - 1].tick;
+    let gap_ticks = (last - first) as f64 / (run.len() - 1) as f64;
+    let per_quarter = (1..=32u32)
+        .filter(|d| tpq.is_multiple_of(*d))
+        .min_by(|&a, &b| {
+            let err = |d: u32| (f64::from(tpq) / f64::from(d) / gap_ticks).ln().abs();
+            err(a).total_cmp(&err(b))
+        })
+        .unwrap_or(8);
+    let step = u64::from(tpq / per_quarter);
+    let strokes = ((last - first) as f64 / step as f64).round() as u64 + 1;
+    Roll {
+        length_ticks: strokes * step,
+        strokes_per_quarter: per_quarter,
+    }
+}
+
+/// The beats of the placed strokes: rolls where [`roll_runs`] finds them, a beat per drum
+/// of each other stroke; the drum's pitch written only where it differs from the kit's.
+pub fn beats(placed: &[Placed], kit: &Kit, tpq: u32) -> (Vec<Beat>, usize) {
+    let runs = roll_runs(placed);
+    let mut beats = Vec::new();
+    let mut i = 0;
+    let mut run = runs.iter().peekable();
+    while i < placed.len() {
+        let p = &placed[i];
+        let beat = |(drum, pitch): (usize, Pitch)| Beat {
+            tick: p.tick,
+            hand: Hand::Auto,
+            mode: PlayingMode::Legato,
+            dynamic: p.dynamic,
+            drum,
+            pitch: (pitch != kit.drums[drum].tuning).then_some(pitch),
+            location: ImpactLocation::PlayingSpot,
+            roll: None,
+            damp: None,
+        };
+        if let Some(&&(a, b)) = run.peek()
+            && a == i
+        {
+            let mut b0 = beat(p.drums[0]);
+            b0.roll = Some(roll_of(&placed[a..=b], tpq));
+            beats.push(b0);
+            run.next();
+            i = b + 1;
+            continue;
+        }
+        beats.extend(p.drums.iter().map(|&d| beat(d)));
+        i += 1;
+    }
+    (beats, runs.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::score::{TempoChange, TempoPoint};
+
+    fn map(bpm: f64) -> TempoMap {
+        TempoMap::new(
+            &[TempoPoint {
+                tick: 0,
+                bpm,
+                change: TempoChange::Step,
+            }],
+            960,
+        )
+    }
+
+    /// On the beat, an eighth, a triplet and a late stroke land on their grids; a stroke
+    /// between grids keeps its exact tick.
+    #[test]
+    fn quantises_to_the_coarsest_grid() {
+        let m = map(60.0);
+        assert_eq!(quantise(&m, 960, 1.003, None), 960);
+        assert_eq!(quantise(&m, 960, 1.5, None), 1440);
+        assert_eq!(quantise(&m, 960, 1.0 / 3.0, None), 320);
+        assert_eq!(quantise(&m, 960, 2.1143, None), 2030);
+        assert_eq!(quantise(&m, 960, 1.0, Some(960)), 961);
+    }
+
+    /// A pitch goes to the drum tuned to it; a chord to two drums; an unreachable pitch
+    /// is moved by octaves; a new pitch retunes the nearest drum in range.
+    #[test]
+    fn drums_for_pitches() {
+        let kit = Kit::standard();
+        let mut tunings: Vec<Pitch> = kit.drums.iter().map(|d| d.tuning).collect();
+        let t = tunings.clone();
+        for (i, &p) in t.iter().enumerate() {
+            assert_eq!(drum_for(&kit, &mut tunings, p, None), Some((i, p, false)));
+        }
+        let (d, _, _) = drum_for(&kit, &mut tunings, t[2], Some(2)).unwrap();
+        assert_ne!(d, 2);
+        let high = Pitch(t[3].0 + 24);
+        let (_, moved, octave) = drum_for(&kit, &mut tunings, high, None).unwrap();
+        assert!(octave && (i32::from(high.0) - i32::from(moved.0)) % 12 == 0);
+        let new = Pitch(t[2].0 + 1);
+        let (d, p, _) = drum_for(&kit, &mut tunings, new, None).unwrap();
+        assert_eq!((p, tunings[d]), (new, new));
+    }
+
+    /// Ten even strokes 62.5 ms apart at 60 bpm become one roll of 16 strokes per quarter
+    /// and ten strokes' length; one stroke 30 ms late breaks the evenness.
+    #[test]
+    fn even_fast_runs_are_rolls() {
+        let m = map(60.0);
+        let placed: Vec<Placed> = (0..10)
+            .map(|k| {
+                let t = 1.0 + f64::from(k) * 0.0625;
+                Placed {
+                    time_s: t,
+                    tick: quantise(&m, 960, t, None),
+                    drums: vec![(1, Pitch(45))],
+                    dynamic: Dynamic::P,
+                }
+            })
+            .collect();
+        assert_eq!(roll_runs(&placed), vec![(0, 9)]);
+        let roll = roll_of(&placed, 960);
+        assert_eq!(roll.strokes_per_quarter, 16);
+        assert_eq!(roll.length_ticks, 10 * 60);
+        let (beats, rolls) = beats(&placed, &Kit::standard(), 960);
+        assert_eq!((beats.len(), rolls), (1, 1));
+        assert_eq!(beats[0].tick, 960);
+        let uneven: Vec<Placed> = placed
+            .iter()
+            .enumerate()
+            .map(|(k, p)| Placed {
+                time_s: p.time_s + if k == 5 { 0.03 } else { 0.0 },
+                ..p.clone()
+            })
+            .collect();
+        assert!(roll_runs(&uneven).is_empty());
+    }
+}

@@ -1,0 +1,143 @@
+//! What each stroke sounded: the spectrum it added (the window after the onset less the
+//! window before it, so drums still ringing from earlier strokes drop out), its principal
+//! (1,1) partial found by the kettledrum ratios (Fletcher & Rossing: 1, 1.50, 1.98, 2.44,
+//! 2.94) within the pitches the kit reaches, and the energy it added over its first 40 ms
+//! (dB re full scale). One pitch per stroke: two drums struck together are heard as the
+//! stronger.
+
+use crate::sound::analysis::KETTLEDRUM_RATIOS;
+use crate::sound::spectrum::{peak_in, principal_hz, spectrum};
+
+/// The spectrum windows start this long after the onset (past the click), s.
+const AFTER_ONSET_S: f64 = 0.005;
+/// Window length: up to the next onset, within these bounds, s.
+const WINDOW_S: (f64, f64) = (0.06, 0.15);
+/// Span over which a stroke's added energy is measured, s.
+pub const LEVEL_SPAN_S: f64 = 0.04;
+/// A re-struck drum still ringing adds little new: when the added spectrum's (1,1) is
+/// under this share of the whole window's, the whole window decides the pitch.
+const RESTRIKE_SHARE: f64 = 0.2;
+
+/// What a stroke added.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Heard {
+    /// Its principal (1,1) frequency, Hz, when a kettledrum pattern was found.
+    pub principal_hz: Option<f64>,
+    /// Energy the stroke added over its first [`LEVEL_SPAN_S`], dB re a full-scale sine.
+    pub level_db: f64,
+}
+
+/// What the stroke at `onset_s` added, `next_s` being the following onset (if any), its
+/// principal sought within `band_hz`.
+pub fn hear(
+    samples: &[f32],
+    rate_hz: u32,
+    onset_s: f64,
+    next_s: Option<f64>,
+    band_hz: (f64, f64),
+) -> Heard {
+    let gap = next_s.map_or(WINDOW_S.1, |n| n - onset_s - 2.0 * AFTER_ONSET_S);
+    let window = gap.clamp(WINDOW_S.0, WINDOW_S.1);
+    let after = slice(samples, rate_hz, onset_s + AFTER_ONSET_S, window);
+    let before = slice(samples, rate_hz, onset_s - AFTER_ONSET_S - window, window);
+    let after = spectrum(&after, rate_hz);
+    let added = added_spectrum(&after, &spectrum(&before, rate_hz));
+    let principal = |spec: &[(f64, f64)]| {
+        let f = principal_hz(spec, band_hz.0, band_hz.1, &KETTLEDRUM_RATIOS)?;
+        Some((f, peak_in(spec, f * 0.99, f * 1.01).map_or(0.0, |p| p.1)))
+    };
+    let new = principal(&added);
+    let principal_hz = match (new, principal(&after)) {
+        (Some((f, a)), Some((_, whole))) if a >= RESTRIKE_SHARE * whole => Some(f),
+        (_, Some((f, _))) => Some(f),
+        (new, None) => new.map(|p| p.0),
+    };
+    Heard {
+        principal_hz,
+        level_db: added_level_db(samples, rate_hz, onset_s),
+    }
+}
+
+/// `len_s` of `samples` from `start_s`, zero where it runs off either end.
+fn slice(samples: &[f32], rate_hz: u32, start_s: f64, len_s: f64) -> Vec<f32> {
+    let rate = f64::from(rate_hz);
+    let start = (start_s * rate).round() as isize;
+    let len = (len_s * rate).round() as usize;
+    (0..len)
+        .map(|i| {
+            let j = start + i as isize;
+            if j >= 0 {
+                samples.get(j as usize).copied().unwrap_or(0.0)
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+/// Amplitudes the later spectrum has above the earlier, bin by bin (none below).
+fn added_spectrum(after: &[(f64, f64)], before: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    after
+        .iter()
+        .zip(before)
+        .map(|(&(f, a), &(_, b))| (f, (a - b).max(0.0)))
+        .collect()
+}
+
+/// Energy added by the stroke at `onset_s`: mean square over [`LEVEL_SPAN_S`] after it
+/// less the mean square over the same span before it, in dB re a full-scale sine (0.5).
+pub fn added_level_db(samples: &[f32], rate_hz: u32, onset_s: f64) -> f64 {
+    let mean_square = |v: &[f32]| {
+        v.iter().map(|&s| f64::from(s) * f64::from(s)).sum::<f64>() / v.len().max(1) as f64
+    };
+    let after = mean_square(&slice(samples, rate_hz, onset_s, LEVEL_SPAN_S));
+    let before = mean_square(&slice(
+        samples,
+        rate_hz,
+        onset_s - LEVEL_SPAN_S,
+        LEVEL_SPAN_S,
+    ));
+    10.0 * ((after - before).max(1e-12) / 0.5).log10()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sound::analysis::KETTLEDRUM_RATIOS;
+
+    /// A kettledrum-like note (the five ratios, each partial 2 dB below the last) from `t0`.
+    fn note(out: &mut [f32], rate: u32, t0: f64, hz: f64, amp: f64) {
+        let start = (t0 * f64::from(rate)) as usize;
+        for (i, s) in out.iter_mut().enumerate().skip(start) {
+            let t = (i - start) as f64 / f64::from(rate);
+            let v: f64 = KETTLEDRUM_RATIOS
+                .iter()
+                .enumerate()
+                .map(|(k, r)| (std::f64::consts::TAU * r * hz * t).sin() * 0.8f64.powi(k as i32))
+                .sum();
+            *s += (amp * (-t / 0.8).exp() * v) as f32;
+        }
+    }
+
+    /// A new note is heard over a louder one still ringing; the level follows the
+    /// amplitude (6 dB per doubling).
+    #[test]
+    fn hears_new_notes_over_ringing_ones() {
+        let rate = 48_000;
+        let mut s = vec![0.0f32; rate as usize * 2];
+        note(&mut s, rate, 0.1, 110.0, 0.6);
+        note(&mut s, rate, 0.5, 146.83, 0.2);
+        let heard = hear(&s, rate, 0.5, None, (60.0, 300.0));
+        assert!(
+            (heard.principal_hz.unwrap() / 146.83 - 1.0).abs() < 0.01,
+            "{heard:?}"
+        );
+
+        let mut loud = vec![0.0f32; rate as usize];
+        note(&mut loud, rate, 0.1, 110.0, 0.4);
+        let mut soft = vec![0.0f32; rate as usize];
+        note(&mut soft, rate, 0.1, 110.0, 0.2);
+        let d = added_level_db(&loud, rate, 0.1) - added_level_db(&soft, rate, 0.1);
+        assert!((d - 6.02).abs() < 0.1, "{d}");
+    }
+}
