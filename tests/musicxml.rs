@@ -1,7 +1,7 @@
 //! MusicXML import: the real Bach chorale movement checked note by note, hand-written
 //! snippets for each element read, malformed input, the whole MusicXML test suite (no
-//! file may crash the importer), `import-musicxml` through the binary, `timpanist FILE`
-//! dispatch, and MIDI text in Shift-JIS and Latin-1.
+//! file may crash the importer), `import-musicxml` and `export-musicxml` through the
+//! binary, `timpanist FILE` dispatch, and MIDI text in Shift-JIS and Latin-1.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -939,6 +939,80 @@ fn cli_import_musicxml() {
         "P0",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// `export-musicxml` writes plain text or a `.mxl` archive with its container; a
+/// missing score or an unwritable target fails naming the file and leaves nothing.
+#[test]
+fn cli_export_musicxml() {
+    let tmp = tempfile::tempdir().unwrap();
+    let score = Path::new(env!("CARGO_MANIFEST_DIR")).join("scores/roll-exercise.ron");
+    let plain = tmp.path().join("roll.musicxml");
+    let o = timpanist(&[
+        "export-musicxml",
+        score.to_str().unwrap(),
+        "-o",
+        plain.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("22 beats"));
+    let loaded = timpanist::score::LoadedScore::load(&score).unwrap();
+    assert_eq!(
+        std::fs::read_to_string(&plain).unwrap(),
+        timpanist::io::musicxml_export::export(&loaded.score, &loaded.kit)
+    );
+    let mxl = tmp.path().join("roll.mxl");
+    let o = timpanist(&[
+        "export-musicxml",
+        score.to_str().unwrap(),
+        "-o",
+        mxl.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let bytes = std::fs::read(&mxl).unwrap();
+    let mut zip = zip::ZipArchive::new(std::io::Cursor::new(&bytes)).unwrap();
+    let names: Vec<String> = zip.file_names().map(|n| n.unwrap().into_owned()).collect();
+    assert_eq!(
+        names,
+        ["mimetype", "META-INF/container.xml", "score.musicxml"]
+    );
+    let mut container = String::new();
+    std::io::Read::read_to_string(
+        &mut zip.by_name("META-INF/container.xml").unwrap(),
+        &mut container,
+    )
+    .unwrap();
+    assert!(container.contains("full-path=\"score.musicxml\""));
+    let (back, _) = import(
+        Path::new("roll.mxl"),
+        &bytes,
+        &loaded.kit,
+        &ImportOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(back.beats.len(), 22);
+
+    let missing = tmp.path().join("none.ron");
+    let out = tmp.path().join("none.musicxml");
+    let o = timpanist(&[
+        "export-musicxml",
+        missing.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("none.ron"));
+    assert!(!out.exists());
+    let o = timpanist(&[
+        "export-musicxml",
+        score.to_str().unwrap(),
+        "-o",
+        "/no/such/dir/x.musicxml",
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("/no/such/dir/x.musicxml"));
+    let left: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().collect();
+    assert_eq!(left.len(), 2, "no temporary files: {left:?}");
 }
 
 // ---- timpanist FILE ----

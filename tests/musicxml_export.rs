@@ -1,9 +1,9 @@
 //! MusicXML export: every demo score exported and imported again keeps its beats' ticks,
 //! pitches, modes, dynamic markings, rolls and hands; a hand-made score checks damping,
 //! ties across bar lines, meter changes, odd lengths and exact velocities; the written
-//! XML is checked element by element; `export-musicxml` through the binary (plain and
-//! `.mxl`, errors naming the file, nothing written on failure); and, when python3 has
-//! music21, an independent reader agrees on every note's offset, pitch and articulation.
+//! XML is checked element by element (`export-musicxml` through the binary is tested in
+//! `tests/musicxml.rs`, beside `import-musicxml`); and, when python3 has music21, an
+//! independent reader agrees on every note's offset, pitch and articulation.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -213,81 +213,6 @@ fn written_elements() {
     assert!(measures[2].contains("<duration>2</duration><voice>1</voice><type>16th</type><notations><articulations><strong-accent type=\"up\"/></articulations>"), "{}", measures[2]);
     // The last beat lasts a quarter, to the end of the bar.
     assert!(measures[2].contains("<duration>6</duration><voice>1</voice><type>quarter</type><notations><articulations><tenuto/></articulations><technical><other-technical>R</other-technical></technical>"), "{}", measures[2]);
-}
-
-fn timpanist(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_timpanist"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-/// `export-musicxml` writes plain text or a `.mxl` archive with its container; a
-/// missing score or an unwritable target fails naming the file and leaves nothing.
-#[test]
-fn cli_export_musicxml() {
-    let tmp = tempfile::tempdir().unwrap();
-    let score = Path::new(ROOT).join("scores/roll-exercise.ron");
-    let plain = tmp.path().join("roll.musicxml");
-    let o = timpanist(&[
-        "export-musicxml",
-        score.to_str().unwrap(),
-        "-o",
-        plain.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert!(String::from_utf8_lossy(&o.stdout).contains("22 beats"));
-    let loaded = LoadedScore::load(&score).unwrap();
-    assert_eq!(
-        std::fs::read_to_string(&plain).unwrap(),
-        export(&loaded.score, &loaded.kit)
-    );
-    let mxl = tmp.path().join("roll.mxl");
-    let o = timpanist(&[
-        "export-musicxml",
-        score.to_str().unwrap(),
-        "-o",
-        mxl.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let bytes = std::fs::read(&mxl).unwrap();
-    let mut zip = zip::ZipArchive::new(std::io::Cursor::new(&bytes)).unwrap();
-    let names: Vec<String> = zip.file_names().map(|n| n.unwrap().into_owned()).collect();
-    assert_eq!(
-        names,
-        ["mimetype", "META-INF/container.xml", "score.musicxml"]
-    );
-    let mut container = String::new();
-    std::io::Read::read_to_string(
-        &mut zip.by_name("META-INF/container.xml").unwrap(),
-        &mut container,
-    )
-    .unwrap();
-    assert!(container.contains("full-path=\"score.musicxml\""));
-    let back = round_trip(&bytes, "roll.mxl", &loaded.kit);
-    assert_eq!(back.beats.len(), 22);
-
-    let missing = tmp.path().join("none.ron");
-    let out = tmp.path().join("none.musicxml");
-    let o = timpanist(&[
-        "export-musicxml",
-        missing.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert!(!o.status.success());
-    assert!(String::from_utf8_lossy(&o.stderr).contains("none.ron"));
-    assert!(!out.exists());
-    let o = timpanist(&[
-        "export-musicxml",
-        score.to_str().unwrap(),
-        "-o",
-        "/no/such/dir/x.musicxml",
-    ]);
-    assert!(!o.status.success());
-    assert!(String::from_utf8_lossy(&o.stderr).contains("/no/such/dir/x.musicxml"));
-    let left: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().collect();
-    assert_eq!(left.len(), 2, "no temporary files: {left:?}");
 }
 
 /// What music21 must read from a demo's export: per note (chord notes each), the offset
