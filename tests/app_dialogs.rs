@@ -1,12 +1,13 @@
 //! The in-window file browser the editor falls back to where the system's dialog cannot
 //! open (no desktop portal): Ctrl+O shows it, a click on a score and on Open loads that
-//! score; Save As writes where it is told; Cancel leaves everything as it was.
+//! score; Save As writes where it is told; Cancel leaves everything as it was; File >
+//! Export MusicXML needs no rendering and writes a score that imports back.
 
 mod common;
 
 use common::{editor, root, settle};
 use eframe::egui;
-use egui_kittest::kittest::Queryable;
+use egui_kittest::kittest::{NodeT, Queryable};
 use std::path::Path;
 
 /// The editor on the demo score `name` from `scores/`, settled (no rendering).
@@ -112,4 +113,51 @@ fn the_demo_scores_menu_opens_a_built_in_demo() {
     assert_eq!(loaded.score.title, want.title);
     assert_eq!(loaded.score.beats.len(), want.beats.len());
     assert_eq!(h.state().path(), None, "a demo opens unsaved");
+}
+
+/// File > Export MusicXML... needs no rendering: it is enabled while rendering is off
+/// and asks where to write; the export (here without the dialog) writes MusicXML that
+/// imports back with the score's beats at the same ticks and pitches, and `.mxl` a zip.
+#[test]
+fn export_musicxml_from_the_file_menu() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = settled(dir.path(), "roll-exercise");
+    h.get_by_label("File").click();
+    settle(&mut h);
+    let item = h.get_by_label("Export MusicXML...");
+    assert!(!item.accesskit_node().is_disabled());
+    assert!(
+        h.get_by_label("Export WAV...")
+            .accesskit_node()
+            .is_disabled()
+    );
+    h.get_by_label("Export MusicXML...").click();
+    settle(&mut h);
+    assert!(h.state().is_file_browser_open(), "no dialog");
+    h.get_by_label("Cancel").click();
+    settle(&mut h);
+
+    let loaded =
+        timpanist::score::LoadedScore::load(&root().join("scores/roll-exercise.ron")).unwrap();
+    for name in ["roll.musicxml", "roll.mxl"] {
+        let path = dir.path().join(name);
+        h.state_mut().export_musicxml_to(&path);
+        h.state_mut().wait_for_files();
+        assert!(h.state().error().is_none(), "{:?}", h.state().error());
+        let (back, _) = timpanist::io::musicxml::import_file(
+            &path,
+            &loaded.kit,
+            &timpanist::io::musicxml::ImportOptions::default(),
+        )
+        .unwrap();
+        let notes = |s: &timpanist::score::Score| -> Vec<(u64, u8)> {
+            s.beats
+                .iter()
+                .map(|b| (b.tick, b.sounding_pitch(&loaded.kit).0))
+                .collect()
+        };
+        assert_eq!(notes(&back), notes(&loaded.score), "{name}");
+    }
+    let mxl = std::fs::read(dir.path().join("roll.mxl")).unwrap();
+    assert!(mxl.starts_with(b"PK\x03\x04"));
 }

@@ -1,7 +1,7 @@
 //! MusicXML import: the real Bach chorale movement checked note by note, hand-written
 //! snippets for each element read, malformed input, the whole MusicXML test suite (no
-//! file may crash the importer), `import-musicxml` through the binary, `timpanist FILE`
-//! dispatch, and MIDI text in Shift-JIS and Latin-1.
+//! file may crash the importer), `import-musicxml` and `export-musicxml` through the
+//! binary, `timpanist FILE` dispatch, and MIDI text in Shift-JIS and Latin-1.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -9,7 +9,7 @@ use timpanist::base::pitch::Pitch;
 use timpanist::io::musicxml::{ImportOptions, ImportReport, MusicXmlError, import, import_file};
 use timpanist::io::open::{self, FileKind, OpenAction, OpenError};
 use timpanist::kit::Kit;
-use timpanist::score::{Dynamic, PlayingMode, Roll, Score};
+use timpanist::score::{Dynamic, Hand, PlayingMode, Roll, Score};
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data");
 const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures");
@@ -434,7 +434,8 @@ fn backup_forward_and_voices() {
     assert_eq!(report.duplicates_dropped, 1);
 }
 
-/// Grace notes are skipped, repeats and fermatas reported, each with its measure.
+/// Grace notes are skipped and fermatas reported, each with its measure; the repeat
+/// is played twice and said so.
 #[test]
 fn reported_not_performed() {
     let xml = doc(&[
@@ -451,16 +452,231 @@ fn reported_not_performed() {
         ),
     ]);
     let (score, report) = run(&xml);
-    assert_eq!(timeline(&score), vec![(0, p("D3"))]);
+    assert_eq!(timeline(&score), vec![(0, p("D3")), (7680, p("D3"))]);
     let all = report.notices.join("\n");
     assert!(
-        all.contains("grace note: skipped (grace notes take no time) (measure 1)"),
+        all.contains("grace note: skipped (grace notes take no time) ×2 (the first in measure 1)"),
         "{all}"
     );
     assert!(all.contains("fermata"), "{all}");
     assert!(
-        all.contains("repeat sign: not expanded") && all.contains("×2"),
+        all.contains("repeats expanded: the 2 written measures are played as 4"),
         "{all}"
+    );
+}
+
+/// A bar line (left or right) holding `inner`.
+fn barline(location: &str, inner: &str) -> String {
+    format!("<barline location=\"{location}\">{inner}</barline>")
+}
+
+/// Repeats and volta endings play in performed order: bar 1, |: bar 2 [1. bar 3 :|]
+/// [2. bar 4] bar 5 |: bar 6 :| ×3 is bars 1 2 3 2 4 5 6 6 6, each a quarter note of its
+/// own pitch in 1/4 (so a bar is 960 ticks); the 45a–45d files of the test suite expand
+/// to the measure counts music21 gives them.
+#[test]
+fn repeats_and_endings_expand() {
+    let one = "<attributes><divisions>1</divisions><time><beats>1</beats><beat-type>4</beat-type></time></attributes>";
+    let pitches = ["C3", "D3", "E3", "F3", "G3", "A2"];
+    let fwd = barline("left", "<repeat direction=\"forward\"/>");
+    let measures = [
+        format!("{one}{}", note(pitches[0], 1, "")),
+        format!("{fwd}{}", note(pitches[1], 1, "")),
+        format!(
+            "{}{}{}",
+            barline("left", "<ending number=\"1\" type=\"start\"/>"),
+            note(pitches[2], 1, ""),
+            barline(
+                "right",
+                "<ending number=\"1\" type=\"stop\"/><repeat direction=\"backward\"/>"
+            )
+        ),
+        format!(
+            "{}{}{}",
+            barline("left", "<ending number=\"2\" type=\"start\"/>"),
+            note(pitches[3], 1, ""),
+            barline("right", "<ending number=\"2\" type=\"discontinue\"/>")
+        ),
+        note(pitches[4], 1, ""),
+        format!(
+            "{fwd}{}{}",
+            note(pitches[5], 1, ""),
+            barline("right", "<repeat direction=\"backward\" times=\"3\"/>")
+        ),
+    ];
+    let refs: Vec<&str> = measures.iter().map(String::as_str).collect();
+    let (score, report) = run(&doc(&refs));
+    let want: Vec<(u64, Pitch)> = [0, 1, 2, 1, 3, 4, 5, 5, 5]
+        .iter()
+        .enumerate()
+        .map(|(k, &m)| (960 * k as u64, p(pitches[m])))
+        .collect();
+    assert_eq!(timeline(&score), want);
+    assert!(
+        report
+            .notices
+            .iter()
+            .any(|n| n == "repeats expanded: the 6 written measures are played as 9"),
+        "{:?}",
+        report.notices
+    );
+    assert!(!report.notices.iter().any(|n| n.contains("repeat sign")));
+
+    // The test suite's repeat files: written and performed measures, as music21 10.5's
+    // expandRepeats counts them (45c nests a times="5" repeat in a times="3" one).
+    let kit = Kit::standard();
+    let dir = Path::new(DATA).join("musicxml-testsuite/xmlFiles");
+    for (name, written, played) in [
+        ("45a-SimpleRepeat.xml", 2, 6),
+        ("45b-RepeatWithAlternatives.xml", 4, 5),
+        ("45c-RepeatMultipleTimes.xml", 8, 46),
+        ("45d-Repeats-Nested-Alternatives.xml", 12, 16),
+    ] {
+        let opts = ImportOptions {
+            part: Some("P1".into()),
+            ..ImportOptions::default()
+        };
+        let (_, report) = import_file(&dir.join(name), &kit, &opts).unwrap();
+        let expanded = format!("the {written} written measures are played as {played}");
+        assert!(
+            report.notices.iter().any(|n| n.contains(&expanded)),
+            "{name}: {:?}",
+            report.notices
+        );
+    }
+}
+
+/// A two-note tremolo alternates its two drums at the rate of its marks plus the notes'
+/// beams: two half notes (each written a whole, 2:1) with 3 marks fill a whole note with
+/// 32 thirty-seconds, D3 first; two quarters typed eighths with 2 marks, 1 beam are 32nds
+/// too; the first stroke on each drum keeps its note's accent.
+#[test]
+fn two_note_tremolos_alternate() {
+    let trem = |t: &str, marks: u32| {
+        format!(
+            "<notations><ornaments><tremolo type=\"{t}\">{marks}</tremolo></ornaments></notations>"
+        )
+    };
+    let half = "<type>whole</type><time-modification><actual-notes>2</actual-notes><normal-notes>1</normal-notes></time-modification>";
+    let xml = doc(&[
+        &format!(
+            "{}{}{}",
+            attrs(2),
+            note("D3", 4, &format!("{half}{}", trem("start", 3))),
+            note("A2", 4, &format!("{half}{}", trem("stop", 3))),
+        ),
+        &format!(
+            "{}{}{}",
+            note(
+                "D3",
+                1,
+                &format!(
+                    "<type>eighth</type>{}",
+                    trem("start", 2).replace(
+                        "</ornaments>",
+                        "</ornaments><articulations><accent/></articulations>"
+                    )
+                )
+            ),
+            note("A2", 1, &format!("<type>eighth</type>{}", trem("stop", 2))),
+            rest(6)
+        ),
+    ]);
+    let (score, report) = run(&xml);
+    let mut want: Vec<(u64, Pitch)> = (0..32)
+        .map(|k| (120 * k, p(if k % 2 == 0 { "D3" } else { "A2" })))
+        .collect();
+    want.extend((0..8).map(|k| (3840 + 120 * k, p(if k % 2 == 0 { "D3" } else { "A2" }))));
+    assert_eq!(timeline(&score), want);
+    let modes: Vec<PlayingMode> = score.beats[32..35].iter().map(|b| b.mode).collect();
+    assert_eq!(
+        modes,
+        [
+            PlayingMode::Accent,
+            PlayingMode::Legato,
+            PlayingMode::Legato
+        ]
+    );
+    assert!(
+        !report.notices.iter().any(|n| n.contains("tremolo")),
+        "{:?}",
+        report.notices
+    );
+}
+
+/// `<stopped/>` damps a note when it (with its tied notes) ends, a damped roll's
+/// tremolo stops where its tied notes stop carrying the marks, and `<other-technical>`
+/// R and L are the hands.
+#[test]
+fn stopped_and_stickings() {
+    let tech = |inner: &str| format!("<notations><technical>{inner}</technical></notations>");
+    let tied_trem = |tie: &str, tremolo: bool, extra: &str| {
+        let trem = if tremolo {
+            "<ornaments><tremolo type=\"single\">3</tremolo></ornaments>"
+        } else {
+            ""
+        };
+        let ties: String = tie
+            .split(',')
+            .map(|t| format!("<tied type=\"{t}\"/>"))
+            .collect();
+        let tie_el: String = tie
+            .split(',')
+            .map(|t| format!("<tie type=\"{t}\"/>"))
+            .collect();
+        format!("{tie_el}<notations>{ties}{trem}{extra}</notations>")
+    };
+    let xml = doc(&[
+        &format!(
+            "{}{}{}{}",
+            attrs(2),
+            note(
+                "D3",
+                1,
+                &tech("<other-technical>L</other-technical><stopped/>")
+            ),
+            rest(1),
+            note(
+                "A2",
+                6,
+                &tied_trem(
+                    "start",
+                    true,
+                    "<technical><other-technical>R</other-technical></technical>"
+                )
+            ),
+        ),
+        &format!(
+            "{}{}{}",
+            note("A2", 2, &tied_trem("stop,start", true, "")),
+            note(
+                "A2",
+                2,
+                &tied_trem("stop", false, "<technical><stopped/></technical>")
+            ),
+            rest(4)
+        ),
+    ]);
+    let (score, _) = run(&xml);
+    let got: Vec<(u64, Hand, Option<Roll>, Option<u64>)> = score
+        .beats
+        .iter()
+        .map(|b| (b.tick, b.hand, b.roll, b.damp))
+        .collect();
+    assert_eq!(
+        got,
+        vec![
+            (0, Hand::Left, None, Some(480)),
+            (
+                960,
+                Hand::Right,
+                Some(Roll {
+                    length_ticks: 3840,
+                    strokes_per_quarter: 8
+                }),
+                Some(960)
+            ),
+        ]
     );
 }
 
@@ -723,6 +939,80 @@ fn cli_import_musicxml() {
         "P0",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// `export-musicxml` writes plain text or a `.mxl` archive with its container; a
+/// missing score or an unwritable target fails naming the file and leaves nothing.
+#[test]
+fn cli_export_musicxml() {
+    let tmp = tempfile::tempdir().unwrap();
+    let score = Path::new(env!("CARGO_MANIFEST_DIR")).join("scores/roll-exercise.ron");
+    let plain = tmp.path().join("roll.musicxml");
+    let o = timpanist(&[
+        "export-musicxml",
+        score.to_str().unwrap(),
+        "-o",
+        plain.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("22 beats"));
+    let loaded = timpanist::score::LoadedScore::load(&score).unwrap();
+    assert_eq!(
+        std::fs::read_to_string(&plain).unwrap(),
+        timpanist::io::musicxml_export::export(&loaded.score, &loaded.kit)
+    );
+    let mxl = tmp.path().join("roll.mxl");
+    let o = timpanist(&[
+        "export-musicxml",
+        score.to_str().unwrap(),
+        "-o",
+        mxl.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let bytes = std::fs::read(&mxl).unwrap();
+    let mut zip = zip::ZipArchive::new(std::io::Cursor::new(&bytes)).unwrap();
+    let names: Vec<String> = zip.file_names().map(|n| n.unwrap().into_owned()).collect();
+    assert_eq!(
+        names,
+        ["mimetype", "META-INF/container.xml", "score.musicxml"]
+    );
+    let mut container = String::new();
+    std::io::Read::read_to_string(
+        &mut zip.by_name("META-INF/container.xml").unwrap(),
+        &mut container,
+    )
+    .unwrap();
+    assert!(container.contains("full-path=\"score.musicxml\""));
+    let (back, _) = import(
+        Path::new("roll.mxl"),
+        &bytes,
+        &loaded.kit,
+        &ImportOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(back.beats.len(), 22);
+
+    let missing = tmp.path().join("none.ron");
+    let out = tmp.path().join("none.musicxml");
+    let o = timpanist(&[
+        "export-musicxml",
+        missing.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("none.ron"));
+    assert!(!out.exists());
+    let o = timpanist(&[
+        "export-musicxml",
+        score.to_str().unwrap(),
+        "-o",
+        "/no/such/dir/x.musicxml",
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("/no/such/dir/x.musicxml"));
+    let left: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().collect();
+    assert_eq!(left.len(), 2, "no temporary files: {left:?}");
 }
 
 // ---- timpanist FILE ----

@@ -209,6 +209,12 @@ impl EditorApp {
         self.export_to(Export::Midi, path);
     }
 
+    /// Export the score as MusicXML at `path` (File > Export MusicXML; `.mxl`
+    /// compressed).
+    pub fn export_musicxml_to(&mut self, path: &Path) {
+        self.export_to(Export::MusicXml, path);
+    }
+
     /// Export the current rendering's motion as C3D at `path` (File > Export motion C3D).
     pub fn export_c3d_to(&mut self, path: &Path) {
         self.export_to(Export::MotionC3d, path);

@@ -4,7 +4,8 @@
 //! tips for motion-capture tools), as BVH (`io::bvh`, the skeleton animated for Blender:
 //! 250 Hz, metres, as `timpanist render --bvh`), as glTF (`io::glb`, the scene animated,
 //! as `timpanist render --glb`); and the score itself as a Standard MIDI File
-//! (`io::midi_export`, as `timpanist export-midi`); and the lesson pack (`io::pack`, as
+//! (`io::midi_export`, as `timpanist export-midi`) or as MusicXML (`io::musicxml_export`,
+//! as `timpanist export-musicxml`: `.mxl` compressed, else plain); and the lesson pack (`io::pack`, as
 //! `timpanist export-pack`: a new folder with the audio, motion, MIDI, plots and an
 //! `index.html` handout); and the video (`exports::video`, as `render --video`: the 3D
 //! view from the viewport's camera over the timeline, with the mix, through ffmpeg) or
@@ -19,7 +20,7 @@ use crate::exports;
 use crate::exports::video::{self, VideoOptions};
 use crate::io::pack::{self, PackError};
 use crate::io::video::VideoError;
-use crate::io::{bvh, glb, midi_export};
+use crate::io::{bvh, glb, midi_export, musicxml_export};
 use crate::kit::Kit;
 use crate::render::Rendering;
 use crate::scene::camera::Camera;
@@ -42,6 +43,8 @@ pub enum Export {
     Glb,
     /// The score (no rendering needed).
     Midi,
+    /// The score as MusicXML for notation programs (no rendering needed).
+    MusicXml,
     /// The lesson pack: a new folder with everything above and an HTML handout.
     Pack,
     /// The 3D view over the timeline, with the mix, as video through ffmpeg.
@@ -52,13 +55,14 @@ pub enum Export {
 
 impl Export {
     /// Every export, in menu order.
-    pub const ALL: [Export; 9] = [
+    pub const ALL: [Export; 10] = [
         Export::Wav,
         Export::Motion,
         Export::MotionC3d,
         Export::Bvh,
         Export::Glb,
         Export::Midi,
+        Export::MusicXml,
         Export::Video,
         Export::VideoFrames,
         Export::Pack,
@@ -73,6 +77,7 @@ impl Export {
             Export::Bvh => "Export motion BVH...",
             Export::Glb => "Export scene glTF...",
             Export::Midi => "Export MIDI...",
+            Export::MusicXml => "Export MusicXML...",
             Export::Pack => "Export lesson pack...",
             Export::Video => "Export video...",
             Export::VideoFrames => "Export video frames (PNG + WAV)...",
@@ -88,6 +93,7 @@ impl Export {
             Export::Bvh => ("BVH animation", &["bvh"]),
             Export::Glb => ("binary glTF", &["glb"]),
             Export::Midi => ("Standard MIDI File", &["mid"]),
+            Export::MusicXml => ("MusicXML", &["musicxml", "mxl"]),
             // A new folder: no file extension, so the dialogs list folders only.
             Export::Pack => ("lesson pack folder", &[]),
             Export::Video => ("video", &["mp4", "mov", "mkv"]),
@@ -104,6 +110,7 @@ impl Export {
             Export::Bvh => format!("{stem}.bvh"),
             Export::Glb => format!("{stem}.glb"),
             Export::Midi => format!("{stem}.mid"),
+            Export::MusicXml => format!("{stem}.musicxml"),
             Export::Pack => format!("{stem}-lesson"),
             Export::Video => format!("{stem}.mp4"),
             Export::VideoFrames => format!("{stem}-frames"),
@@ -112,7 +119,16 @@ impl Export {
 
     /// Whether it writes the rendering (else the score).
     pub fn needs_rendering(self) -> bool {
-        self != Export::Midi
+        !matches!(self, Export::Midi | Export::MusicXml)
+    }
+
+    /// The bytes of a score export (`None` for the rendered ones).
+    fn score_bytes(self, score: &Score, kit: &Kit, path: &Path) -> Option<Vec<u8>> {
+        match self {
+            Export::Midi => Some(midi_export::export(score, kit)),
+            Export::MusicXml => Some(musicxml_export::export_for(path, score, kit)),
+            _ => None,
+        }
     }
 }
 
@@ -199,8 +215,7 @@ pub fn write(
         path: path.to_path_buf(),
         source,
     };
-    if what == Export::Midi {
-        let bytes = midi_export::export(score, kit);
+    if let Some(bytes) = what.score_bytes(score, kit, path) {
         ron_file::write_atomic(path, &bytes).map_err(failed)?;
         return Ok(format!(
             "exported {} ({} beats, {} bytes)",
@@ -222,7 +237,7 @@ pub fn write(
         rendering.motion.rate_hz
     );
     match what {
-        Export::Midi => unreachable!("written from the score above"),
+        Export::Midi | Export::MusicXml => unreachable!("written from the score above"),
         Export::MotionC3d => {
             ron_file::write_atomic(path, &performance.c3d()).map_err(failed)?;
             Ok(samples)

@@ -1,4 +1,5 @@
-//! `timpanist import-midi` and `timpanist export-midi`: Standard MIDI Files in and out.
+//! `timpanist import-midi` and `timpanist export-midi`: Standard MIDI Files in and out
+//! (and the score-export plumbing `export-musicxml` shares).
 
 use crate::base::ron_file;
 use crate::io::midi_export;
@@ -86,11 +87,23 @@ pub(super) fn save_imported(
 
 /// Export the score at `input` to a type 1 Standard MIDI File at `output`.
 pub fn export(input: &Path, output: &Path) -> anyhow::Result<()> {
+    export_score(input, output, &|_, score, kit| {
+        midi_export::export(score, kit)
+    })
+}
+
+/// Load the score at `input`, turn it into bytes with `encode` (given `output`, the
+/// score and its kit) and write them atomically to `output`; print the summary line.
+pub(super) fn export_score(
+    input: &Path,
+    output: &Path,
+    encode: &dyn Fn(&Path, &crate::score::Score, &Kit) -> Vec<u8>,
+) -> anyhow::Result<()> {
     let loaded = LoadedScore::load(input)?;
     for n in &loaded.notices {
         eprintln!("note: {n}");
     }
-    let bytes = midi_export::export(&loaded.score, &loaded.kit);
+    let bytes = encode(output, &loaded.score, &loaded.kit);
     ron_file::write_atomic(output, &bytes)?;
     println!(
         "{} -> {}: {} beats, {:.1} s",

@@ -120,6 +120,15 @@ pub enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// Export a score's timpani part as MusicXML (partwise 4.0; compressed when OUT ends
+    /// in .mxl) for notation programs.
+    ExportMusicxml {
+        /// The score (.ron).
+        score: PathBuf,
+        /// The MusicXML file to write (.musicxml, .xml or .mxl).
+        #[arg(short, long)]
+        output: PathBuf,
+    },
     /// List the demo scores built into the program, or write them into a folder (their
     /// kits named by bundled name, so they load anywhere).
     Demos {
@@ -669,6 +678,9 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         }
         Some(Command::ExportMidi { score, output }) => {
             midi::export(&score, &output).map(|()| ExitCode::SUCCESS)
+        }
+        Some(Command::ExportMusicxml { score, output }) => {
+            musicxml::export(&score, &output).map(|()| ExitCode::SUCCESS)
         }
     }
 }

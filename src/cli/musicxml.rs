@@ -1,8 +1,10 @@
 //! `timpanist import-musicxml`: the timpani part of a MusicXML score (`.musicxml`, `.xml`
-//! or compressed `.mxl`) as a score.
+//! or compressed `.mxl`) as a score; `timpanist export-musicxml`: a score as MusicXML
+//! (compressed when the output ends in `.mxl`).
 
-use super::midi::{Imported, import_kit, save_imported};
+use super::midi::{Imported, export_score, import_kit, save_imported};
 use crate::io::musicxml::{self, ImportOptions};
+use crate::io::musicxml_export;
 use std::path::Path;
 
 /// Import `input` with `kit` (default: the bundled standard kit) and save the score;
@@ -35,4 +37,10 @@ pub fn import(
         eprintln!("note: {n}");
     }
     Ok(())
+}
+
+/// Export the score at `input` as MusicXML at `output` (a `.mxl` archive when `output`
+/// ends in `.mxl`), written atomically.
+pub fn export(input: &Path, output: &Path) -> anyhow::Result<()> {
+    export_score(input, output, &musicxml_export::export_for)
 }

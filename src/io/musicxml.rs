@@ -9,14 +9,18 @@
 //! 960 and every `<divisions>` of the part. Each sounding note (a tie's later notes extend
 //! the first; grace and cue notes are skipped and reported) becomes a beat on a drum chosen
 //! as [`super::midi_import`] does (a drum tuned to the pitch, else the one idle longest;
-//! out-of-range pitches move by octaves). Tremolo marks become rolls, dynamics and hairpins
-//! per-beat dynamics, articulations playing modes, `<sound tempo>` and `<metronome>` the
-//! tempo map (quarter notes per minute), time signatures and measure lengths the meter map.
-//! Whatever is read but not performed (fermatas, repeats, ornaments, texts…) is listed in
+//! out-of-range pitches move by octaves). Measures play in performed order, repeats and
+//! volta endings expanded ([`super::musicxml_repeats`]). Tremolo marks become rolls (a
+//! two-note tremolo: strokes alternating between its two notes), dynamics and hairpins
+//! per-beat dynamics, articulations playing modes, `<stopped/>` damping when the note
+//! ends, `<other-technical>` R/L the hand, `<sound tempo>` and `<metronome>` the tempo
+//! map (quarter notes per minute), time signatures and measure lengths the meter map.
+//! Whatever is read but not performed (fermatas, jumps, ornaments, texts…) is listed in
 //! [`ImportReport::notices`]; notation that only concerns the page (clefs, keys, beams,
 //! stems, layout, lyrics, chord symbols) is left out silently.
 
 use super::midi_import::{self as midi, ANY_DRUM, Note};
+use super::musicxml_repeats as repeats;
 use crate::kit::Kit;
 use crate::score::meter;
 use crate::score::tempo::BPM_RANGE;
@@ -218,7 +222,7 @@ pub fn import(
     let levels = Levels::new(&dynamics, tpq);
     let mut xnotes = one_roll_per_chord(xnotes, &mut notices);
     xnotes.sort_by_key(|n| (n.tick, n.pitch));
-    let mut exact: BTreeMap<(u64, u8), (Dynamic, PlayingMode)> = BTreeMap::new();
+    let mut exact: BTreeMap<(u64, u8), (Dynamic, PlayingMode, Option<u64>)> = BTreeMap::new();
     let mut notes: Vec<Note> = Vec::with_capacity(xnotes.len());
     for n in &xnotes {
         let (vel, accent) = levels.at(n.tick);
@@ -228,28 +232,31 @@ pub fn import(
             n.mode
         };
         let dynamic = dynamic_of(vel);
-        let entry = exact.entry((n.tick, n.pitch)).or_insert((dynamic, mode));
+        let entry = exact
+            .entry((n.tick, n.pitch))
+            .or_insert((dynamic, mode, n.damp));
         if vel > entry.0.velocity() * 127.0 {
-            *entry = (dynamic, mode);
+            *entry = (dynamic, mode, n.damp);
         }
         notes.push(Note {
             tick: n.tick,
             channel: 0,
             key: n.pitch,
             vel: vel.round().clamp(1.0, 127.0) as u8,
-            data: Some(midi_data(mode, n.roll)),
+            data: Some(midi_data(n.hand, mode, n.roll)),
         });
     }
     let duplicates_dropped = midi::drop_duplicates(&mut notes);
     let mut warnings = Vec::new();
     midi::limit_to_two_hands(&mut notes, &mut warnings);
-    let dynamics_of: Vec<(Dynamic, PlayingMode)> =
+    let dynamics_of: Vec<(Dynamic, PlayingMode, Option<u64>)> =
         notes.iter().map(|n| exact[&(n.tick, n.key)]).collect();
     let octave_moves = midi::move_into_range(&mut notes, kit, &mut warnings);
     let mut beats = midi::assign_drums(&notes, kit);
-    for (b, (dynamic, mode)) in beats.iter_mut().zip(dynamics_of) {
+    for (b, (dynamic, mode, damp)) in beats.iter_mut().zip(dynamics_of) {
         b.dynamic = dynamic;
         b.mode = mode;
+        b.damp = damp;
     }
     for w in warnings {
         notices.push_text(w.replace("tick", "score tick"));
@@ -290,14 +297,8 @@ pub fn import(
 }
 
 /// The hand, mode and roll of a note in the MIDI import's terms (the drum left to choose).
-fn midi_data(mode: PlayingMode, roll: Option<Roll>) -> super::midi_export::BeatData {
-    super::midi_export::BeatData(
-        Hand::Auto,
-        mode,
-        ANY_DRUM,
-        ImpactLocation::PlayingSpot,
-        roll,
-    )
+fn midi_data(hand: Hand, mode: PlayingMode, roll: Option<Roll>) -> super::midi_export::BeatData {
+    super::midi_export::BeatData(hand, mode, ANY_DRUM, ImpactLocation::PlayingSpot, roll)
 }
 
 /// The marking of a MIDI velocity if it is exactly one, else the velocity (0–1).
@@ -783,9 +784,37 @@ struct XNote {
     end: u64,
     pitch: u8,
     mode: PlayingMode,
+    /// The sticking written as `<other-technical>` "R" or "L".
+    hand: Hand,
     /// Strokes per quarter of a tremolo; the roll's length is the note's.
     strokes: Option<u32>,
+    /// The end of the last tied note that carries the tremolo (a damped roll's tremolo
+    /// may stop before its tied notes do).
+    roll_end: u64,
+    /// Marked `<stopped/>`: the hand damps the head when the (tied) note ends.
+    damped: bool,
+    /// Half of a two-note tremolo.
+    two_note: Option<TwoNote>,
     roll: Option<Roll>,
+    /// Ticks from the last stroke to the damping touch.
+    damp: Option<u64>,
+}
+
+/// A note's part in a two-note tremolo.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum TwoNote {
+    /// The first note; strokes per quarter of the alternation.
+    Start(u32),
+    Stop,
+}
+
+/// What a note's notations say about how it is played.
+struct NoteMarks {
+    mode: PlayingMode,
+    strokes: Option<u32>,
+    hand: Hand,
+    damped: bool,
+    two_note: Option<TwoNote>,
 }
 
 /// A measure as read: where it starts, how long it is, its written time signature.
@@ -955,7 +984,27 @@ impl<'a, 'd> PartReader<'a, 'd> {
     }
 
     fn read(&mut self, part: Node) -> Result<(), MusicXmlError> {
-        for m in part.children().filter(|n| n.has_tag_name("measure")) {
+        let written: Vec<Node> = part
+            .children()
+            .filter(|n| n.has_tag_name("measure"))
+            .collect();
+        let order = match repeats::performed_order(&written) {
+            Some(order) => order,
+            None => {
+                self.notices.push_text(
+                    "the repeats and endings do not resolve into an order of measures; the music is played once, as written".into(),
+                );
+                (0..written.len()).collect()
+            }
+        };
+        if order.len() != written.len() {
+            self.notices.push_text(format!(
+                "repeats expanded: the {} written measures are played as {}",
+                written.len(),
+                order.len()
+            ));
+        }
+        for m in order.into_iter().map(|i| written[i]) {
             let number = m.attribute("number").unwrap_or("?").to_string();
             let start = self.measures.iter().map(|m| m.length).sum::<u64>();
             let length = self.read_measure(m, start, &number)?;
@@ -975,13 +1024,21 @@ impl<'a, 'd> PartReader<'a, 'd> {
                 implicit: m.attribute("implicit") == Some("yes"),
             });
         }
+        self.notes = two_note_tremolos(std::mem::take(&mut self.notes), self.tpq);
+        let max_damp = crate::score::validate::MAX_DAMP_QUARTERS * self.tpq;
         for n in &mut self.notes {
+            // A damped roll's tremolo may stop before its tied notes do.
+            let roll_end = if n.damped { n.roll_end } else { n.end };
             n.roll = n.strokes.and_then(|spq| {
-                (n.end > n.tick).then_some(Roll {
-                    length_ticks: n.end - n.tick,
+                (roll_end > n.tick).then_some(Roll {
+                    length_ticks: roll_end - n.tick,
                     strokes_per_quarter: spq,
                 })
             });
+            let last_stroke = n.tick + n.roll.map_or(0, |r| r.length_ticks);
+            n.damp = n
+                .damped
+                .then(|| n.end.saturating_sub(last_stroke).clamp(1, max_damp));
         }
         Ok(())
     }
@@ -1045,7 +1102,13 @@ impl<'a, 'd> PartReader<'a, 'd> {
                     };
                     self.direction(el, at(pos + offset), number);
                 }
-                "sound" => self.sound(el, at(pos), number),
+                "sound" => {
+                    let offset = match el.children().find(|c| c.has_tag_name("offset")) {
+                        Some(o) => self.signed_ticks(o, number)?,
+                        None => 0,
+                    };
+                    self.sound(el, at(pos + offset), number);
+                }
                 "barline" => self.barline(el, number),
                 name if PAGE_ONLY.contains(&name) => {}
                 other => self.notices.add(format!("<{other}>: not read"), &place),
@@ -1216,6 +1279,11 @@ impl<'a, 'd> PartReader<'a, 'd> {
             if let Some(k) = open {
                 let i = self.ties[k].1;
                 self.notes[i].end = self.notes[i].end.max(tick + duration);
+                let rolled = has_mark(el, "ornaments", "tremolo");
+                if rolled && self.notes[i].strokes.is_some() {
+                    self.notes[i].roll_end = self.notes[i].end;
+                }
+                self.notes[i].damped |= has_mark(el, "technical", "stopped");
                 if !tie_start {
                     self.ties.remove(k);
                 }
@@ -1227,14 +1295,19 @@ impl<'a, 'd> PartReader<'a, 'd> {
             );
         }
         self.ties.retain(|&(p, _)| p != pitch);
-        let (mode, strokes) = self.notations(el, tick, &place);
+        let marks = self.notations(el, tick, &place);
         self.notes.push(XNote {
             tick,
             end: tick + duration,
             pitch,
-            mode,
-            strokes,
+            mode: marks.mode,
+            hand: marks.hand,
+            strokes: marks.strokes,
+            roll_end: tick + duration,
+            damped: marks.damped,
+            two_note: marks.two_note,
             roll: None,
+            damp: None,
         });
         if tie_start {
             self.ties.push((pitch, self.notes.len() - 1));
@@ -1320,11 +1393,13 @@ impl<'a, 'd> PartReader<'a, 'd> {
         }
     }
 
-    /// A note's playing mode and tremolo strokes per quarter from its notations; its
+    /// A note's playing mode, tremolo, sticking and damping from its notations; its
     /// dynamics and what is not performed go to the dynamics and the notices.
-    fn notations(&mut self, el: Node, tick: u64, place: &str) -> (PlayingMode, Option<u32>) {
+    fn notations(&mut self, el: Node, tick: u64, place: &str) -> NoteMarks {
         let mut marks: Vec<PlayingMode> = Vec::new();
         let mut strokes = None;
+        let mut two_note = None;
+        let (mut hand, mut damped) = (Hand::Auto, false);
         for notations in el.children().filter(|c| c.has_tag_name("notations")) {
             for n in notations.children().filter(Node::is_element) {
                 match n.tag_name().name() {
@@ -1347,7 +1422,13 @@ impl<'a, 'd> PartReader<'a, 'd> {
                     "ornaments" => {
                         for o in n.children().filter(Node::is_element) {
                             if o.has_tag_name("tremolo") {
-                                strokes = self.tremolo(o, place).or(strokes);
+                                match o.attribute("type") {
+                                    Some("start") => {
+                                        two_note = Some(TwoNote::Start(two_note_strokes(el, o)));
+                                    }
+                                    Some("stop") => two_note = Some(TwoNote::Stop),
+                                    _ => strokes = self.tremolo(o, place).or(strokes),
+                                }
                             } else if !o.has_tag_name("accidental-mark") {
                                 self.notices.add(
                                     format!("ornament <{}>: not performed", o.tag_name().name()),
@@ -1357,6 +1438,18 @@ impl<'a, 'd> PartReader<'a, 'd> {
                         }
                     }
                     "dynamics" => self.dynamics(n, tick, place),
+                    "technical" => {
+                        for t in n.children().filter(Node::is_element) {
+                            match (t.tag_name().name(), t.text().map(str::trim)) {
+                                ("stopped", _) => damped = true,
+                                ("other-technical", Some("R")) => hand = Hand::Right,
+                                ("other-technical", Some("L")) => hand = Hand::Left,
+                                (other, _) => self
+                                    .notices
+                                    .add(format!("technical mark <{other}>: not performed"), place),
+                            }
+                        }
+                    }
                     "fermata" => self.notices.add(
                         "fermata: not performed (the note keeps its written length)",
                         place,
@@ -1379,7 +1472,13 @@ impl<'a, 'd> PartReader<'a, 'd> {
             .into_iter()
             .min_by_key(rank)
             .unwrap_or(PlayingMode::Legato);
-        (mode, strokes)
+        NoteMarks {
+            mode,
+            strokes,
+            hand,
+            damped,
+            two_note,
+        }
     }
 
     /// A `<tremolo>`: single with n marks is 2^n strokes per quarter (1 mark eighths, 3
@@ -1398,13 +1497,6 @@ impl<'a, 'd> PartReader<'a, 'd> {
                 Some(1 << marks)
             }
             "unmeasured" => Some(UNMEASURED_STROKES_PER_QUARTER),
-            "start" => {
-                self.notices.add(
-                    "two-note tremolo: its two notes are played once each, not alternated",
-                    place,
-                );
-                None
-            }
             _ => None,
         }
     }
@@ -1561,14 +1653,6 @@ impl<'a, 'd> PartReader<'a, 'd> {
         let place = format!("measure {number}");
         for c in b.children().filter(Node::is_element) {
             match c.tag_name().name() {
-                "repeat" => self.notices.add(
-                    "repeat sign: not expanded (the repeated measures are played once)",
-                    &place,
-                ),
-                "ending" => self.notices.add(
-                    "volta ending: not expanded (every ending is played once, in order)",
-                    &place,
-                ),
                 "segno" | "coda" => self.notices.add(
                     format!(
                         "{}: not followed (jumps are not expanded)",
@@ -1583,6 +1667,81 @@ impl<'a, 'd> PartReader<'a, 'd> {
             }
         }
     }
+}
+
+/// Whether `note` has the notation `<notations><group><name>` (e.g. technical, stopped).
+fn has_mark(note: Node, group: &str, name: &str) -> bool {
+    note.children()
+        .filter(|c| c.has_tag_name("notations"))
+        .flat_map(|n| n.children().filter(|c| c.has_tag_name(group)))
+        .any(|g| g.children().any(|c| c.has_tag_name(name)))
+}
+
+/// Strokes per quarter of a two-note tremolo starting at `note` with mark `tremolo`: its
+/// marks add to the beams of the notes' written type (three marks between half notes
+/// are thirty-seconds: 8 per quarter), 1 (eighths) to 5 in all.
+fn two_note_strokes(note: Node, tremolo: Node) -> u32 {
+    let marks: u32 = tremolo.text().unwrap_or("").trim().parse().unwrap_or(3);
+    let beams = match text_of(note, "type").as_str() {
+        "eighth" => 1,
+        "16th" => 2,
+        "32nd" => 3,
+        "64th" => 4,
+        _ => 0,
+    };
+    1 << (marks + beams).clamp(1, 5)
+}
+
+/// Two-note tremolos as their strokes: from the first note's start to the second's end,
+/// alternating between the two pitches at the tremolo's rate (each a note of its own;
+/// the first stroke on each pitch keeps its note's mode and hand). A half without its
+/// other half is played as written.
+fn two_note_tremolos(notes: Vec<XNote>, tpq: u64) -> Vec<XNote> {
+    let mut out = Vec::with_capacity(notes.len());
+    let mut open: std::collections::VecDeque<(XNote, u32)> = Default::default();
+    for n in notes {
+        match n.two_note {
+            Some(TwoNote::Start(spq)) => open.push_back((n, spq)),
+            Some(TwoNote::Stop) => match open.pop_front() {
+                Some((first, spq)) => out.extend(alternate(&first, &n, spq, tpq)),
+                None => out.push(n),
+            },
+            None => out.push(n),
+        }
+    }
+    out.extend(open.into_iter().map(|(n, _)| n));
+    out
+}
+
+/// The strokes of a two-note tremolo from `a` to `b` at `spq` strokes per quarter.
+fn alternate(a: &XNote, b: &XNote, spq: u32, tpq: u64) -> Vec<XNote> {
+    let spacing = (tpq / u64::from(spq.max(1))).max(1);
+    let end = a.end.max(b.end);
+    (a.tick..end)
+        .step_by(spacing as usize)
+        .enumerate()
+        .map(|(k, tick)| {
+            let from = if k % 2 == 0 { a } else { b };
+            let first = k < 2;
+            XNote {
+                tick,
+                end: (tick + spacing).min(end),
+                pitch: from.pitch,
+                mode: if first {
+                    from.mode
+                } else {
+                    PlayingMode::Legato
+                },
+                hand: if first { from.hand } else { Hand::Auto },
+                strokes: None,
+                roll_end: tick,
+                damped: false,
+                two_note: None,
+                roll: None,
+                damp: None,
+            }
+        })
+        .collect()
 }
 
 /// Quarter notes per minute of a `<metronome>` "beat-unit [dots] = per-minute".
