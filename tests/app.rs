@@ -288,8 +288,9 @@ fn quit_with_unsaved_changes_asks() {
     assert!(h.state().is_dirty());
 }
 
-/// Dropped files: a MIDI file imports as a new unsaved score, a broken score shows an
-/// error in the window, another kind of file is refused with a message.
+/// Dropped files: a MIDI file imports as a new unsaved score, a recording is transcribed
+/// into one, a broken score shows an error in the window, another kind of file is refused
+/// with a message.
 #[test]
 fn dropped_files() {
     let dir = tempfile::tempdir().unwrap();
@@ -317,6 +318,32 @@ fn dropped_files() {
     assert!(app.error().is_none(), "{:?}", app.error());
     assert_eq!(app.loaded().unwrap().score.beats.len(), 16);
     assert!(app.path().is_none(), "an import is not saved yet");
+
+    // A recording is transcribed: three recorded notes 0.8 s apart, three strokes.
+    let wav = dir.path().join("three notes.wav");
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: 32_000,
+        bits_per_sample: 16,
+        sample_format: hound::SampleFormat::Int,
+    };
+    let mut w = hound::WavWriter::create(&wav, spec).unwrap();
+    for name in ["2L", "3R", "2R"] {
+        let path = root().join(format!("kits/samples/Timpani_{name}.wav"));
+        let mut r = hound::WavReader::open(path).unwrap();
+        let note: Vec<i16> = r.samples::<i16>().map(Result::unwrap).collect();
+        for i in 0..25_600 {
+            w.write_sample(note.get(i).copied().unwrap_or(0)).unwrap();
+        }
+    }
+    w.finalize().unwrap();
+    h.state_mut().handle_dropped(&wav);
+    h.state_mut().wait_for_composition();
+    settle(&mut h);
+    let app = h.state();
+    assert!(app.error().is_none(), "{:?}", app.error());
+    assert_eq!(app.loaded().unwrap().score.beats.len(), 3);
+    assert!(app.path().is_none(), "a transcription is not saved yet");
 }
 
 /// Space plays from the playhead on the silent clock and pauses again; F1 shows help.

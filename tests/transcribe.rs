@@ -136,13 +136,11 @@ fn check(
 }
 
 /// The six demo scores, rendered and transcribed, clean and after the damage a user's
-/// file has (−12 dB gain, white noise 50 dB below the peak, 0.35 s of silence in front):
-/// clean, 95 % of the strokes found at ±20 ms and F ≥ 0.9 on every score (the issue asks
-/// F ≥ 0.95: the roll exercise reaches 0.93); damaged, 85 % found and F ≥ 0.6 on every
-/// score (the roll exercise's soft roll strokes drown in the noise). The drum is right for
-/// at least 60 % of the matched strokes — measured 70–73 %; the issue asks 95 %, which is
-/// not met (a head struck near its centre or rim is heard at the wrong pitch, and roll
-/// strokes inherit their roll's first pitch).
+/// file has (−12 dB gain, white noise 50 dB below the peak, 0.35 s of silence in front).
+/// Clean (as the issue asks): F ≥ 0.95 at ±20 ms on every score and the right drum for
+/// 95 % of the matched strokes (measured: F 0.983–1, 279 of 289). Damaged: 85 % of the
+/// strokes found, F ≥ 0.6 on every score, the right drum for 90 % (measured 0.88, 0.62 on
+/// the roll exercise, whose soft roll strokes drown in the noise, and 91 %).
 #[test]
 fn rendered_demo_scores_transcribe_back() {
     let demos = rendered_demos();
@@ -156,12 +154,12 @@ fn rendered_demo_scores_transcribe_back() {
             .map(|s| 0.25 * s + 0.25 * noise * rng.uniform(-1.732, 1.732) as f32)
             .collect()
     };
-    // (variant, delay s, least recall over all strokes, least F per score): measured
-    // clean 0.979 / 0.933, damaged 0.883 / 0.618 (the roll exercise's soft roll strokes
-    // drown in the noise).
-    for (variant, delay, least_recall, least_f) in
-        [("clean", 0.0, 0.95, 0.9), ("damaged", 0.35, 0.85, 0.6)]
-    {
+    // (variant, delay s, least recall over all strokes, least F per score, least share
+    // of right drums).
+    for (variant, delay, least_recall, least_f, least_drums) in [
+        ("clean", 0.0, 0.95, 0.95, 0.95),
+        ("damaged", 0.35, 0.85, 0.6, 0.9),
+    ] {
         let (mut hits, mut drums, mut truth, mut per_score) = (0, 0, 0, Vec::new());
         for d in &demos {
             let mono = if delay > 0.0 {
@@ -186,7 +184,7 @@ fn rendered_demo_scores_transcribe_back() {
             assert!(*f >= least_f, "{name}: F {f:.3}");
         }
         assert!(
-            drums as f64 >= 0.6 * hits as f64,
+            drums as f64 >= least_drums * hits as f64,
             "{variant}: right drum {drums} of {hits}"
         );
     }
@@ -272,4 +270,47 @@ fn bad_input_is_refused_by_name() {
     )
     .unwrap_err();
     assert!(nan.to_string().contains("nan.wav") && nan.to_string().contains("sample 1"));
+}
+
+/// `timpanist transcribe`: a recording becomes a score file that loads; a bad file exits
+/// non-zero naming it and writes nothing.
+#[test]
+fn cli_transcribe() {
+    let dir = tempfile::tempdir().unwrap();
+    let exe = env!("CARGO_BIN_EXE_timpanist");
+    let wav = root().join("kits/samples/Timpani_2L.wav");
+    let out = dir.path().join("note.ron");
+    let run = std::process::Command::new(exe)
+        .args([
+            "transcribe",
+            wav.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let loaded = LoadedScore::load(&out).unwrap();
+    assert_eq!(loaded.score.beats.len(), 1);
+    assert_eq!(loaded.score.title, "Timpani_2L");
+
+    let bad = dir.path().join("broken.wav");
+    std::fs::write(&bad, b"RIFF").unwrap();
+    let never = dir.path().join("never.ron");
+    let run = std::process::Command::new(exe)
+        .args([
+            "transcribe",
+            bad.to_str().unwrap(),
+            "-o",
+            never.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(!run.status.success());
+    assert!(String::from_utf8_lossy(&run.stderr).contains("broken.wav"));
+    assert!(!never.exists());
 }

@@ -43,12 +43,13 @@ impl EditorApp {
                         }
                     }
                 });
-                let imports: [(&str, (&str, &[&str])); 2] = [
+                let imports: [(&str, (&str, &[&str])); 3] = [
                     ("Import MIDI...", ("MIDI", &["mid", "midi"])),
                     (
                         "Import MusicXML...",
                         ("MusicXML", &["musicxml", "xml", "mxl"]),
                     ),
+                    ("Import audio (transcribe)...", ("WAV", &["wav", "wave"])),
                 ];
                 for (label, filter) in imports {
                     if ui.button(label).clicked() {

@@ -121,7 +121,7 @@ impl EditorApp {
         match kind_of(path) {
             FileKind::Other => {
                 self.messages.error = Some(format!(
-                    "{}: drop a score (.ron), a MIDI file (.mid) or a MusicXML file (.musicxml, .xml, .mxl)",
+                    "{}: drop a score (.ron), a MIDI file (.mid), a MusicXML file (.musicxml, .xml, .mxl) or a recording (.wav)",
                     path.display()
                 ))
             }
@@ -384,10 +384,12 @@ impl EditorApp {
             },
             AfterConfirm::OpenDialog => self.ask_and_act(Request {
                 purpose: Purpose::Open,
-                title: "Open a score, MIDI or MusicXML file",
+                title: "Open a score, MIDI, MusicXML or WAV file",
                 filter: (
-                    "score, MIDI or MusicXML",
-                    &["ron", "mid", "midi", "musicxml", "xml", "mxl"],
+                    "score, MIDI, MusicXML or WAV",
+                    &[
+                        "ron", "mid", "midi", "musicxml", "xml", "mxl", "wav", "wave",
+                    ],
                 ),
                 save: false,
                 file_name: None,

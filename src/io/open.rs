@@ -1,6 +1,7 @@
 //! Opening any file that holds a score, the way users open files: a score (`.ron`) is
-//! loaded, a MIDI file (`.mid`) or a MusicXML file (`.musicxml`, `.xml`, `.mxl`) is
-//! imported onto the bundled standard kit as a new, unsaved score. Used by the editor's
+//! loaded, a MIDI file (`.mid`), a MusicXML file (`.musicxml`, `.xml`, `.mxl`) or a
+//! recording (`.wav`, transcribed) is imported onto the bundled standard kit as a new,
+//! unsaved score. Used by the editor's
 //! Open, drag and drop, and by `timpanist FILE`; headless, so it is testable without a
 //! window.
 
@@ -9,6 +10,7 @@ use super::musicxml::{self, MusicXmlError};
 use crate::base::ron_file::FileError;
 use crate::kit::Kit;
 use crate::score::LoadedScore;
+use crate::transcribe::{self, TranscribeError};
 use std::path::{Path, PathBuf};
 
 /// What a file is, judged by its extension.
@@ -17,6 +19,8 @@ pub enum FileKind {
     Score,
     Midi,
     MusicXml,
+    /// A recording, transcribed.
+    Audio,
     Other,
 }
 
@@ -31,6 +35,7 @@ pub fn kind_of(path: &Path) -> FileKind {
         Some("ron") => FileKind::Score,
         Some("mid" | "midi" | "smf") => FileKind::Midi,
         Some("musicxml" | "xml" | "mxl") => FileKind::MusicXml,
+        Some("wav" | "wave") => FileKind::Audio,
         _ => FileKind::Other,
     }
 }
@@ -45,7 +50,7 @@ pub enum OpenAction {
 }
 
 /// The action for a file given on the command line: refused, naming the file, when it
-/// does not exist or is not a score, MIDI or MusicXML file.
+/// does not exist or is not a score, MIDI, MusicXML or WAV file.
 pub fn action_for(path: &Path) -> Result<OpenAction, OpenError> {
     let kind = kind_of(path);
     if kind == FileKind::Other {
@@ -83,8 +88,10 @@ pub enum OpenError {
     Midi(#[from] MidiError),
     #[error(transparent)]
     MusicXml(#[from] MusicXmlError),
+    #[error(transparent)]
+    Audio(#[from] TranscribeError),
     #[error(
-        "{}: not a score (.ron), MIDI (.mid) or MusicXML (.musicxml, .xml, .mxl) file",
+        "{}: not a score (.ron), MIDI (.mid), MusicXML (.musicxml, .xml, .mxl) or WAV (.wav) file",
         .0.display()
     )]
     NotAScore(PathBuf),
@@ -94,7 +101,7 @@ pub enum OpenError {
     NoKit,
 }
 
-/// Read a score file or import a MIDI or MusicXML file, by extension.
+/// Read a score file or import a MIDI, MusicXML or WAV file, by extension.
 pub fn read(path: &Path) -> Result<Opened, OpenError> {
     match kind_of(path) {
         FileKind::Score => {
@@ -112,6 +119,7 @@ pub fn read(path: &Path) -> Result<Opened, OpenError> {
         }
         FileKind::Midi => import_midi(path),
         FileKind::MusicXml => import_musicxml(path),
+        FileKind::Audio => import_audio(path),
         FileKind::Other => Err(OpenError::NotAScore(path.to_path_buf())),
     }
 }
@@ -164,6 +172,20 @@ pub fn import_musicxml(path: &Path) -> Result<Opened, OpenError> {
     Ok(imported(score, kit, summary, report.notices))
 }
 
+/// Transcribe a recording onto the bundled standard kit as a new, unsaved score.
+pub fn import_audio(path: &Path) -> Result<Opened, OpenError> {
+    let kit = Kit::bundled("standard").ok_or(OpenError::NoKit)?;
+    let (score, report) = transcribe::transcribe_file(path, &kit, &transcribe::Options::default())?;
+    let summary = format!(
+        "transcribed {} strokes from {} ({} rolls, {:.0} bpm)",
+        report.strokes,
+        path.display(),
+        report.rolls,
+        report.bpm
+    );
+    Ok(imported(score, kit, summary, report.notices))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -175,7 +197,8 @@ mod tests {
         assert_eq!(kind_of(Path::new("x.mid")), FileKind::Midi);
         assert_eq!(kind_of(Path::new("x.MXL")), FileKind::MusicXml);
         assert_eq!(kind_of(Path::new("x.musicxml")), FileKind::MusicXml);
-        assert_eq!(kind_of(Path::new("x.wav")), FileKind::Other);
+        assert_eq!(kind_of(Path::new("x.WAV")), FileKind::Audio);
+        assert_eq!(kind_of(Path::new("x.txt")), FileKind::Other);
         assert_eq!(kind_of(Path::new("noext")), FileKind::Other);
     }
 

@@ -265,7 +265,7 @@ struct MarkLevels {
 }
 
 /// Length of each reference stroke rendered, s.
-const REFERENCE_STROKE_S: f64 = 0.1;
+const REFERENCE_STROKE_S: f64 = 0.05;
 
 impl MarkLevels {
     fn at(&mut self, pitch: Pitch) -> [f64; 6] {

@@ -12,11 +12,11 @@ use crate::score::{Beat, Dynamic, Hand, ImpactLocation, PlayingMode, Roll, Tempo
 const GRIDS: [u32; 10] = [1, 2, 4, 3, 8, 6, 16, 12, 32, 24];
 /// A quantised stroke may move at most this far, s.
 pub const QUANTISE_TOLERANCE_S: f64 = 0.008;
-/// A roll: at least this many strokes on one drum…
+/// A roll: at least this many strokes…
 const ROLL_MIN_STROKES: usize = 6;
 /// …each at most this long after the previous, s…
 const ROLL_MAX_GAP_S: f64 = 0.13;
-/// …within this share of the run's median gap.
+/// …each within this share of a gap from an even grid.
 const ROLL_EVENNESS: f64 = 0.35;
 
 /// One stroke as heard: when, which pitches (two for a chord), how much energy it added.
@@ -195,15 +195,16 @@ pub fn place(
     (placed, notes)
 }
 
-/// Runs of strokes to write as rolls: (first, last) index, inclusive.
+/// Runs of strokes to write as rolls: (first, last) index, inclusive. Judged by timing
+/// alone — inside a roll each stroke adds little to a head already ringing, so its own
+/// pitch is unreliable — a roll is written on its first stroke's drum.
 pub fn roll_runs(placed: &[Placed]) -> Vec<(usize, usize)> {
-    let same_drum = |a: &Placed, b: &Placed| a.drums.len() == 1 && a.drums == b.drums;
     let mut runs = Vec::new();
     let mut i = 0;
     while i < placed.len() {
         let mut j = i;
         while j + 1 < placed.len()
-            && same_drum(&placed[j], &placed[j + 1])
+            && placed[j].drums.len() == 1
             && placed[j + 1].time_s - placed[j].time_s <= ROLL_MAX_GAP_S
         {
             j += 1;
@@ -216,13 +217,22 @@ pub fn roll_runs(placed: &[Placed]) -> Vec<(usize, usize)> {
     runs
 }
 
-/// Whether the gaps of a run are all within [`ROLL_EVENNESS`] of their median.
+/// Whether the strokes of a run lie on an even grid: every one within [`ROLL_EVENNESS`]
+/// of a gap from the least-squares line through their times.
 fn even(run: &[Placed]) -> bool {
-    let mut gaps: Vec<f64> = run.windows(2).map(|w| w[1].time_s - w[0].time_s).collect();
-    gaps.sort_by(f64::total_cmp);
-    let median = gaps[gaps.len() / 2];
-    gaps.iter()
-        .all(|g| (g / median - 1.0).abs() <= ROLL_EVENNESS)
+    let n = run.len() as f64;
+    let mean_k = (n - 1.0) / 2.0;
+    let mean_t = run.iter().map(|p| p.time_s).sum::<f64>() / n;
+    let (mut num, mut den) = (0.0, 0.0);
+    for (k, p) in run.iter().enumerate() {
+        num += (k as f64 - mean_k) * (p.time_s - mean_t);
+        den += (k as f64 - mean_k).powi(2);
+    }
+    let gap = num / den;
+    gap > 0.0
+        && run.iter().enumerate().all(|(k, p)| {
+            (mean_t + gap * (k as f64 - mean_k) - p.time_s).abs() <= ROLL_EVENNESS * gap
+        })
 }
 
 /// A roll over `run`: strokes per quarter the divisor of `tpq` (1–32) nearest the run's

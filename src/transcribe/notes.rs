@@ -1,12 +1,12 @@
 //! What each stroke sounded: the spectrum it added (the window after the onset less the
 //! window before it, so drums still ringing from earlier strokes drop out), its principal
 //! (1,1) partial found by the kettledrum ratios (Fletcher & Rossing: 1, 1.50, 1.98, 2.44,
-//! 2.94) within the pitches the kit reaches, and the energy it added over its first 40 ms
+//! 2.94) near the pitches the kit reaches, and the energy it added over its first 40 ms
 //! (dB re full scale). One pitch per stroke: two drums struck together are heard as the
 //! stronger.
 
 use crate::sound::analysis::KETTLEDRUM_RATIOS;
-use crate::sound::spectrum::{peak_in, principal_hz, spectrum};
+use crate::sound::spectrum::{peak_in, peaks, spectrum};
 
 /// The spectrum windows start this long after the onset (past the click), s.
 const AFTER_ONSET_S: f64 = 0.005;
@@ -14,9 +14,8 @@ const AFTER_ONSET_S: f64 = 0.005;
 const WINDOW_S: (f64, f64) = (0.06, 0.15);
 /// Span over which a stroke's added energy is measured, s.
 pub const LEVEL_SPAN_S: f64 = 0.04;
-/// A re-struck drum still ringing adds little new: when the added spectrum's (1,1) is
-/// under this share of the whole window's, the whole window decides the pitch.
-const RESTRIKE_SHARE: f64 = 0.2;
+/// Partials are looked for within ± this share of their frequency.
+const PARTIAL_TOLERANCE: f64 = 0.02;
 
 /// What a stroke added.
 #[derive(Clone, Debug, PartialEq)]
@@ -42,20 +41,42 @@ pub fn hear(
     let before = slice(samples, rate_hz, onset_s - AFTER_ONSET_S - window, window);
     let after = spectrum(&after, rate_hz);
     let added = added_spectrum(&after, &spectrum(&before, rate_hz));
-    let principal = |spec: &[(f64, f64)]| {
-        let f = principal_hz(spec, band_hz.0, band_hz.1, &KETTLEDRUM_RATIOS)?;
-        Some((f, peak_in(spec, f * 0.99, f * 1.01).map_or(0.0, |p| p.1)))
-    };
-    let new = principal(&added);
-    let principal_hz = match (new, principal(&after)) {
-        (Some((f, a)), Some((_, whole))) if a >= RESTRIKE_SHARE * whole => Some(f),
-        (_, Some((f, _))) => Some(f),
-        (new, None) => new.map(|p| p.0),
-    };
+    let principal_hz = principal(&added, &after, band_hz);
     Heard {
         principal_hz,
         level_db: added_level_db(samples, rate_hz, onset_s),
     }
+}
+
+/// The stroke's (1,1), Hz: among the frequencies that would put one of their kettledrum
+/// partials on a peak of the added spectrum, the one whose partials hold the most added
+/// amplitude plus the amplitude of its (1,1) in the whole window after the onset. The
+/// whole window counts because a drum struck again while still ringing adds little at its
+/// (1,1) (the new vibration meets the old at a random phase) but much at its faster-decaying
+/// upper partials, which alone would be mistaken for a higher drum.
+fn principal(added: &[(f64, f64)], after: &[(f64, f64)], band: (f64, f64)) -> Option<f64> {
+    let top = KETTLEDRUM_RATIOS[KETTLEDRUM_RATIOS.len() - 1];
+    let near = |spec: &[(f64, f64)], f: f64| {
+        spec.iter()
+            .filter(|(g, _)| (g / f - 1.0).abs() <= PARTIAL_TOLERANCE)
+            .map(|p| p.1)
+            .fold(0.0, f64::max)
+    };
+    let score = |c: f64| -> f64 {
+        KETTLEDRUM_RATIOS
+            .iter()
+            .map(|r| near(added, r * c))
+            .sum::<f64>()
+            + near(after, c)
+    };
+    let best = peaks(added, band.0, band.1 * top, 0.1)
+        .iter()
+        .flat_map(|p| KETTLEDRUM_RATIOS.iter().map(move |r| p.0 / r))
+        .filter(|c| (band.0..=band.1).contains(c))
+        .map(|c| (c, score(c)))
+        .max_by(|a, b| a.1.total_cmp(&b.1))?
+        .0;
+    Some(peak_in(after, best * 0.99, best * 1.01).map_or(best, |p| p.0))
 }
 
 /// `len_s` of `samples` from `start_s`, zero where it runs off either end.

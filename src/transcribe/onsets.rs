@@ -28,6 +28,12 @@ pub const MIN_GAP_S: f64 = 0.03;
 const DELTA_OF_TOP: f64 = 0.06;
 /// …and at least this many times the median frame (the noise floor).
 const DELTA_OF_MEDIAN: f64 = 1.5;
+/// A recording's first frames count as onsets only if they reach this share of its peak.
+const START_SHARE: f32 = 0.05;
+/// An onset must reach this share of the strongest onset strength of the last
+/// [`MASKED_S`]: the decay of a loud note (its partials beating) is not a stroke.
+const MASKED_SHARE: f64 = 0.03;
+const MASKED_S: f64 = 3.0;
 /// Energy blocks of the high-passed signal for placing an onset, s.
 const BLOCK_S: f64 = 0.0005;
 /// The rise is measured against the mean energy of this span before, s.
@@ -81,6 +87,8 @@ pub fn strength(samples: &[f32], rate_hz: u32) -> Strength {
     let lo = (FLUX_BAND_HZ.0 / bin_hz).ceil() as usize;
     let hi = ((FLUX_BAND_HZ.1 / bin_hz).floor() as usize).min(n / 2);
     let frames = samples.len().div_ceil(hop) + 1;
+    let head = &samples[..samples.len().min(n / 2)];
+    let loud_start = head.iter().fold(0.0f32, |m, s| m.max(s.abs())) >= START_SHARE * peak;
     let mut history: Vec<Vec<f64>> = Vec::with_capacity(LAG_FRAMES + 1);
     let mut values = Vec::with_capacity(frames);
     let (mut re, mut im) = (vec![0.0; n], vec![0.0; n]);
@@ -100,6 +108,10 @@ pub fn strength(samples: &[f32], rate_hz: u32) -> Strength {
             .map(|k| (1.0 + LOG_GAMMA * (re[k] * re[k] + im[k] * im[k]).sqrt() / full_scale).ln())
             .collect();
         let flux = match history.first() {
+            // A noise floor that starts with the recording fills the first windows, and a
+            // recording cut off while ringing ends in a step: neither is a stroke.
+            _ if start < 0 && !loud_start => 0.0,
+            _ if start + n as isize > samples.len() as isize => 0.0,
             Some(reference) if history.len() > LAG_FRAMES - 1 => {
                 let reference = max_filtered(reference);
                 log.iter()
@@ -107,6 +119,8 @@ pub fn strength(samples: &[f32], rate_hz: u32) -> Strength {
                     .map(|(l, r)| (l - r).max(0.0))
                     .sum()
             }
+            // Before the first reference frame the signal is measured against silence, so
+            // a stroke at the very start counts.
             _ => log.iter().sum(),
         };
         values.push(flux);
@@ -134,7 +148,8 @@ fn max_filtered(bins: &[f64]) -> Vec<f64> {
 }
 
 /// The frames that are onsets: local maxima of the strength above the local mean plus
-/// the threshold, at least [`MIN_GAP_S`] apart.
+/// the threshold and not masked by a much stronger onset just before, at least
+/// [`MIN_GAP_S`] apart.
 pub fn pick(strength: &Strength) -> Vec<usize> {
     let v = &strength.values;
     if v.is_empty() {
@@ -144,6 +159,7 @@ pub fn pick(strength: &Strength) -> Vec<usize> {
     let (pre_max, post_max) = (strength.frames(PRE_MAX_S), strength.frames(POST_MAX_S));
     let (pre_avg, post_avg) = (strength.frames(PRE_AVG_S), strength.frames(POST_AVG_S));
     let gap = strength.frames(MIN_GAP_S);
+    let masked = strength.frames(MASKED_S);
     let mut prefix = vec![0.0; v.len() + 1];
     for (i, x) in v.iter().enumerate() {
         prefix[i + 1] = prefix[i] + x;
@@ -157,6 +173,13 @@ pub fn pick(strength: &Strength) -> Vec<usize> {
         let (a, b) = (n.saturating_sub(pre_avg), (n + post_avg).min(v.len() - 1));
         let mean = (prefix[b + 1] - prefix[a]) / (b + 1 - a) as f64;
         if v[n] <= 0.0 || v[n] < mean + delta {
+            continue;
+        }
+        let recent = v[n.saturating_sub(masked)..n]
+            .iter()
+            .copied()
+            .fold(0.0, f64::max);
+        if v[n] < MASKED_SHARE * recent {
             continue;
         }
         if picked.last().is_some_and(|&last| n - last < gap) {
