@@ -16,6 +16,11 @@ const WINDOW_S: (f64, f64) = (0.06, 0.15);
 pub const LEVEL_SPAN_S: f64 = 0.04;
 /// Partials are looked for within ± this share of their frequency.
 const PARTIAL_TOLERANCE: f64 = 0.02;
+/// The drum an octave or a fifth below the best fit is heard instead when its (1,1) in
+/// the window reaches this share of the best's…
+const LOWER_SHARE: f64 = 0.3;
+/// …and its partials score this share of the best's.
+const LOWER_SCORE: f64 = 0.6;
 
 /// What a stroke added.
 #[derive(Clone, Debug, PartialEq)]
@@ -74,8 +79,19 @@ fn principal(added: &[(f64, f64)], after: &[(f64, f64)], band: (f64, f64)) -> Op
         .flat_map(|p| KETTLEDRUM_RATIOS.iter().map(move |r| p.0 / r))
         .filter(|c| (band.0..=band.1).contains(c))
         .map(|c| (c, score(c)))
-        .max_by(|a, b| a.1.total_cmp(&b.1))?
-        .0;
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    // A low drum whose (2,1) or (3,1) carries more than its (1,1) looks like a drum a
+    // fifth or an octave higher: the lower one is heard when its (1,1) sounds in the
+    // window and its partials explain nearly as much.
+    let lower = [KETTLEDRUM_RATIOS[2], KETTLEDRUM_RATIOS[1]]
+        .iter()
+        .map(|r| best.0 / r)
+        .find(|&c| {
+            (band.0..=band.1).contains(&c)
+                && near(after, c) >= LOWER_SHARE * near(after, best.0)
+                && score(c) >= LOWER_SCORE * best.1
+        });
+    let best = lower.unwrap_or(best.0);
     Some(peak_in(after, best * 0.99, best * 1.01).map_or(best, |p| p.0))
 }
 
