@@ -347,6 +347,7 @@ fn a_failure_midway_leaves_no_partial_pack() {
         beats: Vec::new(),
         gaze: None,
         grip: None,
+        hands: None,
     };
     let audio = timpanist::sound::Audio {
         rate_hz: 48_000,

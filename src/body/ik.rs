@@ -71,20 +71,49 @@ pub fn solve(
     params: &IkParams,
     limits: &JointLimits,
 ) -> IkResult {
+    solve_task(
+        skeleton,
+        start,
+        (side, Task::Tip),
+        target,
+        reference,
+        params,
+        limits,
+    )
+}
+
+/// [`solve`] for any [`Task`] of the `side` arm; the error is the task's effector's.
+pub fn solve_task(
+    skeleton: &Skeleton,
+    start: &Pose,
+    (side, task): (Side, Task),
+    target: DVec3,
+    reference: Option<&Pose>,
+    params: &IkParams,
+    limits: &JointLimits,
+) -> IkResult {
     let mut pose = *start;
     let mut iterations = 0;
     let mut error = f64::INFINITY;
     while iterations < params.max_iterations {
         let frames = skeleton.forward(&pose);
-        error = (target - frames.tip(side)).length();
+        error = (target - task.effector(&frames, side)).length();
         if error <= params.tolerance_m {
             break;
         }
         iterations += 1;
-        iterate(&frames, &mut pose, side, target, reference, params, limits);
+        iterate_task(
+            &frames,
+            &mut pose,
+            (side, task),
+            target,
+            reference,
+            params,
+            limits,
+        );
     }
     if iterations == params.max_iterations {
-        error = (target - skeleton.tip(&pose, side)).length();
+        error = (target - task.effector(&skeleton.forward(&pose), side)).length();
     }
     IkResult {
         pose,
@@ -139,18 +168,71 @@ pub fn iterate(
     params: &IkParams,
     limits: &JointLimits,
 ) {
+    iterate_task(
+        frames,
+        pose,
+        (side, Task::Tip),
+        target,
+        reference,
+        params,
+        limits,
+    );
+}
+
+/// What an IK step brings to its target, and with which joints.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Task {
+    /// The stick tip, with the whole arm (and the trunk when the parameters say so).
+    Tip,
+    /// The hand (the grip joint, where the fingers hold the stick), with the arm up to the
+    /// wrist: a hand resting on a head to damp it.
+    Hand,
+    /// The stick tip, with the grip joint alone: the stick turned about the hand (which it
+    /// does not move) to point at the target.
+    StickAim,
+}
+
+impl Task {
+    /// The point the task moves, m.
+    fn effector(self, frames: &Frames, side: Side) -> DVec3 {
+        match self {
+            Task::Tip | Task::StickAim => frames.tip(side),
+            Task::Hand => frames.position[Joint::arm(side)[3].index()],
+        }
+    }
+}
+
+/// [`iterate`] for any [`Task`] of the `side` arm.
+pub fn iterate_task(
+    frames: &Frames,
+    pose: &mut Pose,
+    (side, task): (Side, Task),
+    target: DVec3,
+    reference: Option<&Pose>,
+    params: &IkParams,
+    limits: &JointLimits,
+) {
     // Fixed-size buffers: the solver runs every simulation step and must not allocate.
     let mut chain = [(Joint::Trunk, 0.0); 5];
     let mut len = 0;
-    if params.use_trunk {
+    if params.use_trunk && task != Task::StickAim {
         chain[0] = (Joint::Trunk, params.weights[0]);
         len = 1;
     }
-    for (&j, &w) in Joint::arm(side).iter().zip(&params.weights[1..]) {
+    let (skip, take) = match task {
+        Task::Tip => (0, 4),
+        Task::Hand => (0, 3),
+        Task::StickAim => (3, 1),
+    };
+    let arm = Joint::arm(side)
+        .into_iter()
+        .zip(params.weights[1..].iter().copied());
+    for (j, w) in arm.skip(skip).take(take) {
         chain[len] = (j, w);
         len += 1;
     }
     let chain = &chain[..len];
+    let effector = task.effector(frames, side);
     // Outward normals (world) of the limited joints on or beyond their ellipsoids.
     let mut at_limit = [None; 5];
     for (normal, &(j, _)) in at_limit.iter_mut().zip(chain) {
@@ -164,7 +246,7 @@ pub fn iterate(
     }
     let mut clamped = [None; 5];
     let mut step = chain_step(
-        frames, pose, chain, &clamped, side, target, reference, params,
+        frames, pose, chain, &clamped, effector, target, reference, params,
     );
     for _ in 0..chain.len() {
         let mut more = false;
@@ -180,7 +262,7 @@ pub fn iterate(
             break;
         }
         step = chain_step(
-            frames, pose, chain, &clamped, side, target, reference, params,
+            frames, pose, chain, &clamped, effector, target, reference, params,
         );
     }
     for &(j, _) in chain {
@@ -205,12 +287,12 @@ fn chain_step(
     pose: &Pose,
     chain: &[(Joint, f64)],
     clamped: &[Option<DVec3>; 5],
-    side: Side,
+    effector: DVec3,
     target: DVec3,
     reference: Option<&Pose>,
     params: &IkParams,
 ) -> [DVec3; JOINT_COUNT] {
-    let tip = frames.tip(side);
+    let tip = effector;
     let e = target - tip;
     // Columns: three world axes per joint (a clamped joint's projected on its tangent
     // plane: three vectors spanning it, whose outer products sum to the projector).
@@ -461,5 +543,45 @@ mod tests {
         outside[elbow] = start[elbow] * DQuat::from_rotation_x(0.8);
         let from_outside = solve(&s, &outside, Side::Right, target, None, &params, &limits);
         assert!(limit.contains(from_outside.pose[elbow]));
+    }
+
+    /// The hand task puts the grip joint on its target without the grip joint's help, and
+    /// aiming the stick turns only the grip: the hand stays where it is.
+    #[test]
+    fn the_hand_reaches_and_the_stick_turns_about_it() {
+        let s = Skeleton::default();
+        let params = IkParams::default();
+        let grip = Joint::GripR.index();
+        let target = DVec3::new(0.3, 0.35, 1.0);
+        let placed = solve_task(
+            &s,
+            &bent_start(),
+            (Side::Right, Task::Hand),
+            target,
+            None,
+            &params,
+            &NO_LIMITS,
+        );
+        assert!(placed.converged, "{}", placed.error_m);
+        assert_eq!(placed.pose[grip], bent_start()[grip]);
+        let hand = s.forward(&placed.pose).position[grip];
+        assert!(hand.distance(target) < 1e-4);
+        let aim = hand + DVec3::new(0.0, 0.6, 0.8) * s.stick_length_m;
+        let aimed = solve_task(
+            &s,
+            &placed.pose,
+            (Side::Right, Task::StickAim),
+            aim,
+            None,
+            &params,
+            &NO_LIMITS,
+        );
+        assert!(aimed.converged, "{}", aimed.error_m);
+        let frames = s.forward(&aimed.pose);
+        assert!(frames.position[grip].distance(hand) < 1e-12);
+        assert!(frames.tip(Side::Right).distance(aim) < 1e-4);
+        for j in Joint::ALL.into_iter().filter(|&j| j != Joint::GripR) {
+            assert_eq!(aimed.pose[j.index()], placed.pose[j.index()], "{j:?}");
+        }
     }
 }

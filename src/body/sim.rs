@@ -114,6 +114,88 @@ pub struct Reference {
     /// about the fulcrum: the grip's PD and feed-forward scale by it (the arm keeps
     /// aiming). `None` holds both grips firm throughout.
     pub grip: Option<[Vec<f64>; 2]>,
+    /// Hands brought to points of their own (a hand resting on a head to damp it); `None`
+    /// when the hands only carry the sticks.
+    pub hands: Option<HandTargets>,
+}
+
+/// Rounds of [`place_hand`] in a task-rate IK solve.
+const HAND_SOLVE_ROUNDS: usize = 40;
+
+/// Per sample and hand ([left, right]), where the hand goes (its grip joint, m) and how
+/// much of the way: 0 leaves the hand to the stick's task, 1 puts it on its point. While
+/// it is above 0 the stick turns about the hand to point its tip at the tip target.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HandTargets {
+    pub weight: [Vec<f64>; 2],
+    pub points: [Vec<DVec3>; 2],
+}
+
+impl HandTargets {
+    /// Hand `h`'s weight and point between samples `k − 1` and `k` (`u` ∈ [0, 1]), when
+    /// its weight there is above 0.
+    pub fn at(&self, h: usize, k: usize, u: f64) -> Option<(f64, DVec3)> {
+        let (w, p) = (&self.weight[h], &self.points[h]);
+        let (a, b) = (k.saturating_sub(1).min(w.len() - 1), k.min(w.len() - 1));
+        let weight = w[a] + (w[b] - w[a]) * u;
+        (weight > 0.0).then(|| (weight, p[a].lerp(p[b], u)))
+    }
+}
+
+/// The `side` arm's IK when its hand also has a point of its own (weight `w`, `point`):
+/// `rounds` rounds of a tip step toward `tip` scaled by 1 − w and a hand step (the arm up
+/// to the wrist) toward `point` scaled by w, so the arm settles where the two weighted
+/// pulls balance (at w = 1 the hand is on its point), then as many steps of the grip alone
+/// turning the stick about the hand toward `tip`.
+#[allow(clippy::too_many_arguments)]
+fn place_hand(
+    skeleton: &super::skeleton::Skeleton,
+    pose: &mut Pose,
+    side: Side,
+    (weight, point): (f64, DVec3),
+    tip: DVec3,
+    reference: Option<&Pose>,
+    (params, limits): (&IkParams, &JointLimits),
+    rounds: usize,
+) {
+    let w = weight.min(1.0);
+    let grip = Joint::arm(side)[3].index();
+    for _ in 0..rounds {
+        let frames = skeleton.forward(pose);
+        let toward = frames.tip(side).lerp(tip, 1.0 - w);
+        ik::iterate_task(
+            &frames,
+            pose,
+            (side, ik::Task::Tip),
+            toward,
+            reference,
+            params,
+            limits,
+        );
+        let frames = skeleton.forward(pose);
+        let toward = frames.position[grip].lerp(point, w);
+        ik::iterate_task(
+            &frames,
+            pose,
+            (side, ik::Task::Hand),
+            toward,
+            reference,
+            params,
+            limits,
+        );
+    }
+    for _ in 0..rounds {
+        let frames = skeleton.forward(pose);
+        ik::iterate_task(
+            &frames,
+            pose,
+            (side, ik::Task::StickAim),
+            tip,
+            reference,
+            params,
+            limits,
+        );
+    }
 }
 
 /// What the body did, at the task rate.
@@ -256,6 +338,18 @@ pub fn ik_target(
             &params.ik_limits(),
         )
         .pose;
+        if let Some(hand) = reference.hands.as_ref().and_then(|t| t.at(h, k, 1.0)) {
+            place_hand(
+                &model.skeleton,
+                &mut pose,
+                side,
+                hand,
+                reference.tips[h][k],
+                Some(&pull),
+                (&params.ik, &params.ik_limits()),
+                HAND_SOLVE_ROUNDS,
+            );
+        }
     }
     if let Some(gaze) = &reference.gaze {
         let frames = model.skeleton.forward(&pose);
@@ -544,15 +638,27 @@ impl Simulator {
                     let frames = self.model.skeleton.forward(&goal);
                     for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
                         let target = reference.tips[h][k - 1].lerp(reference.tips[h][k], u);
-                        ik::iterate(
-                            &frames,
-                            &mut goal,
-                            side,
-                            target,
-                            Some(&reference_pose),
-                            &self.nested,
-                            &self.ik_limits,
-                        );
+                        match reference.hands.as_ref().and_then(|t| t.at(h, k, u)) {
+                            Some(hand) => place_hand(
+                                &self.model.skeleton,
+                                &mut goal,
+                                side,
+                                hand,
+                                target,
+                                Some(&reference_pose),
+                                (&self.nested, &self.ik_limits),
+                                1,
+                            ),
+                            None => ik::iterate(
+                                &frames,
+                                &mut goal,
+                                side,
+                                target,
+                                Some(&reference_pose),
+                                &self.nested,
+                                &self.ik_limits,
+                            ),
+                        }
                     }
                 }
             }
@@ -694,6 +800,7 @@ mod tests {
             beats: vec![(0.02, 3), (0.06, 4)],
             gaze: None,
             grip: None,
+            hands: None,
         };
         let params = SimParams {
             frequency_hz: [2000.0; JOINT_COUNT],
@@ -735,6 +842,7 @@ mod tests {
             beats: vec![(1.9, 7)],
             gaze: None,
             grip: None,
+            hands: None,
         };
         let run = |limit: f64| {
             let params = SimParams {
@@ -778,6 +886,7 @@ mod tests {
             beats: Vec::new(),
             gaze: None,
             grip: None,
+            hands: None,
         };
         let params = SimParams::default();
         let (a, b) = (reference(0.0), reference(0.5));

@@ -458,6 +458,7 @@ fn print_stats(r: &Rendering) {
         ),
         None => println!("joint limits: none held"),
     }
+    print_damping(&r.damping);
     let forces = strikes::forces_by_dynamic(&r.events);
     let recontacts: usize = forces.iter().map(|f| f.recontacts).sum();
     println!("force by dynamic (peak force of each stroke's contact; re-contacts ≥ 5 N after it):");
@@ -547,4 +548,46 @@ impl ProgressBar {
             eprintln!();
         }
     }
+}
+
+/// The `secco` line of `--stats`: how each damped beat's head was stopped.
+fn print_damping(d: &crate::render::damping::DampReport) {
+    let total = d.by_hand.len() + d.missed.len() + d.without_hand.len();
+    if total == 0 {
+        return;
+    }
+    let beats = |b: &[usize]| {
+        b.iter()
+            .map(|b| b.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let (early, late) = d
+        .by_hand
+        .iter()
+        .fold((0.0f64, 0.0f64), |(lo, hi), &(_, off)| {
+            (lo.min(off), hi.max(off))
+        });
+    println!(
+        "secco: {total} damped beats; {} touched by the free hand ({:+.0} to {:+.0} ms from the damp tick){}{}",
+        d.by_hand.len(),
+        early * 1e3,
+        late * 1e3,
+        if d.missed.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; the hand did not reach the head for beats {} (damped at the tick)",
+                beats(&d.missed)
+            )
+        },
+        if d.without_hand.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; no hand free for beats {} (damped at the tick, no gesture)",
+                beats(&d.without_hand)
+            )
+        }
+    );
 }

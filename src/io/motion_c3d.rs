@@ -88,6 +88,7 @@ mod tests {
             beats: Vec::new(),
             gaze: None,
             grip: None,
+            hands: None,
         };
         let bytes = to_c3d(&motion, &reference, &skeleton);
         let back = read(Path::new("motion.c3d"), &bytes, None).unwrap();

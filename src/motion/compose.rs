@@ -19,6 +19,7 @@
 //! stroke, after its last, and in rests longer than 1.5 s; shorter waits hold a ready
 //! point between the strokes.
 
+use super::muffle::Muffles;
 use super::plan::PlannedStroke;
 use crate::body::limits::{JointLimits, NO_LIMITS};
 use crate::kit::Side;
@@ -104,6 +105,9 @@ pub struct Composition {
     /// database, `MotionDb::joint_limits` of the score's grip; none when composed without
     /// a score): a rendering holds the body within them.
     pub limits: JointLimits,
+    /// The secco beats' damping gestures ([`super::muffle`]; none when composed without a
+    /// score).
+    pub muffles: Muffles,
 }
 
 impl Composition {
@@ -316,6 +320,7 @@ pub fn compose(strokes: &[PlannedStroke], db: &MotionDb, params: &ComposeParams)
         strokes: strokes.to_vec(),
         impact_samples,
         limits: NO_LIMITS,
+        muffles: Muffles::default(),
     }
 }
 

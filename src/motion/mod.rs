@@ -1,9 +1,10 @@
 //! From score to motion: hand assignment (sticking), planning strokes with motion units,
-//! splicing and co-articulating them into two stick-tip trajectories, and the user's
-//! edit handles on top.
+//! splicing and co-articulating them into two stick-tip trajectories, the free hand's
+//! damping of secco beats, and the user's edit handles on top.
 
 pub mod compose;
 pub mod handles;
+pub mod muffle;
 pub mod perform;
 pub mod plan;
 pub mod sticking;

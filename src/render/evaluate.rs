@@ -264,6 +264,7 @@ fn unit_reference(db: &MotionDb, unit: &UnitEntry, tips: [Vec<DVec3>; 2]) -> Ref
         beats: vec![((unit.impact - unit.start) as f64 / take.rate_hz, 0)],
         gaze: None,
         grip: None,
+        hands: None,
     }
 }
 
@@ -322,6 +323,7 @@ fn solved_joints(tips: &[Vec<DVec3>; 2], rate_hz: f64) -> Vec<Pose> {
         beats: Vec::new(),
         gaze: None,
         grip: None,
+        hands: None,
     };
     let model = BodyModel::new(skeleton, 70.0);
     ik_targets(&model, &reference, &SimParams::default(), &start)

@@ -12,6 +12,7 @@
 //! edit ([`render_after`]).
 
 pub mod compensate;
+pub mod damping;
 pub mod evaluate;
 pub mod gaze;
 pub mod reach;
@@ -33,6 +34,7 @@ use crate::motion::plan::{PlanError, PlanParams, PlannedStroke};
 use crate::score::{LoadedScore, Settings};
 use crate::sound::{Audio, SoundError, SoundModel, SoundState, Touch};
 use compensate::{Aims, Performance, Stage};
+use damping::DampReport;
 use glam::DVec3;
 use reference::{Release, StrikeShape, Targets, Warp};
 use std::time::{Duration, Instant};
@@ -226,8 +228,10 @@ pub struct Rendering {
     /// What it was rendered with.
     pub params: RenderParams,
     pub kit: Kit,
-    /// Where hands damped heads (from the score's secco beats).
+    /// Where hands damped heads (the score's secco beats, timed by the simulated hands).
     pub touches: Vec<Touch>,
+    /// How each secco beat's head was stopped.
+    pub damping: DampReport,
 }
 
 /// Why a score could not be rendered.
@@ -377,15 +381,13 @@ pub fn render_composition(
         release: params.release,
     };
     let targets = Targets::new(&composition, &shape, params.strike_depth_m);
-    let touches = touches(&loaded.score);
     let run = Run {
         kit,
-        touches: &touches,
         mallet,
         params,
         composition: &composition,
     };
-    let started = run.start(resume.take(), targets, skeleton)?;
+    let started = run.start(resume.take(), targets, skeleton.clone())?;
     stats.resumed_from_s = started.resumed_from_s;
     let state = resume.insert(started.state);
     let horizon = stats.resumed_from_s.zip(stop_after_s).map(|(from, after)| {
@@ -401,8 +403,16 @@ pub fn render_composition(
     }) {
         return Err(RenderError::Cancelled);
     }
+    let simulated_s = composition.time(state.performance.sim.samples().max(1) - 1);
+    let (touches, damping) = damping::touches(
+        &composition,
+        state.performance.sim.motion(),
+        &skeleton,
+        kit,
+        simulated_s,
+    );
     let began = Instant::now();
-    let (audio, ready_s) = run.sound(state, complete)?;
+    let (audio, ready_s) = run.sound(state, complete, &touches)?;
     stats.sound = began.elapsed();
     progress(Progress {
         stage: "done",
@@ -432,14 +442,13 @@ pub fn render_composition(
         params: params.clone(),
         kit: kit.clone(),
         touches,
+        damping,
     })
 }
 
 /// One rendering's fixed inputs.
 struct Run<'a> {
     kit: &'a Kit,
-    /// Where hands damp heads (secco beats).
-    touches: &'a [Touch],
     /// The kit's mallet the params name.
     mallet: &'a crate::kit::Mallet,
     params: &'a RenderParams,
@@ -632,7 +641,12 @@ impl Run<'_> {
     /// The sound of the performance so far, resuming the state's synthesis, and the score
     /// time up to which it is final, s (a partial rendering's audio stops where later
     /// strikes could still change it).
-    fn sound(&self, state: &mut Resume, complete: bool) -> Result<(Audio, f64), RenderError> {
+    fn sound(
+        &self,
+        state: &mut Resume,
+        complete: bool,
+        touches: &[Touch],
+    ) -> Result<(Audio, f64), RenderError> {
         let comp = self.composition;
         let drums = &state.performance.drums;
         let (end_s, ready_s) = if complete {
@@ -647,7 +661,7 @@ impl Run<'_> {
         let (audio, sound) = crate::sound::render_touched(
             self.kit,
             drums,
-            self.touches,
+            touches,
             end_s.max(0.0),
             self.params.sound,
             Some(previous),
@@ -655,21 +669,6 @@ impl Run<'_> {
         state.sound = sound;
         Ok((audio, ready_s))
     }
-}
-
-/// Where the score's secco beats have a hand damp their drum: the damp tick's time.
-pub fn touches(score: &crate::score::Score) -> Vec<Touch> {
-    let tempo = score.tempo_map();
-    score
-        .beats
-        .iter()
-        .filter_map(|b| {
-            b.damp_tick().map(|tick| Touch {
-                drum: b.drum,
-                at_s: tempo.seconds_at(tick as f64),
-            })
-        })
-        .collect()
 }
 
 impl Rendering {

@@ -11,7 +11,7 @@
 //! the targets only after the anchor before it, which lets the compensation settle a
 //! score front to back and resume from any settled point.
 
-use crate::body::sim::Reference;
+use crate::body::sim::{HandTargets, Reference};
 use crate::motion::compose::Composition;
 use glam::DVec3;
 use std::ops::Range;
@@ -118,6 +118,8 @@ pub struct Targets {
     gaze: Vec<DVec3>,
     /// The fraction of each hand's grip control held per sample, [left, right].
     held: [Vec<f64>; 2],
+    /// Where the hands damp heads (the composition's muffles), when any do.
+    hands: Option<HandTargets>,
 }
 
 impl Targets {
@@ -172,6 +174,7 @@ impl Targets {
             .collect();
         beats.sort_by(|a, b| a.0.total_cmp(&b.0));
         let held = grip_held(&dips, &shape.release, rate, n);
+        let hands = hand_targets(comp);
         let mut targets = Targets {
             rate_hz: rate,
             shaped: raised.clone(),
@@ -180,6 +183,7 @@ impl Targets {
             beats,
             gaze: super::gaze::gaze_points(comp),
             held,
+            hands,
         };
         for i in 0..targets.dips.len() {
             targets.set_depth(i, depth_m);
@@ -257,6 +261,7 @@ impl Targets {
             beats: self.beats.clone(),
             gaze: Some(self.gaze.clone()),
             grip: Some(self.held.clone()),
+            hands: self.hands.clone(),
         }
     }
 
@@ -377,6 +382,49 @@ fn sample<T: Copy>(points: &[T], x: f64, lerp: impl Fn(T, T, f64) -> T) -> T {
     lerp(points[i], points[i + 1], u)
 }
 
+/// The hands' targets of the composition's muffles: per sample, the weight of the muffle
+/// under way (none overlap for one hand) and its hand point; `None` without muffles.
+fn hand_targets(comp: &Composition) -> Option<HandTargets> {
+    let muffles = &comp.muffles.played;
+    if muffles.is_empty() {
+        return None;
+    }
+    let mut weight: [Vec<f64>; 2] = std::array::from_fn(|_| vec![0.0; comp.len()]);
+    let mut points: [Vec<DVec3>; 2] = std::array::from_fn(|_| vec![DVec3::ZERO; comp.len()]);
+    for m in muffles {
+        let h = crate::mocap::db::side_index(m.hand);
+        for k in 0..comp.len() {
+            let t = comp.time(k);
+            let w = m.weight(t);
+            if w > 0.0 {
+                weight[h][k] = w;
+                points[h][k] = m.hand_at(t);
+            }
+        }
+    }
+    // A point held from each muffle's first sample back and to its last forward, so the
+    // interpolation between samples never heads for the origin.
+    for h in 0..2 {
+        let mut last = None;
+        for k in 0..comp.len() {
+            if weight[h][k] > 0.0 {
+                last = Some(points[h][k]);
+            } else if let Some(p) = last {
+                points[h][k] = p;
+            }
+        }
+        let mut next = None;
+        for k in (0..comp.len()).rev() {
+            if weight[h][k] > 0.0 {
+                next = Some(points[h][k]);
+            } else if let Some(p) = next.filter(|_| points[h][k] == DVec3::ZERO) {
+                points[h][k] = p;
+            }
+        }
+    }
+    Some(HandTargets { weight, points })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -391,6 +439,7 @@ mod tests {
             beats: Vec::new(),
             gaze: Vec::new(),
             held: [vec![1.0; n], vec![1.0; n]],
+            hands: None,
         }
     }
 

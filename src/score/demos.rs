@@ -22,6 +22,7 @@ pub const DEMOS: &[(&str, &str)] = &[
         "tempo-change",
         include_str!("../../scores/tempo-change.ron"),
     ),
+    ("secco-study", include_str!("../../scores/secco-study.ron")),
     (
         "improvisation",
         include_str!("../../scores/improvisation.ron"),
