@@ -191,21 +191,31 @@ fn rendered_demo_scores_transcribe_back() {
 }
 
 /// The shipped recorded notes (FluidR3 timpani, 32 kHz, three pitches, each hand) joined
-/// into a phrase 0.9 s apart: every note is found within 20 ms; pitches are printed and
-/// at least the measured number (4 of 6) are right.
-#[test]
-fn recorded_notes_joined_into_a_phrase() {
+/// into a phrase, played `semitones` higher (resampled: shorter and higher, as a tape sped
+/// up), and each note's onset (s) and principal (1,1) frequency (Hz). Each note is cut
+/// after 0.9 s and the next follows; `ringing` instead lets every note ring out under the
+/// next ones, 0.6 s apart.
+fn recorded_phrase(semitones: i32, ringing: bool) -> (Vec<f32>, u32, Vec<(f64, f64)>) {
     let dir = root().join("kits/samples");
+    let speed = 2f64.powf(f64::from(semitones) / 12.0);
     let mut phrase: Vec<f32> = Vec::new();
     let mut truth: Vec<(f64, f64)> = Vec::new();
     let mut rate = 0;
+    let mut next_at = 0.0;
     for name in ["1L", "2R", "3L", "1R", "3R", "2L"] {
-        let (s, r) =
+        let (original, r) =
             timpanist::sound::analysis::read_mono(&dir.join(format!("Timpani_{name}.wav")))
                 .unwrap();
         rate = r;
+        let s: Vec<f32> = (0..((original.len() - 1) as f64 / speed) as usize)
+            .map(|i| {
+                let x = i as f64 * speed;
+                let (k, u) = (x.floor() as usize, (x - x.floor()) as f32);
+                original[k] + (original[k + 1] - original[k]) * u
+            })
+            .collect();
         let onset = timpanist::sound::analysis::onset(&s, r).unwrap() as f64 / f64::from(r);
-        let at = phrase.len() as f64 / f64::from(r);
+        let at = next_at;
         let spec = timpanist::sound::spectrum::spectrum(&s[..(r as usize / 2).min(s.len())], r);
         let hz = timpanist::sound::spectrum::principal_hz(
             &spec,
@@ -215,32 +225,51 @@ fn recorded_notes_joined_into_a_phrase() {
         )
         .unwrap();
         truth.push((at + onset, hz));
-        let keep = (0.9 * f64::from(r)) as usize;
-        phrase.extend(s.iter().take(keep));
-        phrase.resize(phrase.len().max((at * f64::from(r)) as usize + keep), 0.0);
+        let keep = if ringing {
+            s.len()
+        } else {
+            (0.9 * f64::from(r)) as usize
+        };
+        let start = (at * f64::from(r)) as usize;
+        phrase.resize(phrase.len().max(start + keep), 0.0);
+        for (out, x) in phrase[start..].iter_mut().zip(s.iter().take(keep)) {
+            *out += x;
+        }
+        next_at += if ringing { 0.6 } else { 0.9 };
     }
+    (phrase, rate, truth)
+}
+
+/// The recorded phrase as recorded and moved up or down by up to a minor seventh, with
+/// each note cut or ringing under the next: every note is found within 20 ms with its
+/// pitch (a pitch no drum of the standard kit reaches counts when its pitch class is
+/// right: it is moved by octaves into a drum's range, as MIDI import does).
+#[test]
+fn recorded_notes_joined_into_a_phrase() {
     let kit = Kit::standard();
-    let (score, report) = transcribe(&phrase, rate, &kit, "phrase", &Options::default()).unwrap();
-    let found = strokes_of(&score);
-    println!(
-        "recorded phrase: truth {truth:.3?}; heard {:.3?}; {} beats; tuning {:+.0} cents",
-        report.onsets_s,
-        score.beats.len(),
-        report.tuning_cents
-    );
-    assert_eq!(found.len(), truth.len(), "{found:?}");
-    let mut right = 0;
-    for ((t, hz), (beat, (at, _))) in truth.iter().zip(score.beats.iter().zip(&found)) {
-        assert!((at - t).abs() <= TOLERANCE_S, "{at} vs {t}");
-        let want = Pitch((69.0 + 12.0 * (hz / 440.0).log2()).round() as u8);
-        let got = beat.sounding_pitch(&kit);
-        println!("recorded {hz:.1} Hz ({want}): transcribed {got}");
-        let playable = kit.drums.iter().any(|d| d.in_range(want));
-        right += usize::from(got == want || (!playable && got.0 % 12 == want.0 % 12));
+    let variants = [0, -2, 1, 3, 5, 7, 10].map(|s| (s, false));
+    for (semitones, ringing) in variants.into_iter().chain([(0, true), (5, true)]) {
+        let (phrase, rate, truth) = recorded_phrase(semitones, ringing);
+        let (score, report) =
+            transcribe(&phrase, rate, &kit, "phrase", &Options::default()).unwrap();
+        let found = strokes_of(&score);
+        println!(
+            "recorded phrase {semitones:+} semitones (ringing {ringing}): truth {truth:.3?}; heard {:.3?}; tuning {:+.0} cents",
+            report.onsets_s, report.tuning_cents
+        );
+        assert_eq!(found.len(), truth.len(), "{semitones:+}: {found:?}");
+        for ((t, hz), (beat, (at, _))) in truth.iter().zip(score.beats.iter().zip(&found)) {
+            assert!((at - t).abs() <= TOLERANCE_S, "{semitones:+}: {at} vs {t}");
+            let want = Pitch((69.0 + 12.0 * (hz / 440.0).log2()).round() as u8);
+            let got = beat.sounding_pitch(&kit);
+            let playable = kit.drums.iter().any(|d| d.in_range(want));
+            println!("  recorded {hz:.1} Hz ({want}): transcribed {got}");
+            assert!(
+                got == want || (!playable && got.0 % 12 == want.0 % 12),
+                "{semitones:+}: recorded {hz:.1} Hz ({want}) transcribed {got}"
+            );
+        }
     }
-    // The issue asks every pitch; measured 4 of 6 (a note no drum of the kit reaches
-    // counts when its pitch class is right, moved by octaves): see README.
-    assert!(right >= 4, "{right} of 6 pitches right");
 }
 
 /// Bad input: a file that is not a WAV, and silence, are refused naming the file.

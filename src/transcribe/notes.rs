@@ -11,7 +11,7 @@ use crate::sound::spectrum::{peak_in, peaks, spectrum};
 /// The spectrum windows start this long after the onset (past the click), s.
 const AFTER_ONSET_S: f64 = 0.005;
 /// Window length: up to the next onset, within these bounds, s.
-const WINDOW_S: (f64, f64) = (0.06, 0.15);
+const WINDOW_S: (f64, f64) = (0.06, 0.4);
 /// Span over which a stroke's added energy is measured, s.
 pub const LEVEL_SPAN_S: f64 = 0.04;
 /// Partials are looked for within ± this share of their frequency.
