@@ -63,6 +63,22 @@ impl EditorApp {
                 let now = self.ctx.as_ref().map_or(0.0, |c| c.input(|i| i.time));
                 self.views.viewport.go_to(view, now);
             }
+            Action::Speed(steps) => {
+                let speed = self.transport.change_speed(steps);
+                self.messages.status = format!("playback speed {}", speed_label(speed));
+            }
+            Action::StepFrames(frames) => self.transport.step_frames(frames),
+            Action::StepContact(forward) => {
+                let times = self
+                    .pipeline
+                    .composition()
+                    .map(|c| c.strokes.iter().map(|s| s.time_s).collect::<Vec<_>>())
+                    .unwrap_or_default();
+                if !self.transport.step_to_contact(times, forward) {
+                    self.messages.status =
+                        format!("no contact {}", if forward { "after" } else { "before" });
+                }
+            }
             Action::TogglePreferences => self.settings.window_open = !self.settings.window_open,
             Action::ClearSelection => {
                 if let Some(d) = &mut self.doc {
@@ -86,5 +102,14 @@ impl EditorApp {
             self.messages.status = status;
         }
         outcome.changed
+    }
+}
+
+/// A playback speed as the transport bar shows it: "1×", "1/2×", "1/10×".
+pub(super) fn speed_label(speed: f64) -> String {
+    if speed >= 1.0 {
+        "1×".into()
+    } else {
+        format!("1/{}×", (1.0 / speed).round())
     }
 }

@@ -175,6 +175,22 @@ impl EditorApp {
                 position.unwrap_or_default()
             ));
             ui.separator();
+            let speed = self.transport.playback.speed();
+            egui::ComboBox::from_label("Speed")
+                .selected_text(super::actions::speed_label(speed))
+                .show_ui(ui, |ui| {
+                    for s in super::playback::SPEEDS {
+                        if ui
+                            .selectable_label(s == speed, super::actions::speed_label(s))
+                            .clicked()
+                        {
+                            self.transport.playback.set_speed(s);
+                        }
+                    }
+                })
+                .response
+                .on_hover_text("[ slower, ] faster; below 1 the audio is muted");
+            ui.separator();
             ui.add_enabled(
                 self.transport.loop_ticks.is_some(),
                 egui::Checkbox::new(&mut self.transport.looping, "Loop"),
@@ -202,6 +218,13 @@ impl EditorApp {
         ui.horizontal(|ui| {
             if let Some(n) = self.transport.playback.notice() {
                 ui.colored_label(ui.visuals().warn_fg_color, n);
+                ui.separator();
+            }
+            if !self.transport.playback.is_real_time() {
+                ui.colored_label(
+                    ui.visuals().warn_fg_color,
+                    super::playback::SLOW_MOTION_NOTICE,
+                );
                 ui.separator();
             }
             if self.pipeline.is_composing() {
