@@ -11,7 +11,13 @@ use std::time::{Duration, Instant};
 use timpanist::app::EditorApp;
 
 fn harness(dir: &Path) -> Harness<'static, EditorApp> {
-    let score = common::root().join("scores/etude-modes.ron");
+    harness_on(dir, "etude-modes")
+}
+
+/// The editor on the bundled score `name` (the etude is played by the right hand alone;
+/// the dynamics ladder alternates hands).
+fn harness_on(dir: &Path, name: &str) -> Harness<'static, EditorApp> {
+    let score = common::root().join(format!("scores/{name}.ron"));
     let mut h = common::editor(Some(score), dir, false);
     common::settle(&mut h);
     h
@@ -86,4 +92,96 @@ fn frame_and_contact_steps() {
     assert!(second > next);
     press(&mut h, egui::Modifiers::SHIFT, egui::Key::Comma);
     assert_eq!(h.state().playhead_s(), next);
+}
+
+/// View > Camera: follow the hand moves the camera's target after the tip of the hand
+/// that strikes next — gliding, not jumping, when the playhead moves to the other hand's
+/// stroke — and a named view (F6) stops it.
+#[test]
+fn camera_follows_the_next_hand() {
+    use timpanist::kit::Side;
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness_on(dir.path(), "dynamics-ladder");
+    let comp = h.state().composition().unwrap().clone();
+    // A stroke of each hand right after one of the other hand's.
+    let after_other = |hand: Side| {
+        comp.strokes
+            .windows(2)
+            .find(|w| w[1].hand == hand && w[0].hand != hand && w[1].time_s - w[0].time_s > 0.05)
+            .map(|w| w[1].time_s - 0.02)
+            .unwrap()
+    };
+    let tip = |t: f64, hand: Side| {
+        let k = ((t - comp.start_s) * comp.rate_hz).round() as usize;
+        comp.tip(hand)[k]
+    };
+    h.get_by_label("View").click();
+    h.run();
+    h.get_by_label("Camera: follow the hand that strikes next  (F9)")
+        .click();
+    common::settle(&mut h);
+    assert!(h.state().is_following_hand());
+    let t_right = after_other(Side::Right);
+    h.state_mut().seek(t_right);
+    h.run();
+    let goal = tip(t_right, Side::Right);
+    let target = h.state().camera().target;
+    assert!(target.distance(goal) < 0.005, "{target} vs {goal}");
+    let t_left = after_other(Side::Left);
+    h.state_mut().seek(t_left);
+    let goal = tip(t_left, Side::Left);
+    let start = target.distance(goal);
+    assert!(start > 0.05, "the hands' tips are apart: {start}");
+    h.step();
+    let between = h.state().camera().target.distance(goal);
+    assert!(
+        between > 0.05 * start && between < 0.95 * start,
+        "{between} of {start}"
+    );
+    h.run();
+    assert!(h.state().camera().target.distance(goal) < 0.005);
+    h.key_press(egui::Key::F6);
+    h.run();
+    assert!(!h.state().is_following_hand());
+}
+
+/// F frames the selected beat's impact (centred, closer than the default camera), and
+/// with nothing selected the whole kit (every head's centre inside the view).
+#[test]
+fn frame_the_selection() {
+    use timpanist::app::Camera;
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(dir.path());
+    let b = 3;
+    h.state_mut().show_beat(b);
+    common::settle(&mut h);
+    h.key_press(egui::Key::F);
+    h.run();
+    let comp = h.state().composition().unwrap().clone();
+    let (stroke, k) = comp
+        .strokes
+        .iter()
+        .zip(&comp.impact_samples)
+        .find(|(s, _)| s.beat == b)
+        .unwrap();
+    let impact = comp.tip(stroke.hand)[*k];
+    let rect = h.state().viewport_rect().unwrap();
+    let at = h.state().viewport_point(impact).unwrap();
+    assert!((at - rect.center()).length() < 2.0, "{at:?} in {rect:?}");
+    let close = h.state().camera().distance;
+    assert!(close < Camera::default().distance, "{close}");
+    h.key_press(egui::Key::Escape);
+    h.key_press(egui::Key::F);
+    h.run();
+    assert!(h.state().selection().beats.is_empty());
+    assert!(h.state().camera().distance > close);
+    let kit = h.state().loaded().unwrap().kit.clone();
+    for drum in &kit.drums {
+        let at = h.state().viewport_point(drum.centre()).unwrap();
+        assert!(
+            rect.contains(at),
+            "{} at {at:?} outside {rect:?}",
+            drum.name
+        );
+    }
 }

@@ -247,6 +247,16 @@ impl EditorApp {
         self.views.viewport.camera
     }
 
+    /// Whether the 3D camera follows the hand that strikes next (F9).
+    pub fn is_following_hand(&self) -> bool {
+        self.views.viewport.is_following()
+    }
+
+    /// Where the 3D view was drawn last frame.
+    pub fn viewport_rect(&self) -> Option<egui::Rect> {
+        self.views.viewport.rect
+    }
+
     /// Film the current rendering into the video `path` (File > Export video): the 3D
     /// view from the viewport's camera over the timeline, with the mix, through ffmpeg.
     pub fn export_video_to(&mut self, path: &Path) {

@@ -121,6 +121,7 @@ impl EditorApp {
                     self.views.timeline.fit();
                 }
                 if ui.button("Reset the 3D camera").clicked() {
+                    self.views.viewport.hold();
                     self.views.viewport.camera = Camera::default();
                 }
                 for shortcut in super::keys::SHORTCUTS {
@@ -130,6 +131,17 @@ impl EditorApp {
                             .clicked()
                     {
                         self.pending.push(Command::Do(shortcut.action));
+                    }
+                }
+                for (label, action) in [
+                    (
+                        "Camera: follow the hand that strikes next  (F9)",
+                        Action::FollowHand,
+                    ),
+                    ("Frame the selection  (F)", Action::FrameSelection),
+                ] {
+                    if ui.button(label).clicked() {
+                        self.pending.push(Command::Do(action));
                     }
                 }
                 ui.checkbox(&mut self.views.timeline.snap, "Snap to grid");

@@ -30,6 +30,10 @@ pub enum Action {
     ClearSelection,
     /// Move the 3D camera to a named view.
     CameraView(View),
+    /// Make the 3D camera follow the stick tip of the hand that strikes next.
+    FollowHand,
+    /// Move the 3D camera so the selected beats' impacts (or the kit) fill the view.
+    FrameSelection,
     /// Change the playback speed this many steps (positive: faster).
     Speed(i64),
     /// Pause and move the playhead this many video frames.
@@ -97,6 +101,20 @@ pub const SHORTCUTS: &[Shortcut] = &[
         Action::CameraView(View::Top),
         "F8",
         "3D view: from above",
+    ),
+    chord(
+        NONE,
+        Key::F9,
+        Action::FollowHand,
+        "F9",
+        "3D view: follow the hand that strikes next",
+    ),
+    chord(
+        NONE,
+        Key::F,
+        Action::FrameSelection,
+        "F",
+        "3D view: frame the selected beats' impacts (or the kit)",
     ),
     chord(
         NONE,

@@ -15,7 +15,7 @@ use crate::drum::DrumSet;
 use crate::kit::Side;
 use crate::mocap::db::side_index;
 use crate::motion::compose::Composition;
-use crate::scene::camera::{Camera, MOVE_S, Projector, View};
+use crate::scene::camera::{Camera, MOVE_S, Projector, View, follow_step, next_hand};
 use crate::scene::marks::{Anchor, HAND_COLOURS, Mark, Rgba};
 use crate::scene::stage;
 use crate::score::edit::ScoreEdit;
@@ -82,6 +82,8 @@ pub struct Viewport {
     pub camera: Camera,
     /// A move to a named view in progress: from, to, and when it started (egui time, s).
     moving: Option<(Camera, Camera, f64)>,
+    /// Following the hand that strikes next: the egui time of the last step, s.
+    following: Option<f64>,
     /// Show the composed trajectories only this far either side of the playhead, s,
     /// fading toward the ends (`None`: all of them).
     pub trajectory_window_s: Option<f64>,
@@ -130,7 +132,54 @@ fn sample_of(comp: &Composition, t: f64) -> usize {
 impl Viewport {
     /// Move the camera to `view` over [`MOVE_S`], starting at egui time `now_s`.
     pub fn go_to(&mut self, view: View, now_s: f64) {
-        self.moving = Some((self.camera, Camera::of_view(view), now_s));
+        self.move_to(Camera::of_view(view), now_s);
+    }
+
+    /// Move the camera to `to` over [`MOVE_S`], starting at egui time `now_s` (and stop
+    /// following the hand).
+    pub fn move_to(&mut self, to: Camera, now_s: f64) {
+        self.following = None;
+        self.moving = Some((self.camera, to, now_s));
+    }
+
+    /// Follow the stick tip of the hand that strikes next, from egui time `now_s`: the
+    /// target glides after it (orbit and zoom still work; a pan or a move stops it).
+    pub fn follow_hand(&mut self, now_s: f64) {
+        self.moving = None;
+        self.following = Some(now_s);
+    }
+
+    /// Whether the camera follows the hand that strikes next.
+    pub fn is_following(&self) -> bool {
+        self.following.is_some()
+    }
+
+    /// Stop every camera move and following (the camera is set outright).
+    pub fn hold(&mut self) {
+        self.moving = None;
+        self.following = None;
+    }
+
+    /// Step the followed target toward the next hand's tip at `time_s` in `comp`, at egui
+    /// time `now_s`; whether it is still catching up.
+    fn follow(&mut self, comp: &Composition, time_s: f64, now_s: f64) -> bool {
+        let Some(last) = self.following else {
+            return false;
+        };
+        self.following = Some(now_s);
+        let hand = next_hand(comp.strokes.iter().map(|s| (s.time_s, s.hand)), time_s);
+        let (Some(hand), Some(tips)) = (hand, super::pose::tips_at(comp, time_s)) else {
+            return false;
+        };
+        let goal = tips[side_index(hand)];
+        self.camera.target = follow_step(self.camera.target, goal, now_s - last);
+        self.camera.target.distance(goal) > 1e-4
+    }
+
+    /// The size of last frame's viewport, px.
+    pub fn size(&self) -> Option<DVec2> {
+        self.rect
+            .map(|r| DVec2::new(f64::from(r.width()), f64::from(r.height())))
     }
 
     /// Advance a move in progress to egui time `now_s`; whether it is still moving.
@@ -167,7 +216,11 @@ impl Viewport {
         out: &mut Vec<Command>,
     ) {
         self.rect = Some(rect);
-        if self.animate(ui.input(|i| i.time)) {
+        let now = ui.input(|i| i.time);
+        let following = input
+            .composition
+            .is_some_and(|comp| self.follow(comp, input.time_s, now));
+        if self.animate(now) || following {
             ui.ctx().request_repaint();
         }
         let resp = ui.interact(
@@ -229,7 +282,14 @@ impl Viewport {
         painter.text(
             rect.left_bottom() + Vec2::new(6.0, -4.0),
             egui::Align2::LEFT_BOTTOM,
-            format!("Handles: {mode}. Left drag: orbit, Shift: pan, wheel: zoom"),
+            format!(
+                "{}Handles: {mode}. Left drag: orbit, Shift: pan, wheel: zoom",
+                if self.following.is_some() {
+                    "Following the hand that strikes next (a pan or F5–F8 stops). "
+                } else {
+                    ""
+                }
+            ),
             egui::FontId::proportional(11.0),
             Color32::from_gray(170),
         );
@@ -427,7 +487,7 @@ impl Viewport {
                     self.camera.orbit(d);
                 }
                 Some(Drag::Pan) => {
-                    self.moving = None;
+                    self.hold();
                     self.camera.pan(d, size.y);
                 }
                 Some(Drag::Handle {
@@ -536,9 +596,7 @@ impl Viewport {
         out: &mut Vec<Command>,
         map: &crate::score::TempoMap,
     ) -> Option<Drag> {
-        let size = self
-            .rect
-            .map(|r| DVec2::new(f64::from(r.width()), f64::from(r.height())))?;
+        let size = self.size()?;
         let proj = self.camera.projector(size);
         let score = &input.doc.score;
         if let Some(i) = pick_handle(comp, input, &proj, p, map) {
