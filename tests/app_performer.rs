@@ -185,3 +185,32 @@ fn frame_the_selection() {
         );
     }
 }
+
+/// Saving writes the 3D camera into the score (`view: (camera: …)`) without the camera
+/// alone marking the score changed; opening the saved score brings the camera back.
+#[test]
+fn camera_is_saved_with_the_score() {
+    use timpanist::app::Camera;
+    use timpanist::scene::camera::View;
+    use timpanist::score::LoadedScore;
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(dir.path());
+    h.key_press(egui::Key::F6);
+    h.run();
+    let front = Camera::of_view(View::Front);
+    assert_eq!(h.state().camera(), front);
+    assert!(!h.state().is_dirty(), "moving the camera is not an edit");
+    let path = dir.path().join("saved.ron");
+    h.state_mut().save_to(&path);
+    h.state_mut().wait_for_files();
+    let saved = LoadedScore::load(&path).unwrap().score;
+    let camera = saved.view.unwrap().camera.unwrap();
+    assert!((f64::from(camera.yaw_rad) - front.yaw).abs() < 1e-6);
+    assert!((f64::from(camera.distance_m) - front.distance).abs() < 1e-6);
+    let mut reopened = common::editor(Some(path), dir.path(), false);
+    common::settle(&mut reopened);
+    let back = reopened.state().camera();
+    assert!(back.target.distance(front.target) < 1e-6, "{back:?}");
+    assert!((back.pitch - front.pitch).abs() < 1e-6 && (back.yaw - front.yaw).abs() < 1e-6);
+    assert!((back.distance - front.distance).abs() < 1e-6);
+}

@@ -15,11 +15,13 @@ use crate::drum::DrumSet;
 use crate::kit::Side;
 use crate::mocap::db::side_index;
 use crate::motion::compose::Composition;
-use crate::scene::camera::{Camera, MOVE_S, Projector, View, follow_step, next_hand};
+use crate::scene::camera::{
+    Camera, DISTANCE_RANGE_M, MAX_PITCH_RAD, MOVE_S, Projector, View, follow_step, next_hand,
+};
 use crate::scene::marks::{Anchor, HAND_COLOURS, Mark, Rgba};
 use crate::scene::stage;
 use crate::score::edit::ScoreEdit;
-use crate::score::{Handle, ImpactPin, LoadedScore};
+use crate::score::{Handle, ImpactPin, LoadedScore, SavedCamera};
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::{DVec2, DVec3};
 
@@ -109,6 +111,32 @@ fn camera_key(c: &Camera) -> [u64; 8] {
         c.fov_y.to_bits(),
         0,
     ]
+}
+
+/// `camera` as saved with the score (its field of view is the editor's own).
+pub fn saved_camera(camera: &Camera) -> SavedCamera {
+    SavedCamera {
+        target_m: camera.target.as_vec3().to_array(),
+        yaw_rad: camera.yaw as f32,
+        pitch_rad: camera.pitch as f32,
+        distance_m: camera.distance as f32,
+    }
+}
+
+/// A camera saved with a score, as the viewport's (pitch and distance held within what
+/// orbit and zoom allow); `None` for numbers no camera can have.
+pub fn camera_of_saved(saved: &SavedCamera) -> Option<Camera> {
+    if !saved.is_usable() {
+        return None;
+    }
+    let (near, far) = (*DISTANCE_RANGE_M.start(), *DISTANCE_RANGE_M.end());
+    Some(Camera {
+        target: DVec3::from_array(saved.target_m.map(f64::from)),
+        yaw: f64::from(saved.yaw_rad),
+        pitch: f64::from(saved.pitch_rad).clamp(-MAX_PITCH_RAD, MAX_PITCH_RAD),
+        distance: f64::from(saved.distance_m).clamp(near, far),
+        ..Camera::default()
+    })
 }
 
 /// Longest trajectory window the View menu offers, s.

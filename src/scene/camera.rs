@@ -34,6 +34,12 @@ pub struct Basis {
     pub up: DVec3,
 }
 
+/// The steepest the camera looks down (or up), rad.
+pub const MAX_PITCH_RAD: f64 = 1.45;
+
+/// The nearest and farthest the camera orbits its target, m.
+pub const DISTANCE_RANGE_M: std::ops::RangeInclusive<f64> = 0.3..=30.0;
+
 /// Points closer to the eye than this are not drawn, m.
 pub const NEAR_M: f64 = 0.05;
 
@@ -98,7 +104,7 @@ impl Camera {
     /// Orbit by a pointer movement of `delta` pixels.
     pub fn orbit(&mut self, delta: DVec2) {
         self.yaw -= 0.008 * delta.x;
-        self.pitch = (self.pitch + 0.008 * delta.y).clamp(-1.45, 1.45);
+        self.pitch = (self.pitch + 0.008 * delta.y).clamp(-MAX_PITCH_RAD, MAX_PITCH_RAD);
     }
 
     /// Move the target with the pointer by `delta` pixels in a viewport `height` high, so
@@ -111,7 +117,8 @@ impl Camera {
 
     /// Zoom by `factor` (> 1 moves away).
     pub fn zoom(&mut self, factor: f64) {
-        self.distance = (self.distance * factor).clamp(0.3, 30.0);
+        self.distance =
+            (self.distance * factor).clamp(*DISTANCE_RANGE_M.start(), *DISTANCE_RANGE_M.end());
     }
 }
 
