@@ -214,3 +214,39 @@ fn camera_is_saved_with_the_score() {
     assert!((back.pitch - front.pitch).abs() < 1e-6 && (back.yaw - front.yaw).abs() < 1e-6);
     assert!((back.distance - front.distance).abs() < 1e-6);
 }
+
+/// View > Trajectories coloured by speed shows the speed ramp's legend, by phase the four
+/// phases' names, plain the hands' names again.
+#[test]
+fn trajectories_coloured_by_speed_or_phase() {
+    use timpanist::scene::trail::TrailColour;
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(dir.path());
+    assert_eq!(h.state().trajectory_colour(), TrailColour::Plain);
+    h.get_by_label("left target");
+    assert!(h.query_by_label("tip speed, m/s").is_none());
+    let choose = |h: &mut Harness<'static, EditorApp>, item: &str| {
+        h.get_by_label("View").click();
+        h.run();
+        h.get_by_label(item).click();
+        common::settle(h);
+        // Close the menu if the choice left it open.
+        if h.query_by_label(item).is_some() {
+            h.key_press(egui::Key::Escape);
+            common::settle(h);
+        }
+    };
+    choose(&mut h, "Trajectories coloured by speed");
+    assert_eq!(h.state().trajectory_colour(), TrailColour::Speed);
+    h.get_by_label("tip speed, m/s");
+    assert!(h.query_by_label("left target").is_none());
+    choose(&mut h, "Trajectories coloured by phase");
+    assert_eq!(h.state().trajectory_colour(), TrailColour::Phase);
+    for phase in ["preparation", "downstroke", "contact", "rebound"] {
+        h.get_by_label(phase);
+    }
+    assert!(h.query_by_label("tip speed, m/s").is_none());
+    choose(&mut h, "Trajectories coloured plain (by hand)");
+    assert_eq!(h.state().trajectory_colour(), TrailColour::Plain);
+    h.get_by_label("right target");
+}

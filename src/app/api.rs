@@ -242,6 +242,11 @@ impl EditorApp {
             window_s.map(|w| w.clamp(0.25, viewport::MAX_WINDOW_S));
     }
 
+    /// What the composed trajectories' colour shows (View > Trajectories coloured …).
+    pub fn trajectory_colour(&self) -> crate::scene::trail::TrailColour {
+        self.views.viewport.trail_colour
+    }
+
     /// The 3D view's camera as it is now.
     pub fn camera(&self) -> Camera {
         self.views.viewport.camera

@@ -158,6 +158,13 @@ impl EditorApp {
                         egui::Slider::new(w, 0.25..=viewport::MAX_WINDOW_S).text("s either side"),
                     );
                 }
+                for colour in crate::scene::trail::TrailColour::ALL {
+                    ui.radio_value(
+                        &mut viewport.trail_colour,
+                        colour,
+                        format!("Trajectories coloured {}", colour.name()),
+                    );
+                }
             });
             ui.menu_button("Help", |ui| {
                 if ui.button("Keyboard and mouse  (F1)").clicked() {

@@ -20,6 +20,7 @@ use crate::scene::camera::{
 };
 use crate::scene::marks::{Anchor, HAND_COLOURS, Mark, Rgba};
 use crate::scene::stage;
+use crate::scene::trail::{self, StrokePhase, TrailColour, level_colour, speed_level, speed_scale};
 use crate::score::edit::ScoreEdit;
 use crate::score::{Handle, ImpactPin, LoadedScore, SavedCamera};
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Shape, Stroke, Vec2};
@@ -73,6 +74,35 @@ enum Drag {
     },
 }
 
+/// Per-sample speeds and phases of one composition, [left, right].
+struct TrailCache {
+    generation: u64,
+    speeds: [Vec<f64>; 2],
+    phases: [Vec<StrokePhase>; 2],
+    /// The top of the speed ramp, m/s.
+    scale: f64,
+}
+
+impl TrailCache {
+    fn of(comp: &Composition, generation: u64) -> TrailCache {
+        let speeds = [0, 1].map(|h| trail::speeds(&comp.tips[h], comp.rate_hz));
+        let phases = [0, 1].map(|h| {
+            let impacts: Vec<usize> = (comp.strokes.iter().zip(&comp.impact_samples))
+                .filter(|(s, _)| side_index(s.hand) == h)
+                .map(|(_, &k)| k)
+                .collect();
+            trail::phases(&comp.tips[h], comp.rate_hz, &impacts)
+        });
+        let scale = speed_scale(&[speed_scale(&speeds[0]), speed_scale(&speeds[1])]);
+        TrailCache {
+            generation,
+            speeds,
+            phases,
+            scale,
+        }
+    }
+}
+
 struct Projected {
     key: (u64, [u64; 8], [u32; 2]),
     tips: [Vec<Option<DVec2>>; 2],
@@ -89,6 +119,10 @@ pub struct Viewport {
     /// Show the composed trajectories only this far either side of the playhead, s,
     /// fading toward the ends (`None`: all of them).
     pub trajectory_window_s: Option<f64>,
+    /// What the composed trajectories' colour shows.
+    pub trail_colour: TrailColour,
+    /// The composition's tip speeds and stroke phases, for colouring.
+    trail: Option<TrailCache>,
     body: BodyModel,
     drag: Option<Drag>,
     cache: Option<Projected>,
@@ -287,6 +321,10 @@ impl Viewport {
         paint_marks(&painter, rect, &marks);
         if let Some(comp) = input.composition {
             self.update_cache(comp, input.generation, size, &proj);
+            let stale = (self.trail.as_ref()).is_none_or(|t| t.generation != input.generation);
+            if self.trail_colour != TrailColour::Plain && stale {
+                self.trail = Some(TrailCache::of(comp, input.generation));
+            }
             self.draw_trajectories(&painter, rect, &proj, comp, input);
         }
         if let Some(sim) = input.simulated {
@@ -321,14 +359,51 @@ impl Viewport {
             egui::FontId::proportional(11.0),
             Color32::from_gray(170),
         );
-        for (h, name) in [(0, "left target"), (1, "right target")] {
-            painter.text(
-                rect.right_top() + Vec2::new(-8.0, 8.0 + 14.0 * h as f32),
-                egui::Align2::RIGHT_TOP,
-                name,
-                egui::FontId::proportional(11.0),
-                TARGET_COLOURS[h],
-            );
+        self.legend(ui, rect);
+    }
+
+    /// What the trajectories' colours mean, in the view's top right corner.
+    fn legend(&self, ui: &mut egui::Ui, rect: Rect) {
+        let area = Rect::from_min_size(
+            rect.right_top() + Vec2::new(-128.0, 6.0),
+            Vec2::new(120.0, 90.0),
+        );
+        let label = |ui: &mut egui::Ui, text: &str, colour: Color32| {
+            let text = egui::RichText::new(text).size(11.0).color(colour);
+            ui.add(egui::Label::new(text).selectable(false));
+        };
+        // A child of its own: it takes no room from the panels below the view.
+        let ui = &mut ui.new_child(egui::UiBuilder::new().max_rect(area));
+        ui.spacing_mut().item_spacing.y = 1.0;
+        let scale = self.trail.as_ref().map(|t| t.scale);
+        match (self.trail_colour, scale) {
+            (TrailColour::Speed, Some(scale)) => {
+                label(ui, "tip speed, m/s", Color32::from_gray(200));
+                let (bar, _) = ui.allocate_exact_size(Vec2::new(area.width(), 8.0), Sense::hover());
+                let step = bar.width() / trail::SPEED_LEVELS as f32;
+                for l in 0..trail::SPEED_LEVELS {
+                    let x = bar.left() + step * l as f32;
+                    let cell = Rect::from_x_y_ranges(x..=x + step, bar.y_range());
+                    ui.painter()
+                        .rect_filled(cell, 0.0, colour32(level_colour(l)));
+                }
+                ui.horizontal(|ui| {
+                    label(ui, "0", Color32::from_gray(200));
+                    ui.with_layout(egui::Layout::right_to_left(egui::Align::Min), |ui| {
+                        label(ui, &format!("{scale:.0}"), Color32::from_gray(200));
+                    });
+                });
+            }
+            (TrailColour::Phase, Some(_)) => {
+                for phase in StrokePhase::ALL {
+                    label(ui, phase.name(), colour32(phase.colour()));
+                }
+            }
+            _ => {
+                for (h, name) in [(0, "left target"), (1, "right target")] {
+                    label(ui, name, TARGET_COLOURS[h]);
+                }
+            }
         }
     }
 
@@ -374,24 +449,21 @@ impl Viewport {
             }
             None => 1.0,
         };
+        let trail = self
+            .trail
+            .as_ref()
+            .filter(|t| t.generation == input.generation);
         for (h, tips) in cache.tips.iter().enumerate() {
-            let mut start = shown.start;
-            while start + 1 < shown.end {
-                let end = (start + piece).min(shown.end - 1);
-                let stroke = Stroke::new(1.5, TARGET_COLOURS[h].gamma_multiply(fade(start) as f32));
-                let mut run: Vec<Pos2> = Vec::new();
-                for q in &tips[start..=end] {
-                    match q {
-                        Some(q) => run.push(to_pos(rect, *q)),
-                        None if !run.is_empty() => {
-                            painter.add(Shape::line(std::mem::take(&mut run), stroke));
-                        }
-                        None => {}
-                    }
+            let base = |k: usize| match (self.trail_colour, trail) {
+                (TrailColour::Speed, Some(t)) => {
+                    colour32(level_colour(speed_level(t.speeds[h][k], t.scale)))
                 }
-                painter.add(Shape::line(run, stroke));
-                start = end;
-            }
+                (TrailColour::Phase, Some(t)) => colour32(t.phases[h][k].colour()),
+                _ => TARGET_COLOURS[h],
+            };
+            let block = |k: usize| shown.start + (k - shown.start) / piece * piece;
+            let colour = |k: usize| base(k).gamma_multiply(fade(block(k)) as f32);
+            draw_polyline(painter, rect, tips, shown.clone(), colour);
         }
         let score = &input.doc.score;
         for (stroke, &k) in comp.strokes.iter().zip(&comp.impact_samples) {
@@ -683,6 +755,41 @@ impl Viewport {
             current: handle,
         })
     }
+}
+
+/// Draw samples `shown` of the projected `tips` (`None`: not projected, a gap) as
+/// lines 1.5 px wide, in runs of one `colour` each (a run starts at the last point of the
+/// one before, so the line stays unbroken where the colour changes).
+fn draw_polyline(
+    painter: &egui::Painter,
+    rect: Rect,
+    tips: &[Option<DVec2>],
+    shown: std::ops::Range<usize>,
+    colour: impl Fn(usize) -> Color32,
+) {
+    let flush = |run: &mut Vec<Pos2>, c: Color32| {
+        if run.len() > 1 {
+            painter.add(Shape::line(std::mem::take(run), Stroke::new(1.5, c)));
+        }
+        run.clear();
+    };
+    let mut run: Vec<Pos2> = Vec::new();
+    let mut run_colour = Color32::TRANSPARENT;
+    for k in shown {
+        let Some(q) = tips.get(k).copied().flatten() else {
+            flush(&mut run, run_colour);
+            continue;
+        };
+        let c = colour(k);
+        if c != run_colour {
+            let last = run.last().copied();
+            flush(&mut run, run_colour);
+            run.extend(last);
+            run_colour = c;
+        }
+        run.push(to_pos(rect, q));
+    }
+    flush(&mut run, run_colour);
 }
 
 /// The handle whose marker is within 9 px of `p` (of several, the nearest in time to
