@@ -196,6 +196,7 @@ impl EditorApp {
             ui.separator();
             let speed = self.transport.playback.speed();
             egui::ComboBox::from_label("Speed")
+                .width(64.0)
                 .selected_text(super::actions::speed_label(speed))
                 .show_ui(ui, |ui| {
                     for s in super::playback::SPEEDS {
