@@ -258,12 +258,16 @@ fn save_and_reopen() {
     let mut h = harness(Some(demo()), dir.path());
     let at = common::steady_timeline_point(&mut h, 960 * 3, Hand::Right);
     common::click(&mut h, at);
-    let edited = h.state().loaded().unwrap().score.clone();
+    let beats = h.state().loaded().unwrap().score.beats.clone();
     let target = dir.path().join("saved.ron");
     h.state_mut().save_to(&target);
     h.state_mut().wait_for_files();
     assert!(h.state().error().is_none(), "{:?}", h.state().error());
     assert!(!h.state().is_dirty());
+    // What was saved: the edited beats, and the 3D camera with them.
+    let edited = h.state().loaded().unwrap().score.clone();
+    assert_eq!(edited.beats, beats);
+    assert!(edited.view.is_some());
     let again = harness(Some(target.clone()), dir.path());
     assert_eq!(again.state().loaded().unwrap().score, edited);
     assert_eq!(again.state().recent_files()[0], target);

@@ -242,9 +242,24 @@ impl EditorApp {
             window_s.map(|w| w.clamp(0.25, viewport::MAX_WINDOW_S));
     }
 
+    /// What the composed trajectories' colour shows (View > Trajectories coloured …).
+    pub fn trajectory_colour(&self) -> crate::scene::trail::TrailColour {
+        self.views.viewport.trail_colour
+    }
+
     /// The 3D view's camera as it is now.
     pub fn camera(&self) -> Camera {
         self.views.viewport.camera
+    }
+
+    /// Whether the 3D camera follows the hand that strikes next (F9).
+    pub fn is_following_hand(&self) -> bool {
+        self.views.viewport.is_following()
+    }
+
+    /// Where the 3D view was drawn last frame.
+    pub fn viewport_rect(&self) -> Option<egui::Rect> {
+        self.views.viewport.rect
     }
 
     /// Film the current rendering into the video `path` (File > Export video): the 3D

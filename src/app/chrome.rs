@@ -121,6 +121,7 @@ impl EditorApp {
                     self.views.timeline.fit();
                 }
                 if ui.button("Reset the 3D camera").clicked() {
+                    self.views.viewport.hold();
                     self.views.viewport.camera = Camera::default();
                 }
                 for shortcut in super::keys::SHORTCUTS {
@@ -130,6 +131,17 @@ impl EditorApp {
                             .clicked()
                     {
                         self.pending.push(Command::Do(shortcut.action));
+                    }
+                }
+                for (label, action) in [
+                    (
+                        "Camera: follow the hand that strikes next  (F9)",
+                        Action::FollowHand,
+                    ),
+                    ("Frame the selection  (F)", Action::FrameSelection),
+                ] {
+                    if ui.button(label).clicked() {
+                        self.pending.push(Command::Do(action));
                     }
                 }
                 ui.checkbox(&mut self.views.timeline.snap, "Snap to grid");
@@ -144,6 +156,13 @@ impl EditorApp {
                 if let Some(w) = &mut viewport.trajectory_window_s {
                     ui.add(
                         egui::Slider::new(w, 0.25..=viewport::MAX_WINDOW_S).text("s either side"),
+                    );
+                }
+                for colour in crate::scene::trail::TrailColour::ALL {
+                    ui.radio_value(
+                        &mut viewport.trail_colour,
+                        colour,
+                        format!("Trajectories coloured {}", colour.name()),
                     );
                 }
             });
@@ -175,6 +194,23 @@ impl EditorApp {
                 position.unwrap_or_default()
             ));
             ui.separator();
+            let speed = self.transport.playback.speed();
+            egui::ComboBox::from_label("Speed")
+                .width(64.0)
+                .selected_text(super::actions::speed_label(speed))
+                .show_ui(ui, |ui| {
+                    for s in super::playback::SPEEDS {
+                        if ui
+                            .selectable_label(s == speed, super::actions::speed_label(s))
+                            .clicked()
+                        {
+                            self.transport.playback.set_speed(s);
+                        }
+                    }
+                })
+                .response
+                .on_hover_text("[ slower, ] faster; below 1 the audio is muted");
+            ui.separator();
             ui.add_enabled(
                 self.transport.loop_ticks.is_some(),
                 egui::Checkbox::new(&mut self.transport.looping, "Loop"),
@@ -202,6 +238,13 @@ impl EditorApp {
         ui.horizontal(|ui| {
             if let Some(n) = self.transport.playback.notice() {
                 ui.colored_label(ui.visuals().warn_fg_color, n);
+                ui.separator();
+            }
+            if !self.transport.playback.is_real_time() {
+                ui.colored_label(
+                    ui.visuals().warn_fg_color,
+                    super::playback::SLOW_MOTION_NOTICE,
+                );
                 ui.separator();
             }
             if self.pipeline.is_composing() {

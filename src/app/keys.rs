@@ -30,6 +30,16 @@ pub enum Action {
     ClearSelection,
     /// Move the 3D camera to a named view.
     CameraView(View),
+    /// Make the 3D camera follow the stick tip of the hand that strikes next.
+    FollowHand,
+    /// Move the 3D camera so the selected beats' impacts (or the kit) fill the view.
+    FrameSelection,
+    /// Change the playback speed this many steps (positive: faster).
+    Speed(i64),
+    /// Pause and move the playhead this many video frames.
+    StepFrames(i64),
+    /// Pause and move the playhead to the next (true) or previous contact.
+    StepContact(bool),
 }
 
 /// A key chord and what it does; `label` is how the help overlay shows it.
@@ -60,6 +70,7 @@ const fn chord(
 const CMD: Modifiers = Modifiers::COMMAND;
 const CMD_SHIFT: Modifiers = Modifiers::COMMAND.plus(Modifiers::SHIFT);
 const NONE: Modifiers = Modifiers::NONE;
+const SHIFT: Modifiers = Modifiers::SHIFT;
 
 /// Every shortcut. More specific chords (with Shift) come before their plain forms.
 pub const SHORTCUTS: &[Shortcut] = &[
@@ -93,6 +104,48 @@ pub const SHORTCUTS: &[Shortcut] = &[
     ),
     chord(
         NONE,
+        Key::F9,
+        Action::FollowHand,
+        "F9",
+        "3D view: follow the hand that strikes next",
+    ),
+    chord(
+        NONE,
+        Key::F,
+        Action::FrameSelection,
+        "F",
+        "3D view: frame the selected beats' impacts (or the kit)",
+    ),
+    chord(
+        NONE,
+        Key::OpenBracket,
+        Action::Speed(-1),
+        "[",
+        "slower playback (1, 1/2, 1/4, 1/10; audio muted below 1)",
+    ),
+    chord(
+        NONE,
+        Key::CloseBracket,
+        Action::Speed(1),
+        "]",
+        "faster playback",
+    ),
+    chord(
+        SHIFT,
+        Key::Comma,
+        Action::StepContact(false),
+        "Shift+,",
+        "pause, playhead to the previous contact",
+    ),
+    chord(
+        SHIFT,
+        Key::Period,
+        Action::StepContact(true),
+        "Shift+.",
+        "pause, playhead to the next contact",
+    ),
+    chord(
+        NONE,
         Key::Space,
         Action::PlayPause,
         "Space",
@@ -106,6 +159,20 @@ pub const SHORTCUTS: &[Shortcut] = &[
         Action::TogglePreferences,
         "Ctrl+,",
         "preferences",
+    ),
+    chord(
+        NONE,
+        Key::Comma,
+        Action::StepFrames(-1),
+        ",",
+        "pause, playhead back one video frame (1/60 s)",
+    ),
+    chord(
+        NONE,
+        Key::Period,
+        Action::StepFrames(1),
+        ".",
+        "pause, playhead on one video frame (1/60 s)",
     ),
     chord(CMD_SHIFT, Key::S, Action::SaveAs, "Ctrl+Shift+S", "save as"),
     chord(CMD, Key::S, Action::Save, "Ctrl+S", "save"),

@@ -7,6 +7,10 @@
 //! With a device, one [tape](super::tape) sound is played for the whole session and
 //! controlled through its handle: new audio is swapped in under the playhead without
 //! restarting (a 5 ms crossfade), and play, pause and seek ramp over 5 ms.
+//!
+//! Slow motion ([`Playback::set_speed`] below 1): the clock runs on the wall clock
+//! scaled by the speed and the tape stays paused — the mix cannot be heard slowed down
+//! in sync, so it is muted (and [`SLOW_MOTION_NOTICE`] says so).
 
 use super::tape::{StereoSource, TapeData, TapeHandle};
 use kira::backend::cpal::CpalBackendSettings;
@@ -21,6 +25,12 @@ pub const AUDIO_RATE_HZ: u32 = super::tape::SOURCE_RATE_HZ;
 
 /// The notice shown when there is no sound device.
 pub const SILENT_NOTICE: &str = "No sound device: silent playback";
+
+/// The notice shown while playing slower than real time.
+pub const SLOW_MOTION_NOTICE: &str = "slow motion: audio muted";
+
+/// The playback speeds offered, fastest first (1 = real time).
+pub const SPEEDS: [f64; 4] = [1.0, 0.5, 0.25, 0.1];
 
 /// Errors of the playback module.
 #[derive(Debug, thiserror::Error)]
@@ -42,6 +52,8 @@ pub struct Playback {
     anchor_s: f64,
     /// When the clock last started; `None` when paused.
     started: Option<Instant>,
+    /// Score seconds per wall-clock second (1: real time, with sound).
+    speed: f64,
 }
 
 impl Playback {
@@ -87,6 +99,7 @@ impl Playback {
             has_audio: false,
             anchor_s: 0.0,
             started: None,
+            speed: 1.0,
         }
     }
 
@@ -121,12 +134,38 @@ impl Playback {
         Ok(())
     }
 
-    /// Start playing at `t_s` seconds.
+    /// Start playing at `t_s` seconds (the tape only at real time).
     pub fn play_from(&mut self, t_s: f64) {
         self.anchor_s = t_s.max(0.0);
         self.started = Some(Instant::now());
+        let real_time = self.is_real_time();
         if let Some(tape) = &mut self.tape {
-            tape.play_from(self.anchor_s);
+            if real_time {
+                tape.play_from(self.anchor_s);
+            } else {
+                tape.pause();
+                tape.seek(self.anchor_s);
+            }
+        }
+    }
+
+    /// Score seconds per wall-clock second.
+    pub fn speed(&self) -> f64 {
+        self.speed
+    }
+
+    /// Whether the clock runs at real time (and the audio is heard).
+    pub fn is_real_time(&self) -> bool {
+        self.speed == 1.0
+    }
+
+    /// Play at `speed` (clamped to 0.01–1) from where the clock is now, playing or
+    /// paused; below 1 the audio is muted.
+    pub fn set_speed(&mut self, speed: f64) {
+        let at = self.position_s();
+        self.speed = speed.clamp(0.01, 1.0);
+        if self.is_playing() {
+            self.play_from(at);
         }
     }
 
@@ -156,12 +195,12 @@ impl Playback {
         self.started.is_some()
     }
 
-    /// The current position, s: the tape's while it plays on a device, else the wall
-    /// clock's.
+    /// The current position, s: the tape's while it plays on a device at real time,
+    /// else the wall clock's times the speed.
     pub fn position_s(&self) -> f64 {
         match (self.started, &self.tape) {
-            (Some(_), Some(tape)) => tape.position_s(),
-            (Some(t0), None) => self.anchor_s + t0.elapsed().as_secs_f64(),
+            (Some(_), Some(tape)) if self.is_real_time() => tape.position_s(),
+            (Some(t0), _) => self.anchor_s + t0.elapsed().as_secs_f64() * self.speed,
             (None, _) => self.anchor_s,
         }
     }
@@ -226,6 +265,24 @@ mod tests {
         p.seek(1.0);
         assert_eq!(p.position_s(), 1.0);
         assert!(!p.is_playing());
+    }
+
+    /// At a quarter speed the clock runs a quarter as fast, and changing the speed while
+    /// playing keeps the position.
+    #[test]
+    fn slow_motion_clock() {
+        let mut p = Playback::silent();
+        p.set_speed(0.25);
+        p.play_from(1.0);
+        std::thread::sleep(Duration::from_millis(200));
+        let t = p.position_s();
+        assert!((1.04..1.1).contains(&t), "{t}");
+        p.set_speed(1.0);
+        let after = p.position_s();
+        assert!(after >= t && after < t + 0.02, "{t} then {after}");
+        assert!(p.is_real_time());
+        p.set_speed(0.0);
+        assert_eq!(p.speed(), 0.01);
     }
 
     /// Opening the default device never fails: with no sound card (as on the build

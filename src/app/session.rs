@@ -9,9 +9,9 @@ use super::export::{self, Export};
 use super::files::{self, FileKind, kind_of};
 use super::jobs::{Done, Finished};
 use super::renderer::Rendered;
-use super::{AfterConfirm, DEMO_SCORE_PATH, EditorApp};
+use super::{AfterConfirm, DEMO_SCORE_PATH, EditorApp, viewport};
 use crate::kit::Kit;
-use crate::score::{LoadedScore, Score};
+use crate::score::{LoadedScore, Score, ViewSettings};
 use eframe::egui;
 use std::path::{Path, PathBuf};
 
@@ -32,6 +32,13 @@ impl EditorApp {
     }
 
     fn set_document(&mut self, loaded: LoadedScore, path: Option<PathBuf>) {
+        let saved = (loaded.score.view.as_ref())
+            .and_then(|v| v.camera.as_ref())
+            .and_then(viewport::camera_of_saved);
+        if let Some(camera) = saved {
+            self.views.viewport.hold();
+            self.views.viewport.camera = camera;
+        }
         self.doc = Some(Document::new(loaded, path));
         self.recovery.restart();
         self.transport.reset();
@@ -130,9 +137,15 @@ impl EditorApp {
     }
 
     /// Save the score to `path` (Save As without a dialog) on a background job; the
-    /// outcome goes to the status bar, or the error to the window.
+    /// outcome goes to the status bar, or the error to the window. The 3D camera is saved
+    /// with the score (`view`).
     pub fn save_to(&mut self, path: &Path) {
-        let Some(doc) = &self.doc else { return };
+        let camera = viewport::saved_camera(&self.views.viewport.camera);
+        let Some(doc) = &mut self.doc else { return };
+        // The camera is saved as it is, not as an edit (no undo step, nothing unsaved).
+        doc.loaded.score.view = Some(ViewSettings {
+            camera: Some(camera),
+        });
         let text = doc.loaded.score.to_ron();
         let target = path.to_path_buf();
         let done = Done::Saved {

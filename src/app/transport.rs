@@ -1,8 +1,10 @@
 //! The transport: the playhead, the loop region and the playback clock it follows, and
 //! Space's rule — play at once if the audio past the playhead is rendered, else wait for
-//! it (the rendering worker delivers the edited part first, then the rest).
+//! it (the rendering worker delivers the edited part first, then the rest). Also slow
+//! motion (the speeds of [`SPEEDS`], audio muted below 1) and stepping the playhead by a
+//! video frame ([`FRAME_S`]) or to the previous or next contact.
 
-use super::playback::{Playback, PlaybackError};
+use super::playback::{Playback, PlaybackError, SPEEDS};
 use super::tape::StereoSource;
 use crate::render::Rendering;
 use crate::score::Score;
@@ -10,6 +12,9 @@ use std::sync::Arc;
 
 /// Space plays at once only if this much audio past the playhead is ready, s.
 const PLAY_AHEAD_S: f64 = 0.3;
+
+/// One video frame, the step of `,` and `.`, s (60 frames per second).
+pub const FRAME_S: f64 = 1.0 / 60.0;
 
 /// Where playback is and what it plays.
 pub struct Transport {
@@ -64,8 +69,7 @@ impl Transport {
     /// message for the status bar, if any.
     pub fn play_pause(&mut self) -> Option<String> {
         if self.playback.is_playing() {
-            self.playback.pause();
-            self.playhead_s = self.playback.position_s();
+            self.pause();
             None
         } else if self.waiting_to_play {
             self.waiting_to_play = false;
@@ -100,6 +104,53 @@ impl Transport {
         Ok(())
     }
 
+    /// Move `steps` places along [`SPEEDS`] (positive: faster), keeping the playhead;
+    /// the new speed.
+    pub fn change_speed(&mut self, steps: i64) -> f64 {
+        let now = SPEEDS
+            .iter()
+            .position(|s| *s <= self.playback.speed())
+            .unwrap_or(SPEEDS.len() - 1) as i64;
+        let to = (now - steps).clamp(0, SPEEDS.len() as i64 - 1) as usize;
+        self.playback.set_speed(SPEEDS[to]);
+        SPEEDS[to]
+    }
+
+    /// Pause and move the playhead `frames` video frames (of [`FRAME_S`]) from the
+    /// frame nearest it.
+    pub fn step_frames(&mut self, frames: i64) {
+        self.pause();
+        let frame = (self.playhead_s / FRAME_S).round() + frames as f64;
+        self.seek(frame * FRAME_S);
+    }
+
+    /// Pause and move the playhead to the first of `contacts_s` (times, s) after it
+    /// (`forward`) or the last before it; false, staying put, when there is none.
+    pub fn step_to_contact(
+        &mut self,
+        contacts_s: impl IntoIterator<Item = f64>,
+        forward: bool,
+    ) -> bool {
+        self.pause();
+        let here = self.playhead_s;
+        let times = contacts_s.into_iter();
+        let found = if forward {
+            times.filter(|t| *t > here + 1e-6).min_by(f64::total_cmp)
+        } else {
+            times.filter(|t| *t < here - 1e-6).max_by(f64::total_cmp)
+        };
+        found.inspect(|t| self.seek(*t)).is_some()
+    }
+
+    /// Stop at the current position (and stop waiting to play).
+    fn pause(&mut self) {
+        if self.playback.is_playing() {
+            self.playback.pause();
+            self.playhead_s = self.playback.position_s();
+        }
+        self.waiting_to_play = false;
+    }
+
     /// Whether Space waits for audio not yet rendered.
     pub fn is_waiting_to_play(&self) -> bool {
         self.waiting_to_play
@@ -125,5 +176,40 @@ impl Transport {
             self.playback.pause();
         }
         Some(map.tick_at(self.playhead_s))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `[` and `]` walk the speeds and stop at the ends; frame steps land on the 60 Hz
+    /// grid; contact steps find the neighbours and stay put past the last.
+    #[test]
+    fn speeds_and_steps() {
+        let mut t = Transport::new(Playback::silent());
+        assert_eq!(t.change_speed(-1), 0.5);
+        assert_eq!(t.change_speed(-5), 0.1);
+        assert_eq!(t.change_speed(1), 0.25);
+        assert_eq!(t.change_speed(9), 1.0);
+        t.seek(0.101);
+        t.step_frames(1);
+        assert!(
+            (t.playhead_s - 7.0 / 60.0).abs() < 1e-12,
+            "{}",
+            t.playhead_s
+        );
+        t.step_frames(-2);
+        assert!((t.playhead_s - 5.0 / 60.0).abs() < 1e-12);
+        let contacts = [0.5, 1.0, 1.5];
+        assert!(t.step_to_contact(contacts, true));
+        assert_eq!(t.playhead_s, 0.5);
+        assert!(t.step_to_contact(contacts, true));
+        assert_eq!(t.playhead_s, 1.0);
+        assert!(t.step_to_contact(contacts, false));
+        assert_eq!(t.playhead_s, 0.5);
+        assert!(!t.step_to_contact(contacts, false));
+        assert_eq!(t.playhead_s, 0.5);
+        assert_eq!(t.playback.position_s(), 0.5);
     }
 }

@@ -15,11 +15,14 @@ use crate::drum::DrumSet;
 use crate::kit::Side;
 use crate::mocap::db::side_index;
 use crate::motion::compose::Composition;
-use crate::scene::camera::{Camera, MOVE_S, Projector, View};
+use crate::scene::camera::{
+    Camera, DISTANCE_RANGE_M, MAX_PITCH_RAD, MOVE_S, Projector, View, follow_step, next_hand,
+};
 use crate::scene::marks::{Anchor, HAND_COLOURS, Mark, Rgba};
 use crate::scene::stage;
+use crate::scene::trail::{self, StrokePhase, TrailColour, level_colour, speed_level, speed_scale};
 use crate::score::edit::ScoreEdit;
-use crate::score::{Handle, ImpactPin, LoadedScore};
+use crate::score::{Handle, ImpactPin, LoadedScore, SavedCamera};
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::{DVec2, DVec3};
 
@@ -71,6 +74,35 @@ enum Drag {
     },
 }
 
+/// Per-sample speeds and phases of one composition, [left, right].
+struct TrailCache {
+    generation: u64,
+    speeds: [Vec<f64>; 2],
+    phases: [Vec<StrokePhase>; 2],
+    /// The top of the speed ramp, m/s.
+    scale: f64,
+}
+
+impl TrailCache {
+    fn of(comp: &Composition, generation: u64) -> TrailCache {
+        let speeds = [0, 1].map(|h| trail::speeds(&comp.tips[h], comp.rate_hz));
+        let phases = [0, 1].map(|h| {
+            let impacts: Vec<usize> = (comp.strokes.iter().zip(&comp.impact_samples))
+                .filter(|(s, _)| side_index(s.hand) == h)
+                .map(|(_, &k)| k)
+                .collect();
+            trail::phases(&comp.tips[h], comp.rate_hz, &impacts)
+        });
+        let scale = speed_scale(&[speed_scale(&speeds[0]), speed_scale(&speeds[1])]);
+        TrailCache {
+            generation,
+            speeds,
+            phases,
+            scale,
+        }
+    }
+}
+
 struct Projected {
     key: (u64, [u64; 8], [u32; 2]),
     tips: [Vec<Option<DVec2>>; 2],
@@ -82,9 +114,15 @@ pub struct Viewport {
     pub camera: Camera,
     /// A move to a named view in progress: from, to, and when it started (egui time, s).
     moving: Option<(Camera, Camera, f64)>,
+    /// Following the hand that strikes next: the egui time of the last step, s.
+    following: Option<f64>,
     /// Show the composed trajectories only this far either side of the playhead, s,
     /// fading toward the ends (`None`: all of them).
     pub trajectory_window_s: Option<f64>,
+    /// What the composed trajectories' colour shows.
+    pub trail_colour: TrailColour,
+    /// The composition's tip speeds and stroke phases, for colouring.
+    trail: Option<TrailCache>,
     body: BodyModel,
     drag: Option<Drag>,
     cache: Option<Projected>,
@@ -109,6 +147,32 @@ fn camera_key(c: &Camera) -> [u64; 8] {
     ]
 }
 
+/// `camera` as saved with the score (its field of view is the editor's own).
+pub fn saved_camera(camera: &Camera) -> SavedCamera {
+    SavedCamera {
+        target_m: camera.target.as_vec3().to_array(),
+        yaw_rad: camera.yaw as f32,
+        pitch_rad: camera.pitch as f32,
+        distance_m: camera.distance as f32,
+    }
+}
+
+/// A camera saved with a score, as the viewport's (pitch and distance held within what
+/// orbit and zoom allow); `None` for numbers no camera can have.
+pub fn camera_of_saved(saved: &SavedCamera) -> Option<Camera> {
+    if !saved.is_usable() {
+        return None;
+    }
+    let (near, far) = (*DISTANCE_RANGE_M.start(), *DISTANCE_RANGE_M.end());
+    Some(Camera {
+        target: DVec3::from_array(saved.target_m.map(f64::from)),
+        yaw: f64::from(saved.yaw_rad),
+        pitch: f64::from(saved.pitch_rad).clamp(-MAX_PITCH_RAD, MAX_PITCH_RAD),
+        distance: f64::from(saved.distance_m).clamp(near, far),
+        ..Camera::default()
+    })
+}
+
 /// Longest trajectory window the View menu offers, s.
 pub const MAX_WINDOW_S: f64 = 8.0;
 
@@ -130,7 +194,54 @@ fn sample_of(comp: &Composition, t: f64) -> usize {
 impl Viewport {
     /// Move the camera to `view` over [`MOVE_S`], starting at egui time `now_s`.
     pub fn go_to(&mut self, view: View, now_s: f64) {
-        self.moving = Some((self.camera, Camera::of_view(view), now_s));
+        self.move_to(Camera::of_view(view), now_s);
+    }
+
+    /// Move the camera to `to` over [`MOVE_S`], starting at egui time `now_s` (and stop
+    /// following the hand).
+    pub fn move_to(&mut self, to: Camera, now_s: f64) {
+        self.following = None;
+        self.moving = Some((self.camera, to, now_s));
+    }
+
+    /// Follow the stick tip of the hand that strikes next, from egui time `now_s`: the
+    /// target glides after it (orbit and zoom still work; a pan or a move stops it).
+    pub fn follow_hand(&mut self, now_s: f64) {
+        self.moving = None;
+        self.following = Some(now_s);
+    }
+
+    /// Whether the camera follows the hand that strikes next.
+    pub fn is_following(&self) -> bool {
+        self.following.is_some()
+    }
+
+    /// Stop every camera move and following (the camera is set outright).
+    pub fn hold(&mut self) {
+        self.moving = None;
+        self.following = None;
+    }
+
+    /// Step the followed target toward the next hand's tip at `time_s` in `comp`, at egui
+    /// time `now_s`; whether it is still catching up.
+    fn follow(&mut self, comp: &Composition, time_s: f64, now_s: f64) -> bool {
+        let Some(last) = self.following else {
+            return false;
+        };
+        self.following = Some(now_s);
+        let hand = next_hand(comp.strokes.iter().map(|s| (s.time_s, s.hand)), time_s);
+        let (Some(hand), Some(tips)) = (hand, super::pose::tips_at(comp, time_s)) else {
+            return false;
+        };
+        let goal = tips[side_index(hand)];
+        self.camera.target = follow_step(self.camera.target, goal, now_s - last);
+        self.camera.target.distance(goal) > 1e-4
+    }
+
+    /// The size of last frame's viewport, px.
+    pub fn size(&self) -> Option<DVec2> {
+        self.rect
+            .map(|r| DVec2::new(f64::from(r.width()), f64::from(r.height())))
     }
 
     /// Advance a move in progress to egui time `now_s`; whether it is still moving.
@@ -167,7 +278,11 @@ impl Viewport {
         out: &mut Vec<Command>,
     ) {
         self.rect = Some(rect);
-        if self.animate(ui.input(|i| i.time)) {
+        let now = ui.input(|i| i.time);
+        let following = input
+            .composition
+            .is_some_and(|comp| self.follow(comp, input.time_s, now));
+        if self.animate(now) || following {
             ui.ctx().request_repaint();
         }
         let resp = ui.interact(
@@ -206,6 +321,10 @@ impl Viewport {
         paint_marks(&painter, rect, &marks);
         if let Some(comp) = input.composition {
             self.update_cache(comp, input.generation, size, &proj);
+            let stale = (self.trail.as_ref()).is_none_or(|t| t.generation != input.generation);
+            if self.trail_colour != TrailColour::Plain && stale {
+                self.trail = Some(TrailCache::of(comp, input.generation));
+            }
             self.draw_trajectories(&painter, rect, &proj, comp, input);
         }
         if let Some(sim) = input.simulated {
@@ -229,18 +348,62 @@ impl Viewport {
         painter.text(
             rect.left_bottom() + Vec2::new(6.0, -4.0),
             egui::Align2::LEFT_BOTTOM,
-            format!("Handles: {mode}. Left drag: orbit, Shift: pan, wheel: zoom"),
+            format!(
+                "{}Handles: {mode}. Left drag: orbit, Shift: pan, wheel: zoom",
+                if self.following.is_some() {
+                    "Following the hand that strikes next (a pan or F5–F8 stops). "
+                } else {
+                    ""
+                }
+            ),
             egui::FontId::proportional(11.0),
             Color32::from_gray(170),
         );
-        for (h, name) in [(0, "left target"), (1, "right target")] {
-            painter.text(
-                rect.right_top() + Vec2::new(-8.0, 8.0 + 14.0 * h as f32),
-                egui::Align2::RIGHT_TOP,
-                name,
-                egui::FontId::proportional(11.0),
-                TARGET_COLOURS[h],
-            );
+        self.legend(ui, rect);
+    }
+
+    /// What the trajectories' colours mean, in the view's top right corner.
+    fn legend(&self, ui: &mut egui::Ui, rect: Rect) {
+        let area = Rect::from_min_size(
+            rect.right_top() + Vec2::new(-128.0, 6.0),
+            Vec2::new(120.0, 90.0),
+        );
+        let label = |ui: &mut egui::Ui, text: &str, colour: Color32| {
+            let text = egui::RichText::new(text).size(11.0).color(colour);
+            ui.add(egui::Label::new(text).selectable(false));
+        };
+        // A child of its own: it takes no room from the panels below the view.
+        let ui = &mut ui.new_child(egui::UiBuilder::new().max_rect(area));
+        ui.spacing_mut().item_spacing.y = 1.0;
+        let scale = self.trail.as_ref().map(|t| t.scale);
+        match (self.trail_colour, scale) {
+            (TrailColour::Speed, Some(scale)) => {
+                label(ui, "tip speed, m/s", Color32::from_gray(200));
+                let (bar, _) = ui.allocate_exact_size(Vec2::new(area.width(), 8.0), Sense::hover());
+                let step = bar.width() / trail::SPEED_LEVELS as f32;
+                for l in 0..trail::SPEED_LEVELS {
+                    let x = bar.left() + step * l as f32;
+                    let cell = Rect::from_x_y_ranges(x..=x + step, bar.y_range());
+                    ui.painter()
+                        .rect_filled(cell, 0.0, colour32(level_colour(l)));
+                }
+                ui.horizontal(|ui| {
+                    label(ui, "0", Color32::from_gray(200));
+                    ui.with_layout(egui::Layout::right_to_left(egui::Align::Min), |ui| {
+                        label(ui, &format!("{scale:.0}"), Color32::from_gray(200));
+                    });
+                });
+            }
+            (TrailColour::Phase, Some(_)) => {
+                for phase in StrokePhase::ALL {
+                    label(ui, phase.name(), colour32(phase.colour()));
+                }
+            }
+            _ => {
+                for (h, name) in [(0, "left target"), (1, "right target")] {
+                    label(ui, name, TARGET_COLOURS[h]);
+                }
+            }
         }
     }
 
@@ -286,24 +449,21 @@ impl Viewport {
             }
             None => 1.0,
         };
+        let trail = self
+            .trail
+            .as_ref()
+            .filter(|t| t.generation == input.generation);
         for (h, tips) in cache.tips.iter().enumerate() {
-            let mut start = shown.start;
-            while start + 1 < shown.end {
-                let end = (start + piece).min(shown.end - 1);
-                let stroke = Stroke::new(1.5, TARGET_COLOURS[h].gamma_multiply(fade(start) as f32));
-                let mut run: Vec<Pos2> = Vec::new();
-                for q in &tips[start..=end] {
-                    match q {
-                        Some(q) => run.push(to_pos(rect, *q)),
-                        None if !run.is_empty() => {
-                            painter.add(Shape::line(std::mem::take(&mut run), stroke));
-                        }
-                        None => {}
-                    }
+            let base = |k: usize| match (self.trail_colour, trail) {
+                (TrailColour::Speed, Some(t)) => {
+                    colour32(level_colour(speed_level(t.speeds[h][k], t.scale)))
                 }
-                painter.add(Shape::line(run, stroke));
-                start = end;
-            }
+                (TrailColour::Phase, Some(t)) => colour32(t.phases[h][k].colour()),
+                _ => TARGET_COLOURS[h],
+            };
+            let block = |k: usize| shown.start + (k - shown.start) / piece * piece;
+            let colour = |k: usize| base(k).gamma_multiply(fade(block(k)) as f32);
+            draw_polyline(painter, rect, tips, shown.clone(), colour);
         }
         let score = &input.doc.score;
         for (stroke, &k) in comp.strokes.iter().zip(&comp.impact_samples) {
@@ -427,7 +587,7 @@ impl Viewport {
                     self.camera.orbit(d);
                 }
                 Some(Drag::Pan) => {
-                    self.moving = None;
+                    self.hold();
                     self.camera.pan(d, size.y);
                 }
                 Some(Drag::Handle {
@@ -536,9 +696,7 @@ impl Viewport {
         out: &mut Vec<Command>,
         map: &crate::score::TempoMap,
     ) -> Option<Drag> {
-        let size = self
-            .rect
-            .map(|r| DVec2::new(f64::from(r.width()), f64::from(r.height())))?;
+        let size = self.size()?;
         let proj = self.camera.projector(size);
         let score = &input.doc.score;
         if let Some(i) = pick_handle(comp, input, &proj, p, map) {
@@ -597,6 +755,41 @@ impl Viewport {
             current: handle,
         })
     }
+}
+
+/// Draw samples `shown` of the projected `tips` (`None`: not projected, a gap) as
+/// lines 1.5 px wide, in runs of one `colour` each (a run starts at the last point of the
+/// one before, so the line stays unbroken where the colour changes).
+fn draw_polyline(
+    painter: &egui::Painter,
+    rect: Rect,
+    tips: &[Option<DVec2>],
+    shown: std::ops::Range<usize>,
+    colour: impl Fn(usize) -> Color32,
+) {
+    let flush = |run: &mut Vec<Pos2>, c: Color32| {
+        if run.len() > 1 {
+            painter.add(Shape::line(std::mem::take(run), Stroke::new(1.5, c)));
+        }
+        run.clear();
+    };
+    let mut run: Vec<Pos2> = Vec::new();
+    let mut run_colour = Color32::TRANSPARENT;
+    for k in shown {
+        let Some(q) = tips.get(k).copied().flatten() else {
+            flush(&mut run, run_colour);
+            continue;
+        };
+        let c = colour(k);
+        if c != run_colour {
+            let last = run.last().copied();
+            flush(&mut run, run_colour);
+            run.extend(last);
+            run_colour = c;
+        }
+        run.push(to_pos(rect, q));
+    }
+    flush(&mut run, run_colour);
 }
 
 /// The handle whose marker is within 9 px of `p` (of several, the nearest in time to

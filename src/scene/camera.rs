@@ -1,7 +1,11 @@
 //! The 3D viewport's orbit camera: a pinhole camera looking at a target point from a
 //! yaw/pitch/distance orbit (performer frame, z up), with projection of points to the
-//! viewport's pixels and the inverse (a pixel's viewing ray) — pure math, no egui.
+//! viewport's pixels and the inverse (a pixel's viewing ray), named views and eased moves
+//! between cameras, framing a set of points, and following the hand that strikes next
+//! (the hand, and a first-order lag that keeps the target from jerking) — pure math, no
+//! egui.
 
+use crate::kit::Side;
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
@@ -29,6 +33,12 @@ pub struct Basis {
     pub right: DVec3,
     pub up: DVec3,
 }
+
+/// The steepest the camera looks down (or up), rad.
+pub const MAX_PITCH_RAD: f64 = 1.45;
+
+/// The nearest and farthest the camera orbits its target, m.
+pub const DISTANCE_RANGE_M: std::ops::RangeInclusive<f64> = 0.3..=30.0;
 
 /// Points closer to the eye than this are not drawn, m.
 pub const NEAR_M: f64 = 0.05;
@@ -94,7 +104,7 @@ impl Camera {
     /// Orbit by a pointer movement of `delta` pixels.
     pub fn orbit(&mut self, delta: DVec2) {
         self.yaw -= 0.008 * delta.x;
-        self.pitch = (self.pitch + 0.008 * delta.y).clamp(-1.45, 1.45);
+        self.pitch = (self.pitch + 0.008 * delta.y).clamp(-MAX_PITCH_RAD, MAX_PITCH_RAD);
     }
 
     /// Move the target with the pointer by `delta` pixels in a viewport `height` high, so
@@ -107,7 +117,8 @@ impl Camera {
 
     /// Zoom by `factor` (> 1 moves away).
     pub fn zoom(&mut self, factor: f64) {
-        self.distance = (self.distance * factor).clamp(0.3, 30.0);
+        self.distance =
+            (self.distance * factor).clamp(*DISTANCE_RANGE_M.start(), *DISTANCE_RANGE_M.end());
     }
 }
 
@@ -178,6 +189,67 @@ impl Camera {
             fov_y: mix(self.fov_y, to.fov_y),
         }
     }
+}
+
+/// Framing leaves this much room around the points (1: the points' sphere touches the
+/// edges).
+const FRAME_MARGIN: f64 = 1.2;
+
+/// The smallest radius framed, m (a single point is shown with some room around it).
+const MIN_FRAME_RADIUS_M: f64 = 0.12;
+
+impl Camera {
+    /// This camera moved, looking the same way, so the sphere around `points` fills a
+    /// view `aspect` (width / height) wide: the target at the centre of their bounds, the
+    /// distance so the sphere fits the narrower field of view with a margin. `None`
+    /// without points.
+    pub fn framing(&self, points: &[DVec3], aspect: f64) -> Option<Camera> {
+        let first = *points.first()?;
+        let (lo, hi) = points
+            .iter()
+            .fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        let centre = 0.5 * (lo + hi);
+        let radius = points
+            .iter()
+            .map(|p| p.distance(centre))
+            .fold(MIN_FRAME_RADIUS_M, f64::max);
+        let half_y = 0.5 * self.fov_y;
+        let half_x = (aspect.max(0.1) * half_y.tan()).atan();
+        let half = half_x.min(half_y);
+        let mut framed = Camera {
+            target: centre,
+            ..*self
+        };
+        framed.distance = 1.0;
+        framed.zoom(FRAME_MARGIN * radius / half.sin());
+        Some(framed)
+    }
+}
+
+/// Time constant of the followed target's lag behind the hand, s.
+pub const FOLLOW_LAG_S: f64 = 0.25;
+
+/// The hand whose next stroke (at or after `t_s`) comes soonest, of `strokes` (time, s,
+/// and hand); past the last stroke, the hand of the last. `None` without strokes.
+pub fn next_hand(strokes: impl IntoIterator<Item = (f64, Side)>, t_s: f64) -> Option<Side> {
+    let mut last: Option<(f64, Side)> = None;
+    let mut next: Option<(f64, Side)> = None;
+    for (t, hand) in strokes {
+        if t >= t_s && next.is_none_or(|(n, _)| t < n) {
+            next = Some((t, hand));
+        }
+        if last.is_none_or(|(l, _)| t > l) {
+            last = Some((t, hand));
+        }
+    }
+    next.or(last).map(|(_, hand)| hand)
+}
+
+/// `from` moved toward `to` over `dt_s` seconds by a first-order lag of time constant
+/// [`FOLLOW_LAG_S`] (never past it, however long the step).
+pub fn follow_step(from: DVec3, to: DVec3, dt_s: f64) -> DVec3 {
+    let k = 1.0 - (-dt_s.max(0.0) / FOLLOW_LAG_S).exp();
+    from.lerp(to, k)
 }
 
 /// Projection with a precomputed basis.
@@ -299,6 +371,50 @@ mod tests {
         cam.pan(DVec2::new(40.0, -25.0), SIZE.y);
         let (after, _) = cam.project(p, SIZE).unwrap();
         assert!((after - before - DVec2::new(40.0, -25.0)).length() < 1e-6);
+    }
+
+    /// Framing puts the points' centre at the view's centre and every point inside the
+    /// view, nearer for close points than for spread ones, keeping the direction.
+    #[test]
+    fn framing_fits_points() {
+        let cam = Camera::default();
+        assert!(cam.framing(&[], 1.5).is_none());
+        let near = [DVec3::new(0.1, 0.4, 0.8), DVec3::new(0.2, 0.45, 0.8)];
+        let wide = [DVec3::new(-0.6, 0.2, 0.8), DVec3::new(0.7, 0.9, 0.8)];
+        let narrow_view = DVec2::new(400.0, 600.0);
+        let (a, b) = (
+            cam.framing(&near, 1.0).unwrap(),
+            cam.framing(&wide, 400.0 / 600.0).unwrap(),
+        );
+        assert!(a.distance < b.distance);
+        assert_eq!((a.yaw, a.pitch), (cam.yaw, cam.pitch));
+        let (centre, _) = a.project(0.5 * (near[0] + near[1]), SIZE).unwrap();
+        assert!((centre - 0.5 * SIZE).length() < 1e-6);
+        for p in wide {
+            let (px, _) = b.project(p, narrow_view).unwrap();
+            assert!(
+                px.x > 0.0 && px.x < narrow_view.x && px.y > 0.0 && px.y < narrow_view.y,
+                "{px}"
+            );
+        }
+    }
+
+    /// The next hand is the one striking soonest from now (at the stroke itself too), the
+    /// last one's after the end; the follow lag approaches the goal without overshoot.
+    #[test]
+    fn following_the_next_hand() {
+        let strokes = [(1.0, Side::Right), (0.5, Side::Left), (1.5, Side::Left)];
+        assert_eq!(next_hand(strokes, 0.0), Some(Side::Left));
+        assert_eq!(next_hand(strokes, 0.7), Some(Side::Right));
+        assert_eq!(next_hand(strokes, 1.0), Some(Side::Right));
+        assert_eq!(next_hand(strokes, 1.2), Some(Side::Left));
+        assert_eq!(next_hand(strokes, 9.0), Some(Side::Left));
+        assert_eq!(next_hand([], 0.0), None);
+        let (from, to) = (DVec3::ZERO, DVec3::X);
+        let one = follow_step(from, to, FOLLOW_LAG_S);
+        assert!((one.x - (1.0 - (-1.0f64).exp())).abs() < 1e-12);
+        assert!(follow_step(from, to, 100.0).x <= 1.0);
+        assert_eq!(follow_step(from, to, -1.0), from);
     }
 
     /// Orbit keeps the distance to the target; zoom is clamped.

@@ -33,6 +33,7 @@ pub(super) fn from_v1(v1: ScoreV1) -> Score {
         handles: Vec::new(),
         pins: Vec::new(),
         settings: super::Settings::default(),
+        view: None,
     }
 }
 

@@ -1,6 +1,7 @@
 //! The gesture score: beats in exact musical time (integer ticks) under a tempo map and
 //! time signatures, each with hand, playing mode, dynamic, drum, pitch, impact location and
-//! an optional roll; read from and written to strict, versioned RON files (`scores/*.ron`).
+//! an optional roll; read from and written to strict, versioned RON files (`scores/*.ron`),
+//! with the editor's view of it (`view`: the 3D camera) when saved from the editor.
 
 pub mod demos;
 pub mod edit;
@@ -9,6 +10,7 @@ mod migrate;
 pub mod settings;
 pub mod tempo;
 pub mod validate;
+pub mod view;
 
 use crate::base::pitch::Pitch;
 use crate::base::ron_file::{self, FileError};
@@ -20,6 +22,7 @@ pub use crate::base::gesture::{Dynamic, Grip, Hand, ImpactLocation, PlayingMode}
 pub use meter::{BarBeat, MeterChange, MeterMap};
 pub use settings::Settings;
 pub use tempo::{TempoChange, TempoMap, TempoPoint};
+pub use view::{SavedCamera, ViewSettings};
 
 /// The score file format this timpanist writes and the newest it reads.
 pub const SCORE_FORMAT_VERSION: u32 = 2;
@@ -159,6 +162,9 @@ pub struct Score {
     /// How it is performed and heard (left out of the file when default).
     #[serde(default, skip_serializing_if = "Settings::is_default")]
     pub settings: Settings,
+    /// How the editor last showed it (its 3D camera), written by the editor's Save.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub view: Option<ViewSettings>,
 }
 
 /// A score together with its kit, as loaded from disk.
@@ -195,6 +201,7 @@ impl Score {
             handles: Vec::new(),
             pins: Vec::new(),
             settings: Settings::default(),
+            view: None,
         }
     }
 
