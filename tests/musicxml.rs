@@ -546,6 +546,69 @@ fn repeats_and_endings_expand() {
     }
 }
 
+/// Jumps are followed as music21 10.5's `expandRepeats` follows them (its notes for these
+/// two documents, checked with it): D.C. al Fine written as words only plays bars 1 2 3 4
+/// 1 2; a D.S. al Coda (sound attributes) after a repeat plays the repeat first, then goes
+/// to the segno without repeating, takes the To Coda to the coda: 1 2 3 4 2 3 4 2 3 5 6.
+/// Neither leaves a "not performed" notice for the jump marks.
+#[test]
+fn jumps_are_followed() {
+    let one = "<attributes><divisions>1</divisions><time><beats>1</beats><beat-type>4</beat-type></time></attributes>";
+    let words = |t: &str, sound: &str| {
+        format!("<direction><direction-type><words>{t}</words></direction-type>{sound}</direction>")
+    };
+    let q = |pitch: &str| note(pitch, 1, "");
+    let played = |xml: &str| -> Vec<Pitch> {
+        let (score, report) = run(xml);
+        let all = report.notices.join("\n");
+        assert!(
+            !all.contains("not performed") && !all.contains("not followed"),
+            "{all}"
+        );
+        let ticks: Vec<u64> = score.beats.iter().map(|b| b.tick).collect();
+        assert_eq!(
+            ticks,
+            (0..ticks.len() as u64).map(|k| k * 960).collect::<Vec<_>>()
+        );
+        timeline(&score).into_iter().map(|(_, p)| p).collect()
+    };
+    let dc = doc(&[
+        &format!("{one}{}", q("D3")),
+        &format!("{}{}", q("E3"), words("Fine", "")),
+        &q("F3"),
+        &format!("{}{}", q("G3"), words("D.C. al Fine", "")),
+    ]);
+    let want: Vec<Pitch> = ["D3", "E3", "F3", "G3", "D3", "E3"].map(p).to_vec();
+    assert_eq!(played(&dc), want);
+
+    let segno =
+        "<direction><direction-type><segno/></direction-type><sound segno=\"s\"/></direction>";
+    let coda = "<direction><direction-type><coda/></direction-type><sound coda=\"c\"/></direction>";
+    let ds = doc(&[
+        &format!("{one}{}", q("D3")),
+        &format!(
+            "{}{segno}{}",
+            barline("left", "<repeat direction=\"forward\"/>"),
+            q("E3")
+        ),
+        &format!("{}{}", q("F3"), words("To Coda", "<sound tocoda=\"c\"/>")),
+        &format!(
+            "{}{}{}",
+            q("G3"),
+            words("D.S. al Coda", "<sound dalsegno=\"s\"/>"),
+            barline("right", "<repeat direction=\"backward\"/>")
+        ),
+        &format!("{coda}{}", q("A2")),
+        &q("Bb2"),
+    ]);
+    let want: Vec<Pitch> = [
+        "D3", "E3", "F3", "G3", "E3", "F3", "G3", "E3", "F3", "A2", "Bb2",
+    ]
+    .map(p)
+    .to_vec();
+    assert_eq!(played(&ds), want);
+}
+
 /// A two-note tremolo alternates its two drums at the rate of its marks plus the notes'
 /// beams: two half notes (each written a whole, 2:1) with 3 marks fill a whole note with
 /// 32 thirty-seconds, D3 first; two quarters typed eighths with 2 marks, 1 beam are 32nds

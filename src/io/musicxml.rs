@@ -989,7 +989,12 @@ impl<'a, 'd> PartReader<'a, 'd> {
             .filter(|n| n.has_tag_name("measure"))
             .collect();
         let order = match repeats::performed_order(&written) {
-            Some(order) => order,
+            Some((order, notes)) => {
+                for note in notes {
+                    self.notices.push_text(note);
+                }
+                order
+            }
             None => {
                 self.notices.push_text(
                     "the repeats and endings do not resolve into an order of measures; the music is played once, as written".into(),
@@ -1604,19 +1609,14 @@ impl<'a, 'd> PartReader<'a, 'd> {
             }
             "words" => {
                 let text: String = t.text().unwrap_or("").trim().chars().take(40).collect();
-                if !text.is_empty() {
+                if !text.is_empty() && !repeats::is_jump_mark(&text) {
                     self.notices
                         .add(format!("text \"{text}\": not performed"), place);
                 }
             }
             "rehearsal" | "dashes" | "bracket" | "octave-shift" | "image" => {}
-            "segno" | "coda" => self.notices.add(
-                format!(
-                    "{}: not followed (jumps are not expanded)",
-                    t.tag_name().name()
-                ),
-                place,
-            ),
+            // Followed by `musicxml_repeats`.
+            "segno" | "coda" => {}
             other => self
                 .notices
                 .add(format!("direction <{other}>: not performed"), place),
@@ -1639,14 +1639,8 @@ impl<'a, 'd> PartReader<'a, 'd> {
                     .add(format!("<sound tempo=\"{tempo}\">: not a tempo"), &place),
             }
         }
-        for jump in ["dacapo", "dalsegno", "tocoda", "fine", "forward-repeat"] {
-            if s.attribute(jump).is_some() {
-                self.notices.add(
-                    format!("<sound {jump}>: not followed (jumps are not expanded)"),
-                    &place,
-                );
-            }
-        }
+        // Jumps (dacapo, dalsegno, tocoda, fine, segno, coda) are followed by
+        // `musicxml_repeats`; a forward repeat is read from the bar line.
     }
 
     fn barline(&mut self, b: Node, number: &str) {
@@ -1655,7 +1649,7 @@ impl<'a, 'd> PartReader<'a, 'd> {
             match c.tag_name().name() {
                 "segno" | "coda" => self.notices.add(
                     format!(
-                        "{}: not followed (jumps are not expanded)",
+                        "{} on a bar line: not followed (write it as a direction)",
                         c.tag_name().name()
                     ),
                     &place,

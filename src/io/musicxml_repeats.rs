@@ -4,8 +4,17 @@
 //! expanded, for [`super::musicxml`], as music21 and MuseScore do: a backward repeat
 //! returns to the forward repeat it closes, else to the start (so it encloses earlier
 //! repeats, which play all their passes again); one inside an ending jumps back until
-//! the highest ending number of its run of endings has been reached. Jumps (da capo, dal
-//! segno, coda, fine) are not followed here.
+//! the highest ending number of its run of endings has been reached.
+//!
+//! Then one jump, as music21's `expandRepeats` follows it: at the end of the last pass
+//! through a measure marked *da capo* or *dal segno* (`<sound dacapo="yes">`,
+//! `<sound dalsegno="x">`, or the words "D.C.", "Da capo", "D.S.", "Dal segno"), the
+//! music goes back to the start or to the measure with the segno (`<segno/>`,
+//! `<sound segno="x">`) and is played once more without repeats (each run of endings by its
+//! last ending), up to the end of a measure marked *fine* (`<sound fine>`, "Fine"), or
+//! from a measure marked *to coda* (`<sound tocoda="x">`, "To Coda") on to the coda
+//! (`<coda/>`, `<sound coda="x">`) and the end. Jump marks taken as measure-wide: a jump
+//! happens at the end of its measure, a segno or coda marks its start.
 
 use roxmltree::Node;
 
@@ -33,11 +42,154 @@ struct Ending {
     numbers: Vec<u32>,
 }
 
+/// The jump marks of one measure (labels as written, "" when unnamed).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+struct Jumps {
+    da_capo: bool,
+    dal_segno: Option<String>,
+    segno: Option<String>,
+    to_coda: Option<String>,
+    coda: Option<String>,
+    fine: bool,
+}
+
 /// The indices of `measures` in performed order, or `None` when the repeats never end
-/// (more than [`MAX_PASSES_PER_MEASURE`] passes per measure).
-pub(crate) fn performed_order(measures: &[Node]) -> Option<Vec<usize>> {
+/// (more than [`MAX_PASSES_PER_MEASURE`] passes per measure), with what about the jumps
+/// could not be followed.
+pub(crate) fn performed_order(measures: &[Node]) -> Option<(Vec<usize>, Vec<String>)> {
     let bars: Vec<Bars> = measures.iter().map(|m| bars_of(*m)).collect();
-    order(&bars)
+    let jumps: Vec<Jumps> = measures.iter().map(|m| jumps_of(*m)).collect();
+    let mut notes = Vec::new();
+    let order = jump(&bars, &jumps, order(&bars)?, &mut notes);
+    Some((order, notes))
+}
+
+fn jumps_of(measure: Node) -> Jumps {
+    let mut j = Jumps::default();
+    let label = |v: &str| v.trim().to_string();
+    for n in measure.descendants().filter(Node::is_element) {
+        match n.tag_name().name() {
+            "sound" => {
+                j.da_capo |= n.attribute("dacapo").is_some_and(|v| v.trim() == "yes");
+                j.fine |= n.attribute("fine").is_some();
+                for (attr, slot) in [
+                    ("dalsegno", &mut j.dal_segno),
+                    ("segno", &mut j.segno),
+                    ("tocoda", &mut j.to_coda),
+                    ("coda", &mut j.coda),
+                ] {
+                    if let Some(v) = n.attribute(attr) {
+                        *slot = Some(label(v));
+                    }
+                }
+            }
+            "segno" if n.parent().is_some_and(|p| p.has_tag_name("direction-type")) => {
+                j.segno.get_or_insert_with(String::new);
+            }
+            "coda" if n.parent().is_some_and(|p| p.has_tag_name("direction-type")) => {
+                j.coda.get_or_insert_with(String::new);
+            }
+            "words" => words(n.text().unwrap_or(""), &mut j),
+            _ => {}
+        }
+    }
+    j
+}
+
+/// Whether `text` is a jump mark this module follows ("D.C. al Fine", "Fine", …).
+pub(crate) fn is_jump_mark(text: &str) -> bool {
+    let mut j = Jumps::default();
+    words(text, &mut j);
+    j != Jumps::default()
+}
+
+/// Jump marks written as words ("D.C. al Fine", "D.S. al Coda", "Fine", "To Coda").
+fn words(text: &str, j: &mut Jumps) {
+    let t = text.trim().to_lowercase();
+    let compact: String = t.chars().filter(|c| !c.is_whitespace()).collect();
+    if compact.starts_with("d.c.") || t.starts_with("da capo") {
+        j.da_capo = true;
+    } else if compact.starts_with("d.s.") || t.starts_with("dal segno") {
+        j.dal_segno.get_or_insert_with(String::new);
+    } else if t == "fine" {
+        j.fine = true;
+    } else if t.starts_with("to coda") {
+        j.to_coda.get_or_insert_with(String::new);
+    }
+}
+
+/// `order` (the measures with their repeats) with the first da capo or dal segno
+/// followed (see the module's doc); what could not be followed goes into `notes`.
+fn jump(bars: &[Bars], jumps: &[Jumps], order: Vec<usize>, notes: &mut Vec<String>) -> Vec<usize> {
+    let Some(from) = jumps
+        .iter()
+        .position(|j| j.da_capo || j.dal_segno.is_some())
+    else {
+        return order;
+    };
+    let target = if jumps[from].da_capo {
+        Some(0)
+    } else {
+        let wanted = jumps[from].dal_segno.as_deref().unwrap_or("");
+        let segnos = || jumps.iter().enumerate().filter(|(_, j)| j.segno.is_some());
+        segnos()
+            .find(|(_, j)| j.segno.as_deref() == Some(wanted))
+            .or_else(|| segnos().next())
+            .map(|(i, _)| i)
+    };
+    let Some(target) = target else {
+        notes.push(format!(
+            "dal segno in measure {}: no segno to go back to; not followed",
+            from + 1
+        ));
+        return order;
+    };
+    if jumps
+        .iter()
+        .skip(from + 1)
+        .any(|j| j.da_capo || j.dal_segno.is_some())
+    {
+        notes.push("a second da capo or dal segno: only the first is followed".into());
+    }
+    // Up to the last pass through the jump's measure.
+    let Some(last) = order.iter().rposition(|&i| i == from) else {
+        return order;
+    };
+    let mut out = order[..=last].to_vec();
+    let endings = endings(bars);
+    let mut i = target;
+    let mut coda_taken = false;
+    while i < bars.len() {
+        if let Some(e) = ending_at(&endings, i).filter(|&e| endings[e].first == i)
+            && !endings[e].numbers.contains(&highest_pass(&endings, e))
+        {
+            i = endings[e].last + 1;
+            continue;
+        }
+        out.push(i);
+        if jumps[i].fine {
+            return out;
+        }
+        if let (Some(wanted), false) = (&jumps[i].to_coda, coda_taken) {
+            let codas = || (i + 1..bars.len()).filter(|&c| jumps[c].coda.is_some());
+            match codas()
+                .find(|&c| jumps[c].coda.as_ref() == Some(wanted))
+                .or_else(|| codas().next())
+            {
+                Some(c) => {
+                    coda_taken = true;
+                    i = c;
+                    continue;
+                }
+                None => notes.push(format!(
+                    "to coda in measure {}: no coda after it; not followed",
+                    i + 1
+                )),
+            }
+        }
+        i += 1;
+    }
+    out
 }
 
 fn bars_of(measure: Node) -> Bars {
@@ -230,18 +382,23 @@ mod tests {
         assert_eq!(order(&b), Some(vec![0, 1, 1, 2, 0, 1, 1, 2, 3]));
     }
 
-    /// 0 [1: 1 :|] [2: 2] 3 plays 0 1 0 2 3; a run of endings 1 … 3 with repeats in
-    /// the first two plays each in turn; a repeat after the endings, without a forward
-    /// sign, returns to the start and the endings play again from the first.
-    #[test]
-    fn endings() {
-        let b = bars(4, |b| {
+    /// 0 [1: 1 :|] [2: 2] 3.
+    fn first_and_second_ending() -> Vec<Bars> {
+        bars(4, |b| {
             b[1].ending_start = Some(vec![1]);
             b[1].ending_stop = true;
             b[1].backward = Some(None);
             b[2].ending_start = Some(vec![2]);
             b[2].ending_stop = true;
-        });
+        })
+    }
+
+    /// 0 [1: 1 :|] [2: 2] 3 plays 0 1 0 2 3; a run of endings 1 … 3 with repeats in
+    /// the first two plays each in turn; a repeat after the endings, without a forward
+    /// sign, returns to the start and the endings play again from the first.
+    #[test]
+    fn endings() {
+        let b = first_and_second_ending();
         assert_eq!(order(&b), Some(vec![0, 1, 0, 2, 3]));
         let b = bars(5, |b| {
             for (i, n) in [(1, 1), (2, 2), (3, 3)] {
@@ -266,5 +423,43 @@ mod tests {
     fn runaway_repeat() {
         let b = bars(1, |b| b[0].backward = Some(Some(1000)));
         assert_eq!(order(&b), None);
+    }
+
+    /// A dal segno with no segno, or a to coda with no coda after it, is reported and not
+    /// followed; a D.C. with neither fine nor coda plays everything once more, its ending
+    /// run by its last ending; words are recognised as jump marks.
+    #[test]
+    fn jumps_without_their_marks() {
+        let plain = bars(3, |_| {});
+        let mut notes = Vec::new();
+        let mut jumps = vec![Jumps::default(); 3];
+        jumps[2].dal_segno = Some(String::new());
+        assert_eq!(
+            jump(&plain, &jumps, vec![0, 1, 2], &mut notes),
+            vec![0, 1, 2]
+        );
+        assert!(notes[0].contains("no segno"), "{notes:?}");
+        let mut notes = Vec::new();
+        let mut jumps = vec![Jumps::default(); 3];
+        jumps[1].da_capo = true;
+        jumps[0].to_coda = Some("x".into());
+        assert_eq!(
+            jump(&plain, &jumps, vec![0, 1, 2], &mut notes),
+            vec![0, 1, 0, 1, 2]
+        );
+        assert!(notes[0].contains("no coda"), "{notes:?}");
+        // 0 [1: 1 :|] [2: 2] 3(D.C.): after the jump only the second ending plays.
+        let b = first_and_second_ending();
+        let mut jumps = vec![Jumps::default(); 4];
+        jumps[3].da_capo = true;
+        let mut notes = Vec::new();
+        let order = order(&b).unwrap();
+        assert_eq!(
+            jump(&b, &jumps, order, &mut notes),
+            vec![0, 1, 0, 2, 3, 0, 2, 3]
+        );
+        assert!(notes.is_empty());
+        assert!(is_jump_mark("D. C. al Fine") && is_jump_mark("Dal Segno") && is_jump_mark("Fine"));
+        assert!(!is_jump_mark("dolce") && !is_jump_mark("finely"));
     }
 }
