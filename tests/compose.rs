@@ -257,3 +257,48 @@ fn above_the_heads_and_in_reach() {
         }
     }
 }
+
+/// Scores the editor still composes while they have problems — beats pasted over beats
+/// (two strokes of one hand at once, three strokes at once) and beats a few ticks apart —
+/// compose to finite trajectories (a NaN tip once reached the plots after a paste).
+#[test]
+fn scores_with_problems_compose_to_finite_tips() {
+    let db = db();
+    let base = LoadedScore::load(&root().join("scores/minute-study.ron")).unwrap();
+    type Edit = fn(&mut Vec<timpanist::score::Beat>);
+    let variants: [(&str, Edit); 3] = [
+        ("pasted over itself", |beats| {
+            let copy = beats.clone();
+            beats.extend(copy);
+        }),
+        ("pasted a tick later", |beats| {
+            let copy: Vec<_> = beats
+                .iter()
+                .map(|b| timpanist::score::Beat {
+                    tick: b.tick + 1,
+                    ..*b
+                })
+                .collect();
+            beats.extend(copy);
+        }),
+        ("pasted three times over itself", |beats| {
+            let copy = beats.clone();
+            beats.extend(copy.clone());
+            beats.extend(copy);
+        }),
+    ];
+    for (name, edit) in variants {
+        let mut s = base.clone();
+        edit(&mut s.score.beats);
+        s.score.beats.sort_by_key(|b| b.tick);
+        let comp = compose(&s, &db);
+        for h in [Side::Left, Side::Right] {
+            let bad = comp.tip(h).iter().position(|p| !p.is_finite());
+            assert!(
+                bad.is_none(),
+                "{name}: {h:?} tip not finite at {:.3} s",
+                comp.time(bad.unwrap())
+            );
+        }
+    }
+}

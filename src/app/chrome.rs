@@ -387,6 +387,10 @@ impl EditorApp {
                 )
             })
         });
+        let ghosts = match (comp, self.views.simulated.as_ref()) {
+            (Some(c), Some(sim)) => super::pose::ghosts(c, sim, &doc.selection.beats),
+            _ => Vec::new(),
+        };
         self.views.viewport.show(
             ui,
             rect,
@@ -395,6 +399,7 @@ impl EditorApp {
                 composition: comp,
                 generation: self.pipeline.generation(),
                 pose: pose.as_ref(),
+                ghosts: &ghosts,
                 simulated: self.views.simulated.as_ref().map(|s| &s.motion().tips),
                 drums: (self.views.simulated.as_ref())
                     .and_then(|s| s.rendering())

@@ -70,6 +70,24 @@ impl Simulated {
     }
 }
 
+/// The most ghost poses shown at once.
+pub const MAX_GHOSTS: usize = 12;
+
+/// The simulated poses at the impacts of the `selected` beats (each beat's first stroke;
+/// at most [`MAX_GHOSTS`], the earliest), for the 3D view to show faintly.
+pub fn ghosts(
+    comp: &Composition,
+    simulated: &Simulated,
+    selected: &std::collections::BTreeSet<usize>,
+) -> Vec<Pose> {
+    selected
+        .iter()
+        .filter_map(|&b| comp.strokes.iter().find(|s| s.beat == b))
+        .take(MAX_GHOSTS)
+        .filter_map(|s| simulated.pose_at(s.time_s).copied())
+        .collect()
+}
+
 /// A playing posture: upper arms forward, elbows bent, sticks pointing forward and down.
 pub fn ready_pose() -> Pose {
     let mut p = REST;
@@ -183,5 +201,51 @@ mod tests {
             assert!(tip.y > 0.3, "{tip}");
             assert!(tip.z < f.position[Joint::arm(side)[0].index()].z);
         }
+    }
+
+    /// Ghosts are the simulated poses at the selected beats' first strokes, in beat
+    /// order; unselected beats and beats without strokes have none.
+    #[test]
+    fn ghosts_at_the_selected_impacts() {
+        let poses: Vec<Pose> = (0..20)
+            .map(|k| {
+                let mut p = REST;
+                p[0] = DQuat::from_rotation_z(0.01 * k as f64);
+                p
+            })
+            .collect();
+        let sim = Simulated::of_motion(
+            0.0,
+            Motion {
+                rate_hz: 10.0,
+                tips: Default::default(),
+                poses: poses.clone(),
+            },
+        );
+        let stroke = |beat: usize, time_s: f64| crate::motion::plan::PlannedStroke {
+            beat,
+            tick: 0,
+            hand: Side::Right,
+            time_s,
+            target: DVec3::ZERO,
+            toward_player: DVec3::NEG_Y,
+            drum: 0,
+            mode: crate::score::PlayingMode::Legato,
+            dynamic: crate::score::Dynamic::Mf,
+            unit: 0,
+        };
+        let comp = Composition {
+            rate_hz: 10.0,
+            start_s: 0.0,
+            tips: [vec![DVec3::ZERO; 20], vec![DVec3::ZERO; 20]],
+            tags: Default::default(),
+            strokes: vec![stroke(0, 0.5), stroke(1, 1.2), stroke(1, 1.4)],
+            impact_samples: vec![5, 12, 14],
+            limits: crate::body::limits::NO_LIMITS,
+            muffles: Default::default(),
+        };
+        let selected = [1, 0, 7].into_iter().collect();
+        assert_eq!(ghosts(&comp, &sim, &selected), vec![poses[5], poses[12]]);
+        assert!(ghosts(&comp, &sim, &Default::default()).is_empty());
     }
 }

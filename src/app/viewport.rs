@@ -48,6 +48,8 @@ pub struct ViewportInput<'a> {
     pub generation: u64,
     /// The body pose to draw (IK now, simulated later).
     pub pose: Option<&'a Pose>,
+    /// Faint poses to draw as well: the simulated body at the selected beats' impacts.
+    pub ghosts: &'a [Pose],
     /// Simulated tip trajectories on the composition's time grid, [left, right].
     pub simulated: Option<&'a [Vec<DVec3>; 2]>,
     /// The rendered drums, whose recorded membrane motion the heads show.
@@ -311,6 +313,9 @@ impl Viewport {
         for (index, drum) in kit.drums.iter().enumerate() {
             let membrane = |p: DVec3| head_displacement(input.drums, index, input.time_s, p);
             stage::drum(&proj, drum, &membrane, &mut marks);
+        }
+        for ghost in input.ghosts {
+            stage::ghost(&proj, &self.body, ghost, &mut marks);
         }
         if let Some(pose) = input.pose {
             stage::body(&proj, &self.body, pose, &mut marks);

@@ -378,6 +378,13 @@ fn shape<'a>(
             }
         }
     }
+    // Strokes of one hand on the same sample (a score with problems, which the editor
+    // still shows) squeeze each other's approach and rebound to nothing: keep one sample
+    // of each, so positions stay finite.
+    for s in &mut shaped {
+        s.prep_s = s.prep_s.max(1.0 / rate);
+        s.rebound_s = s.rebound_s.max(1.0 / rate);
+    }
     shaped
 }
 

@@ -129,9 +129,29 @@ pub fn drum(proj: &Projector, drum: &Drum, membrane: &dyn Fn(DVec3) -> f64, out:
     }
 }
 
+/// Colour of a ghost pose: a faint blue-grey.
+pub const GHOST: Rgba = Rgba([150, 175, 210, 70]);
+
 /// The body in `pose`: one capsule per segment, as wide as the segment (at least
 /// 1.5 px), the far ones first; the sticks in [`STICK`], the body shaded by depth.
 pub fn body(proj: &Projector, model: &BodyModel, pose: &Pose, out: &mut Vec<Mark>) {
+    capsules(proj, model, pose, None, out);
+}
+
+/// A ghost of the body in `pose` (e.g. at a selected beat's impact), every segment in
+/// translucent [`GHOST`].
+pub fn ghost(proj: &Projector, model: &BodyModel, pose: &Pose, out: &mut Vec<Mark>) {
+    capsules(proj, model, pose, Some(GHOST), out);
+}
+
+/// The body's capsules, in `tint` when given.
+fn capsules(
+    proj: &Projector,
+    model: &BodyModel,
+    pose: &Pose,
+    tint: Option<Rgba>,
+    out: &mut Vec<Mark>,
+) {
     let frames = model.skeleton.forward(pose);
     let mut capsules: Vec<(f64, DVec2, DVec2, f32, Rgba)> = Vec::with_capacity(JOINT_COUNT);
     for j in Joint::ALL {
@@ -143,7 +163,9 @@ pub fn body(proj: &Projector, model: &BodyModel, pose: &Pose, out: &mut Vec<Mark
         };
         let depth = 0.5 * (za + zb);
         let width = (2.0 * seg.radius_m * proj.scale_at(depth)) as f32;
-        let colour = if matches!(j, Joint::GripL | Joint::GripR) {
+        let colour = if let Some(tint) = tint {
+            tint
+        } else if matches!(j, Joint::GripL | Joint::GripR) {
             STICK
         } else {
             let shade = (215.0 - 25.0 * depth).clamp(120.0, 210.0) as u8;

@@ -102,8 +102,10 @@ pub struct Series {
 }
 
 impl Series {
-    /// A series of `points`, sorted by x.
-    pub fn new(points: Vec<[f64; 2]>) -> Series {
+    /// A series of `points`, sorted by x; points that are not finite are left out (the
+    /// plot library cannot order them).
+    pub fn new(mut points: Vec<[f64; 2]>) -> Series {
+        points.retain(|p| p.iter().all(|v| v.is_finite()));
         debug_assert!(points.windows(2).all(|w| w[0][0] <= w[1][0]));
         Series {
             full: points,
