@@ -133,12 +133,18 @@ pub struct HandTargets {
 
 impl HandTargets {
     /// Hand `h`'s weight and point between samples `k − 1` and `k` (`u` ∈ [0, 1]), when
-    /// its weight there is above 0.
+    /// its weight there is above 0. A sample of weight 0 has no point of its own: next to
+    /// one the point is the other sample's.
     pub fn at(&self, h: usize, k: usize, u: f64) -> Option<(f64, DVec3)> {
         let (w, p) = (&self.weight[h], &self.points[h]);
         let (a, b) = (k.saturating_sub(1).min(w.len() - 1), k.min(w.len() - 1));
         let weight = w[a] + (w[b] - w[a]) * u;
-        (weight > 0.0).then(|| (weight, p[a].lerp(p[b], u)))
+        let point = match (w[a] > 0.0, w[b] > 0.0) {
+            (true, true) => p[a].lerp(p[b], u),
+            (true, false) => p[a],
+            _ => p[b],
+        };
+        (weight > 0.0).then_some((weight, point))
     }
 }
 

@@ -1,5 +1,5 @@
-//! Secco beats (timpani practice: the hand stops the head): a beat with `damp: Some(ticks)` is stopped by
-//! a hand resting on its head at the damp tick. The *free* hand does it — the one not
+//! Secco beats (timpani practice: the hand stops the head): a beat with
+//! `damp: Some(ticks)` is stopped by a hand resting on its head at the damp tick. The *free* hand does it — the one not
 //! playing around that time, preferably not the one that struck — by moving to the head
 //! near the rim on the player's side, its fingers on the head and the stick turned up and
 //! away so the felt stays clear, resting there for [`TOUCH_S`] and going back to its own
@@ -143,11 +143,9 @@ pub fn plan(score: &Score, kit: &Kit, strokes: &[PlannedStroke]) -> Muffles {
             out.without_hand.push(damp);
             continue;
         };
-        let p = &drum.placement;
-        let centre = DVec3::new(p.x_m, p.y_m, p.head_height_m);
-        let toward_player = DVec3::new(-p.x_m, -p.y_m, 0.0).normalize_or(DVec3::NEG_Y);
-        let hand_point = centre
-            + toward_player * (0.5 * drum.diameter_m - IN_FROM_RIM_M)
+        let toward_player = drum.toward_player().extend(0.0);
+        let hand_point = drum.centre()
+            + toward_player * (drum.radius_m() - IN_FROM_RIM_M)
             + DVec3::Z * HAND_ABOVE_HEAD_M;
         let up_and_away =
             (-toward_player * (1.0 - STICK_UP * STICK_UP).sqrt() + DVec3::Z * STICK_UP).normalize();

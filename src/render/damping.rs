@@ -71,15 +71,15 @@ fn touched_at(
     kit: &Kit,
 ) -> Option<f64> {
     let drum = kit.drums.get(m.damp.drum)?;
-    let p = &drum.placement;
+    let centre = drum.centre();
     let grip = Joint::arm(m.hand)[3].index();
     let first = ((m.leave_s - comp.start_s) * comp.rate_hz).ceil().max(0.0) as usize;
     let last = ((m.back_s - comp.start_s) * comp.rate_hz).floor().max(0.0) as usize;
     (first..=last.min(motion.poses.len().saturating_sub(1)))
         .find(|&k| {
             let hand = skeleton.forward(&motion.poses[k]).position[grip];
-            let over = (hand.x - p.x_m).hypot(hand.y - p.y_m) <= 0.5 * drum.diameter_m;
-            over && hand.z - p.head_height_m <= HAND_ABOVE_HEAD_M + TOUCH_TOLERANCE_M
+            let over = (hand - centre).truncate().length() <= drum.radius_m();
+            over && hand.z - centre.z <= HAND_ABOVE_HEAD_M + TOUCH_TOLERANCE_M
         })
         .map(|k| comp.time(k))
 }

@@ -391,35 +391,15 @@ fn hand_targets(comp: &Composition) -> Option<HandTargets> {
     }
     let mut weight: [Vec<f64>; 2] = std::array::from_fn(|_| vec![0.0; comp.len()]);
     let mut points: [Vec<DVec3>; 2] = std::array::from_fn(|_| vec![DVec3::ZERO; comp.len()]);
+    // The samples from one before the muffle leaves to one after it is back.
+    let sample = |t: f64| ((t - comp.start_s) * comp.rate_hz).max(0.0) as usize;
     for m in muffles {
         let h = crate::mocap::db::side_index(m.hand);
-        for k in 0..comp.len() {
+        let last = (sample(m.back_s) + 2).min(comp.len());
+        for k in sample(m.leave_s).saturating_sub(1).min(last)..last {
             let t = comp.time(k);
-            let w = m.weight(t);
-            if w > 0.0 {
-                weight[h][k] = w;
-                points[h][k] = m.hand_at(t);
-            }
-        }
-    }
-    // A point held from each muffle's first sample back and to its last forward, so the
-    // interpolation between samples never heads for the origin.
-    for h in 0..2 {
-        let mut last = None;
-        for k in 0..comp.len() {
-            if weight[h][k] > 0.0 {
-                last = Some(points[h][k]);
-            } else if let Some(p) = last {
-                points[h][k] = p;
-            }
-        }
-        let mut next = None;
-        for k in (0..comp.len()).rev() {
-            if weight[h][k] > 0.0 {
-                next = Some(points[h][k]);
-            } else if let Some(p) = next.filter(|_| points[h][k] == DVec3::ZERO) {
-                points[h][k] = p;
-            }
+            weight[h][k] = m.weight(t);
+            points[h][k] = m.hand_at(t);
         }
     }
     Some(HandTargets { weight, points })
