@@ -30,19 +30,6 @@ fn settle(h: &mut Harness<'static, EditorApp>, rendering: bool) {
     }
 }
 
-/// A click at `pos` (see `common::click`), settled as [`settle`] does.
-fn click(h: &mut Harness<'static, EditorApp>, pos: eframe::egui::Pos2, rendering: bool) {
-    if !rendering {
-        return common::click(h, pos);
-    }
-    h.hover_at(pos);
-    settle(h, true);
-    h.drag_at(pos);
-    h.step();
-    h.drop_at(pos);
-    settle(h, true);
-}
-
 /// Resident memory of this process, bytes (Linux; 0 elsewhere).
 fn resident_bytes() -> u64 {
     std::fs::read_to_string("/proc/self/statm")
@@ -134,7 +121,7 @@ fn long_random_session_keeps_undo_exact() {
                         && at.y > 0.0
                         && at.y < 900.0
                     {
-                        click(&mut h, at, render);
+                        common::click_settled_by(&mut h, at, |h| settle(h, render));
                     }
                 }
             }

@@ -57,6 +57,15 @@ pub fn settle(h: &mut Harness<'static, EditorApp>) {
 /// settling between press and release (as many frames as the workers keep the UI busy,
 /// more under load) once made a click add no beat.
 pub fn click(h: &mut Harness<'static, EditorApp>, pos: egui::Pos2) {
+    click_settled_by(h, pos, settle);
+}
+
+/// [`click`], letting the UI settle between its frames with `settle`.
+pub fn click_settled_by(
+    h: &mut Harness<'static, EditorApp>,
+    pos: egui::Pos2,
+    settle: impl Fn(&mut Harness<'static, EditorApp>),
+) {
     h.hover_at(pos);
     settle(h);
     h.drag_at(pos);
