@@ -1,7 +1,8 @@
 //! Measuring a struck note the way the guide's reference numbers were measured (guide §5,
 //! "Recorded timpani"): the onset, then over the first second after it the energy in
-//! the octave bands 63 Hz – 4 kHz as a share of the whole (dB), the spectral centroid, the
-//! (1,1) frequency over time (pitch glide) and the decay of a partial. Used by the
+//! the octave bands 63 Hz – 4 kHz as a share of the whole (dB) and the spectral centroid,
+//! both under one Hann window spanning that second (as the reference figures
+//! were measured: see `power_spectrum`), the (1,1) frequency over time (pitch glide) and the decay of a partial. Used by the
 //! calibration fit, `timpanist sound analyse`, the tests and the plots; the same code
 //! measures recordings and our own renders.
 
@@ -44,11 +45,19 @@ pub fn onset(samples: &[f32], rate_hz: u32) -> Option<usize> {
     Some(first.saturating_sub((ONSET_LEAD_S * f64::from(rate_hz)) as usize))
 }
 
-/// Power spectrum (no window: Parseval holds) of `samples` zero-padded to a power of two:
-/// (bin width Hz, power per bin for bins 0..=N/2).
+/// Power spectrum of `samples` under one Hann window spanning them, zero-padded to a power
+/// of two: (bin width Hz, power per bin for bins 0..=N/2). The window matters: cutting a
+/// note that still rings at the span's end with no taper spreads its (1,1) over every
+/// band (−6 dB per octave), which put a D3 note's 63 Hz band near −27 dB where the
+/// issue's Hann measurement of the same render reads −91 dB.
 fn power_spectrum(samples: &[f32], rate_hz: u32) -> (f64, Vec<f64>) {
     let n = samples.len().max(2).next_power_of_two();
-    let mut re: Vec<f64> = samples.iter().map(|&s| f64::from(s)).collect();
+    let len = samples.len();
+    let mut re: Vec<f64> = samples
+        .iter()
+        .enumerate()
+        .map(|(i, &s)| f64::from(s) * hann(i, len))
+        .collect();
     re.resize(n, 0.0);
     let mut im = vec![0.0; n];
     fft(&mut re, &mut im);
@@ -195,12 +204,7 @@ pub fn band_t60(
 ) -> Option<f64> {
     let start = onset(samples, rate_hz)?;
     let points = levels(samples, rate_hz, (start, span_s), window_s, |w| {
-        let windowed: Vec<f32> = w
-            .iter()
-            .enumerate()
-            .map(|(i, &s)| s * hann(i, w.len()) as f32)
-            .collect();
-        let (bin, power) = power_spectrum(&windowed, rate_hz);
+        let (bin, power) = power_spectrum(w, rate_hz);
         let energy = octave_energy(bin, &power, centre_hz);
         (energy > 0.0).then(|| 10.0 * energy.log10())
     });

@@ -6,7 +6,9 @@
 //! (f/f11) moves its radiation correction by the mean (recording − model) share of the
 //! notes' bands that fall in it, and each band's T60 by
 //! the geometric-mean ratio of the recordings' band T60 to the model's. The listed
-//! partials take the recordings' measured T60s directly. Deterministic: the same
+//! partials take the recordings' measured T60s directly; the unlisted axisymmetric modes'
+//! correction moves with the share of the span below the (1,1) where the (0,1) thumps,
+//! on the notes whose model (0,1) lies in that span. Deterministic: the same
 //! recordings give the same calibration.
 
 use super::analysis::{self, OCTAVE_CENTRES_HZ};
@@ -17,7 +19,7 @@ use crate::base::pitch::Pitch;
 use crate::drum::strike::{
     PLAYING_SPOT_FRACTION, SIM_RATE_HZ, aimed_force_n, scripted, speed_for_force,
 };
-use crate::drum::{ContactEvent, DrumSet, ModeConfig};
+use crate::drum::{ContactEvent, DrumSet, HeadModes, ModeConfig};
 use crate::kit::{Kit, Side};
 
 /// Rounds of the band fit.
@@ -59,6 +61,22 @@ pub struct Note {
 /// The span below the (1,1) where the (0,1) thumps, as fractions of the (1,1): the (0,1)
 /// with its kettle near 0.85, clear of the (1,1)'s own line.
 pub const THUMP_SPAN: (f64, f64) = (0.3, 0.92);
+
+/// Whether the model's (0,1) on the first drum of `kit` lies in the [`THUMP_SPAN`], so
+/// that span's share measures it. A slack head over its kettle rings its (0,1) at or above
+/// its (1,1) (the 32-inch drum in G2 at 0.98, in C2 at 1.35: the kettle's air spring
+/// outweighs the membrane's), where no share below the (1,1) can see it; such notes do
+/// not move the (0,1)'s correction, which then keeps its physical radiation.
+fn thump_measurable(kit: &Kit) -> bool {
+    let drum = &kit.drums[0];
+    let f11 = drum.tuning.hz();
+    HeadModes::below_hz(drum, ModeConfig::default().source, 2.0 * f11).is_ok_and(|head| {
+        head.modes()
+            .iter()
+            .find(|k| (k.m, k.n) == (0, 1))
+            .is_some_and(|k| (THUMP_SPAN.0..THUMP_SPAN.1).contains(&(k.freq_hz / f11)))
+    })
+}
 
 /// What a note measures: pitch (Hz), band shares (dB), band T60s (s), the share of the
 /// thump span (dB).
@@ -254,7 +272,9 @@ pub fn fit(
             let model = measure(&audio, super::SAMPLE_RATE_HZ)
                 .ok_or_else(|| FitError::NoPitch(format!("the model's {}", note.name)))?;
 
-            thump_steps.push(target.thump_db - model.thump_db);
+            if thump_measurable(kit) {
+                thump_steps.push(target.thump_db - model.thump_db);
+            }
             let mut bands_db = [0.0; 7];
             for b in 0..7 {
                 bands_db[b] = model.bands_db[b] - target.bands_db[b];
@@ -286,8 +306,10 @@ pub fn fit(
             let step = geometric_mean(&t60_ratios[b]).clamp(0.7, 1.4);
             cal.t60_s[b] = (cal.t60_s[b] * step).clamp(MIN_T60_S, MAX_T60_S);
         }
-        let step = thump_steps.iter().sum::<f64>() / thump_steps.len() as f64;
-        cal.axisymmetric_db += step.clamp(-MAX_STEP_DB, MAX_STEP_DB);
+        if !thump_steps.is_empty() {
+            let step = thump_steps.iter().sum::<f64>() / thump_steps.len() as f64;
+            cal.axisymmetric_db += step.clamp(-MAX_STEP_DB, MAX_STEP_DB);
+        }
         // Orders below every note's fitted ones (there the listed partials rule the band
         // shares and a correction of the others is not measurable) keep the physical
         // Rayleigh radiation: the (0,1) with its kettle, the (1,2), the (0,2).

@@ -35,9 +35,13 @@ pub const SAMPLE_RATE_HZ: u32 = 48_000;
 pub const PEAK_LIMIT: f64 = 0.891_250_938_133_745_5;
 /// Placement x (m) that pans a drum fully to one side; nearer drums pan in proportion.
 pub const PAN_SPAN_M: f64 = 1.2;
-/// Impact speed of the reference strike every model calibrates to, m/s (ff, see
-/// [`crate::drum::strike::impact_speed_mps`]).
-pub const REFERENCE_SPEED_MPS: f64 = 4.94;
+/// Impact speed of the reference strike the sample and signal models calibrate to, m/s:
+/// the scripted ff's, [`crate::drum::strike::impact_speed_mps`] (a copied number went
+/// stale when the strokes' speeds were rescaled, and every stroke from mf up then played
+/// the sample model's unfiltered ff brightness).
+pub fn reference_speed_mps() -> f64 {
+    crate::drum::strike::impact_speed_mps(crate::score::Dynamic::Ff)
+}
 /// Peak level the sample and signal models give the reference strike (−6 dBFS); the
 /// modal model's calibration puts a reference strike on the 26-inch drum there too.
 pub const REFERENCE_LEVEL: f64 = 0.5;

@@ -2,7 +2,7 @@
 //! note, the one whose measured (1,1) pitch is nearest the drum's tuning (in semitones),
 //! resampled (cubic Hermite interpolation) so its (1,1) lands on the tuning, darkened by a
 //! low-pass that opens with the impact speed, at an amplitude proportional to the impact
-//! speed v: gain = `REFERENCE_LEVEL` × v / `REFERENCE_SPEED_MPS` on the filtered note
+//! speed v: gain = `REFERENCE_LEVEL` × v / [`reference_speed_mps`] on the filtered note
 //! (each recording is first normalised to peak 1; the low-pass has unit gain at 0 Hz).
 //!
 //! **Recordings and hands.** The FluidR3 GM timpani (MIT,
@@ -23,32 +23,32 @@
 //!
 //! f_c(v) = [`CUTOFF_P_HZ`] × (v_ff − v_p) / (v_ff − v) for v < v_ff, none (α = 1) for v ≥ v_ff,
 //!
-//! where v_p = 2.16 m/s and v_ff = `REFERENCE_SPEED_MPS` = 4.94 m/s are the impact speeds
+//! where v_p = 3.09 m/s and v_ff = [`reference_speed_mps`] = 7.06 m/s are the impact speeds
 //! of p and ff ([`crate::drum::strike::impact_speed_mps`]). So the filter's time constant
 //! 1/(2π f_c) shrinks in proportion to how far the stroke falls short of ff, the ff
-//! reference plays the recording unfiltered (bit for bit; `impact_speed_mps(Ff)` = 4.939
-//! m/s gives f_c ≈ 1.9 MHz, α = 1 in double precision), and the cutoff never falls below
-//! f_c(0) = 550 Hz: pp 1.46 m/s → 780 Hz, p → 980 Hz, mp 2.82 m/s → 1.29 kHz, mf 3.53 m/s
-//! → 1.93 kHz, f 4.23 m/s → 3.85 kHz. A pitched note's cutoff moves with it (× tuning /
-//! measured (1,1)), so the filter shapes every recording's spectrum the same way at any
-//! tuning and a render's p/ff centroid ratio is its recording's (the standard kit's drums
-//! all replay note 3: 0.80 with the left stick, 0.76 with the right).
+//! reference plays the recording unfiltered (bit for bit), and the cutoff never falls
+//! below f_c(0) = 313 Hz: pp 2.08 m/s → 443 Hz, p → 556 Hz, mp 4.03 m/s → 728 Hz, mf
+//! 5.04 m/s → 1.09 kHz, f 6.05 m/s → 2.19 kHz. Rendered strokes reach these speeds and
+//! more (the dynamics ladder's medians: pp 3.1, p 3.8, mf 6.0, ff 8.4 m/s), so a
+//! rendered p is brighter than the scripted one and everything from f up plays nearly
+//! unfiltered. A pitched note's cutoff moves with it (× tuning / measured (1,1)), so the
+//! filter shapes every recording's spectrum the same way at any tuning.
 //!
-//! [`CUTOFF_P_HZ`] = 980 Hz is chosen on the recordings: the guide puts the spectral
+//! [`CUTOFF_P_HZ`] = 556 Hz is chosen on the recordings: the guide puts the spectral
 //! centroid of recorded timpani at ≈ 280 Hz for p and 330 Hz for ff, so each of the six
-//! recordings is played at its own pitch with the p filter and unfiltered, and 980 Hz makes
-//! the geometric mean of their centroid ratios (first second after the onset,
-//! [`super::analysis::profile`]) 280/330 = 0.85. Per recording the ratio is 0.76–0.92
-//! (1L 0.87, 2L 0.92, 3L 0.80, 1R 0.85, 2R 0.91, 3R 0.76): the brighter the note, the more
-//! the filter takes. A one-pole suffices: the notes' centroids (120–330 Hz unfiltered) lie
-//! well below the cutoff, so the gentle slope tilts the upper partials and the attack
-//! without touching the (1,1).
+//! recordings is played at its own pitch with the p filter and unfiltered, and 556 Hz makes
+//! the geometric mean of their centroid ratios (first second after the onset, Hann
+//! window, [`super::analysis::profile`]) 280/330 = 0.85. Per recording the ratio is
+//! 0.79–0.92 (1L 0.83, 2L 0.92, 3L 0.83, 1R 0.81, 2R 0.92, 3R 0.79): the brighter the
+//! note, the more the filter takes. A one-pole suffices: the notes' centroids (100–280 Hz
+//! unfiltered) lie below the cutoff, so the gentle slope tilts the upper partials and the
+//! attack and takes a little of the (1,1).
 //!
 //! Pitching a note up also raises its top octave; content shifted above 24 kHz aliases
 //! (the recordings hold little energy there).
 
 use super::spectrum::{principal_hz, spectrum};
-use super::{REFERENCE_LEVEL, REFERENCE_SPEED_MPS, SAMPLE_RATE_HZ, SoundError};
+use super::{REFERENCE_LEVEL, SAMPLE_RATE_HZ, SoundError, reference_speed_mps};
 use crate::drum::DrumSet;
 use crate::drum::strike::impact_speed_mps;
 use crate::kit::{Drum, Side};
@@ -96,7 +96,7 @@ pub const RECORDINGS: [(&str, Side, &[u8]); 6] = [
 const NOTES: usize = 3;
 
 /// Low-pass cutoff for a p stroke, Hz (see the module docs for the law and its calibration).
-pub const CUTOFF_P_HZ: f64 = 980.0;
+pub const CUTOFF_P_HZ: f64 = 556.0;
 
 /// Kettledrum mode ratios used to recognise the (1,1) in a recording.
 const KETTLEDRUM_RATIOS: [f64; 5] = [1.0, 1.5, 1.98, 2.44, 2.94];
@@ -203,9 +203,9 @@ pub fn nearest_pair(hz: f64) -> Result<(&'static Recording, &'static Recording),
 /// (v_ff − v), infinite (no filter) from the reference (ff) speed up.
 pub fn cutoff_hz(speed_mps: f64) -> f64 {
     let p = impact_speed_mps(Dynamic::P);
-    let short = REFERENCE_SPEED_MPS - speed_mps;
+    let short = reference_speed_mps() - speed_mps;
     if short > 0.0 {
-        CUTOFF_P_HZ * (REFERENCE_SPEED_MPS - p) / short
+        CUTOFF_P_HZ * (reference_speed_mps() - p) / short
     } else {
         f64::INFINITY
     }
@@ -260,7 +260,7 @@ pub fn render_drum(
         };
         // Recording samples per output sample.
         let step = drum.tuning.hz() / rec.principal_hz * f64::from(rec.rate_hz) / fs;
-        let amp = REFERENCE_LEVEL * c.impact_speed_mps / REFERENCE_SPEED_MPS;
+        let amp = REFERENCE_LEVEL * c.impact_speed_mps / reference_speed_mps();
         let start = ((c.start_s * fs).round().max(0.0) as usize).min(out.len());
         let cutoff = cutoff_hz(c.impact_speed_mps) * drum.tuning.hz() / rec.principal_hz;
         play(rec, step, cutoff, amp, &mut out[start..]);
@@ -306,11 +306,11 @@ mod tests {
         assert!((p / CUTOFF_P_HZ - 1.0).abs() < 1e-12, "{p}");
         let speeds = [0.0, 1.46, 2.16, 2.82, 3.53, 4.23, 4.9];
         assert!(speeds.windows(2).all(|w| cutoff_hz(w[0]) < cutoff_hz(w[1])));
-        assert_eq!(cutoff_hz(REFERENCE_SPEED_MPS), f64::INFINITY);
+        assert_eq!(cutoff_hz(reference_speed_mps()), f64::INFINITY);
         assert_eq!(cutoff_hz(f64::NAN), f64::INFINITY);
         let rec = &recordings().unwrap()[0];
         let mut out = vec![0.0; 1000];
-        play(rec, 1.0, cutoff_hz(REFERENCE_SPEED_MPS), 1.0, &mut out);
+        play(rec, 1.0, cutoff_hz(reference_speed_mps()), 1.0, &mut out);
         assert_eq!(out[..], rec.samples[..1000]);
     }
 

@@ -2,12 +2,12 @@
 //! partials at the head's mode frequencies, decays and gains (the voices of
 //! [`voices_for`]), each weighted by its mode shape at the impact point, plus a
 //! short noise burst (deterministic, seeded by drum and contact), all in proportion to
-//! the impact speed: a strike at `REFERENCE_SPEED_MPS` gives partials of total amplitude
+//! the impact speed: a strike at [`reference_speed_mps`] gives partials of total amplitude
 //! ≈ `REFERENCE_LEVEL` at the playing spot.
 
 use super::modal::FLUSH_FLOOR;
 use super::voices::{Voice, VoiceBank};
-use super::{REFERENCE_LEVEL, REFERENCE_SPEED_MPS, SAMPLE_RATE_HZ};
+use super::{REFERENCE_LEVEL, SAMPLE_RATE_HZ, reference_speed_mps};
 use crate::base::rng::Rng;
 use crate::drum::{DrumSet, HeadModes, Orientation};
 
@@ -73,7 +73,7 @@ pub fn render_drum(drums: &DrumSet, j: usize, out: &mut [f32]) -> bool {
         let start = ((c.start_s * fs).round().max(0.0) as usize).min(out.len());
         bank.ring(&mut out[cursor..start], FLUSH_FLOOR);
         cursor = start;
-        let amp = REFERENCE_LEVEL * c.impact_speed_mps / REFERENCE_SPEED_MPS;
+        let amp = REFERENCE_LEVEL * c.impact_speed_mps / reference_speed_mps();
         head.shapes_at(head.local(c.point), &mut shapes);
         for (d, &k) in kick.iter_mut().zip(&index) {
             *d = (amp / total_gain * SIGNAL_SCALE * shapes[k]) as f32;
