@@ -1,25 +1,49 @@
-//! A snapshot of the editor's main window on the demo score, rendered headless with wgpu
-//! (software rendering is enough: lavapipe or llvmpipe). The status bar, which shows
-//! timings and the sound device's message, is masked. Update with UPDATE_SNAPSHOTS=1.
+//! Snapshots of the editor's main window on the demo score, rendered headless with wgpu
+//! (software rendering is enough: lavapipe or llvmpipe): the 3D view lit and
+//! depth-buffered on the GPU, and the flat view it falls back to (View > Flat 3D view).
+//! The status bar, which shows timings and the sound device's message, is masked. Update
+//! with UPDATE_SNAPSHOTS=1.
 
 mod common;
 
 use eframe::egui;
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
 use timpanist::app::EditorApp;
 
-/// The main window with every panel, as rendered, matches the stored snapshot.
-#[test]
-fn main_window_snapshot() {
+fn window() -> (Harness<'static, EditorApp>, tempfile::TempDir) {
     let dir = tempfile::tempdir().unwrap();
     let score = common::root().join("scores/etude-modes.ron");
-    let options = common::options(Some(score), dir.path(), false);
-    let mut h = common::builder()
-        .wgpu()
-        .build_eframe(move |_cc| EditorApp::with_options(options));
-    common::settle(&mut h);
+    let h = common::wgpu_editor(score, dir.path());
+    (h, dir)
+}
+
+/// Snapshot the window as `name`, the status bar masked.
+fn snapshot(h: &mut Harness<'static, EditorApp>, name: &str) {
     h.mask(egui::Rect::from_min_max(
         egui::pos2(0.0, 870.0),
         egui::pos2(1400.0, 900.0),
     ));
-    h.snapshot("main_window");
+    h.snapshot(name);
+}
+
+/// The main window with every panel, the stage drawn lit on the GPU, matches the stored
+/// snapshot.
+#[test]
+fn main_window_snapshot() {
+    let (mut h, _dir) = window();
+    snapshot(&mut h, "main_window");
+}
+
+/// With View > Flat 3D view the stage is drawn as flat marks, as when no GPU draws it.
+#[test]
+fn flat_view_snapshot() {
+    let (mut h, _dir) = window();
+    h.get_by_label("View").click();
+    h.run();
+    h.get_by_label("Flat 3D view (no lighting)").click();
+    h.run();
+    h.key_press(egui::Key::Escape);
+    common::settle(&mut h);
+    snapshot(&mut h, "main_window_flat");
 }

@@ -12,7 +12,6 @@ use egui_kittest::kittest::{NodeT, Queryable};
 use std::path::Path;
 use std::time::Instant;
 use timpanist::app::EditorApp;
-use timpanist::render::{RenderParams, render};
 use timpanist::score::{Beat, Hand, Score};
 
 /// Median and maximum of `n` frame times while playing, ms.
@@ -90,13 +89,7 @@ fn edit_to_composition_and_frame_times() {
 
     // The score as edited, rendered in one simulation pass (the plots' cost does not
     // depend on how many passes made the rendering) and handed to the editor.
-    let loaded = h.state().loaded().unwrap().clone();
-    let db = timpanist::mocap::shipped::built_in().unwrap();
-    let params = RenderParams {
-        max_attempts: 1,
-        ..RenderParams::default()
-    };
-    let rendering = render(&loaded, &db, &params, &mut |_| true).unwrap();
+    let rendering = common::render_once(h.state().loaded().unwrap());
     let contacts = rendering.events.len();
     h.state_mut().set_rendering(std::sync::Arc::new(rendering));
     h.step();
@@ -136,6 +129,37 @@ fn edit_to_composition_and_frame_times() {
             println!("plot tab Sound: a frame analysing a new strike {spent:.1} ms");
         }
     }
+}
+
+/// The 3D view drawn lit on the GPU (wgpu; here a software rasteriser, llvmpipe or
+/// lavapipe) on the one-minute demo study with its rendering, playing: the CPU side of a
+/// frame (the UI, which builds the stage's triangles and the heads' motion) and a whole
+/// frame with the GPU's drawing and the image read back. Measured, not asserted.
+#[test]
+fn gpu_view_frame_times() {
+    let dir = tempfile::tempdir().unwrap();
+    let score = common::root().join("scores/minute-study.ron");
+    let mut h = common::wgpu_editor(score, dir.path());
+    let rendering = common::render_once(h.state().loaded().unwrap());
+    h.key_press(egui::Key::Space);
+    h.state_mut().set_rendering(std::sync::Arc::new(rendering));
+    h.state_mut().seek(10.0);
+    h.step();
+    assert!(h.state().playback().is_playing());
+    let (median, max) = frame_times(&mut h, 60);
+    let mut whole = Vec::new();
+    for _ in 0..20 {
+        let t = Instant::now();
+        h.step();
+        h.render().unwrap();
+        whole.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    println!(
+        "GPU 3D view, one-minute study playing: CPU side of a frame median {median:.1} ms, \
+         max {max:.1} ms; with the GPU drawing and read-back median {:.1} ms, max {:.1} ms",
+        percentile(&mut whole, 0.5),
+        percentile(&mut whole, 1.0)
+    );
 }
 
 /// Percentile `p` (0–1) of `values` (sorted in place).

@@ -9,6 +9,9 @@ use super::session::ConfirmAnswer;
 use super::{
     Action, AfterConfirm, Camera, EditorApp, Export, plots, tempo_lane, timeline, viewport,
 };
+use crate::body::skeleton::Pose;
+use crate::scene::marks::Rgba;
+use crate::scene::stage;
 use eframe::egui;
 
 impl EditorApp {
@@ -145,6 +148,19 @@ impl EditorApp {
                     }
                 }
                 ui.checkbox(&mut self.views.timeline.snap, "Snap to grid");
+                ui.checkbox(
+                    &mut self.views.overlay_target,
+                    "Overlay the target pose (composed tips through the IK)",
+                );
+                ui.checkbox(
+                    &mut self.views.overlay_previous,
+                    "Overlay the previous rendering (before the last edit)",
+                );
+                ui.checkbox(&mut self.views.flat_view, "Flat 3D view (no lighting)")
+                    .on_hover_text(
+                        "Draw the stage as flat shapes instead of lit, depth-buffered solids \
+                         (the flat view is also what shows when the GPU cannot draw)",
+                    );
                 let viewport = &mut self.views.viewport;
                 let mut windowed = viewport.trajectory_window_s.is_some();
                 if ui
@@ -377,20 +393,35 @@ impl EditorApp {
         let simulated_pose = (self.views.simulated.as_ref())
             .and_then(|s| s.pose_at(self.transport.playhead_s))
             .copied();
-        let pose = simulated_pose.or_else(|| {
-            comp.map(|c| {
-                *self.views.ik.pose(
-                    &self.views.viewport.body().skeleton,
-                    c,
-                    self.pipeline.generation(),
-                    self.transport.playhead_s,
-                )
-            })
+        let playhead = self.transport.playhead_s;
+        let target_pose = comp.map(|c| {
+            *self.views.ik.pose(
+                &self.views.viewport.body().skeleton,
+                c,
+                self.pipeline.generation(),
+                playhead,
+            )
         });
-        let ghosts = match (comp, self.views.simulated.as_ref()) {
-            (Some(c), Some(sim)) => super::pose::ghosts(c, sim, &doc.selection.beats),
+        let pose = simulated_pose.or(target_pose);
+        let mut ghosts: Vec<(Pose, Rgba)> = match (comp, self.views.simulated.as_ref()) {
+            (Some(c), Some(sim)) => super::pose::ghosts(c, sim, &doc.selection.beats)
+                .into_iter()
+                .map(|g| (g, stage::GHOST))
+                .collect(),
             _ => Vec::new(),
         };
+        let mut overlays = Vec::new();
+        if let (true, Some(_), Some(target)) =
+            (self.views.overlay_target, simulated_pose, target_pose)
+        {
+            ghosts.push((target, stage::TARGET_POSE));
+            overlays.push(("target pose (IK)", stage::TARGET_POSE));
+        }
+        let previous = (self.views.previous.as_ref()).and_then(|p| p.pose_at(playhead));
+        if let (true, Some(previous)) = (self.views.overlay_previous, previous) {
+            ghosts.push((*previous, stage::PREVIOUS_POSE));
+            overlays.push(("previous rendering", stage::PREVIOUS_POSE));
+        }
         self.views.viewport.show(
             ui,
             rect,
@@ -400,6 +431,7 @@ impl EditorApp {
                 generation: self.pipeline.generation(),
                 pose: pose.as_ref(),
                 ghosts: &ghosts,
+                overlays: &overlays,
                 simulated: self.views.simulated.as_ref().map(|s| &s.motion().tips),
                 drums: (self.views.simulated.as_ref())
                     .and_then(|s| s.rendering())

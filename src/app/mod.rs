@@ -17,6 +17,7 @@ mod document;
 mod export;
 mod file_browser;
 mod files;
+mod gpu_view;
 mod history;
 mod inspector;
 mod jobs;
@@ -35,6 +36,7 @@ mod renderer;
 mod selection;
 mod session;
 mod settings_panel;
+mod solid_frame;
 pub mod tape;
 mod tempo_lane;
 mod time_axis;
@@ -123,6 +125,16 @@ struct Views {
     simulated: Option<Simulated>,
     plots: plots::Plots,
     show_help: bool,
+    /// Draw the 3D view flat (2D marks) even when the GPU can draw it lit.
+    flat_view: bool,
+    /// Overlay the target pose (the composed tips through the IK) on the simulated one.
+    overlay_target: bool,
+    /// Overlay the previous rendering's pose (the score before the last edit).
+    overlay_previous: bool,
+    /// The last complete rendering before the one shown, once a newer one arrived.
+    previous: Option<Simulated>,
+    /// Whether the rendering shown is complete (the next one then makes it `previous`).
+    shown_complete: bool,
 }
 
 /// What the window says: the last error (until dismissed) and a passing status line.
@@ -227,6 +239,11 @@ impl EditorApp {
                 simulated: None,
                 plots: plots::Plots::default(),
                 show_help: false,
+                flat_view: std::env::var_os("TIMPANIST_FLAT_VIEW").is_some(),
+                overlay_target: false,
+                overlay_previous: false,
+                previous: None,
+                shown_complete: false,
             },
             jobs: Jobs::default(),
             recent: RecentFiles::load(options.recent_store.clone()),
@@ -318,8 +335,12 @@ impl EditorApp {
 }
 
 impl eframe::App for EditorApp {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+    fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
+        self.views.viewport.gpu = frame
+            .wgpu_render_state()
+            .filter(|_| !self.views.flat_view)
+            .map(|rs| rs.target_format);
         self.take_inputs(&ctx);
         egui::Panel::top("menu").show(ui, |ui| {
             self.menu_bar(ui);

@@ -44,6 +44,8 @@ impl EditorApp {
         self.transport.reset();
         self.views.timeline.fit();
         self.views.simulated = None;
+        self.views.previous = None;
+        self.views.shown_complete = false;
         self.messages.error = None;
         self.pipeline.forget_rendering();
         self.recompose();
@@ -71,6 +73,12 @@ impl EditorApp {
     /// bar, its audio to playback. Swaps are seamless (a crossfade under the playhead), so
     /// every rendering is heard at once, a new version or more of the one playing.
     pub(super) fn show_rendering(&mut self, r: Rendered) {
+        // A complete rendering replaced by a new one is the score before the edit: kept
+        // for View > Overlay the previous rendering (the steps of one rendering are not).
+        if self.views.shown_complete {
+            self.views.previous = self.views.simulated.take();
+        }
+        self.views.shown_complete = r.complete;
         self.views.simulated = Some(r.simulated);
         self.messages.status = r.summary;
         if let Err(e) = self.transport.load(&r.rendering) {

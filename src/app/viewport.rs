@@ -48,8 +48,11 @@ pub struct ViewportInput<'a> {
     pub generation: u64,
     /// The body pose to draw (IK now, simulated later).
     pub pose: Option<&'a Pose>,
-    /// Faint poses to draw as well: the simulated body at the selected beats' impacts.
-    pub ghosts: &'a [Pose],
+    /// Faint poses to draw as well, each in its colour: the simulated body at the
+    /// selected beats' impacts, the target pose, the previous rendering's pose.
+    pub ghosts: &'a [(Pose, Rgba)],
+    /// Legend lines for the overlaid poses shown (name, colour).
+    pub overlays: &'a [(&'static str, Rgba)],
     /// Simulated tip trajectories on the composition's time grid, [left, right].
     pub simulated: Option<&'a [Vec<DVec3>; 2]>,
     /// The rendered drums, whose recorded membrane motion the heads show.
@@ -130,6 +133,11 @@ pub struct Viewport {
     cache: Option<Projected>,
     /// Where the viewport was drawn last frame.
     pub rect: Option<Rect>,
+    /// egui's target format when the editor runs on wgpu: the stage is then drawn lit and
+    /// depth-buffered on the GPU (`gpu_view`); `None` paints the flat 2D marks.
+    pub gpu: Option<eframe::wgpu::TextureFormat>,
+    /// The heads' mode shapes for the GPU view.
+    heads: super::solid_frame::HeadShapes,
 }
 
 fn to_pos(rect: Rect, p: DVec2) -> Pos2 {
@@ -307,18 +315,35 @@ impl Viewport {
         let painter = ui.painter_at(rect);
         painter.rect_filled(rect, 4.0, colour32(stage::BACKGROUND));
         let mut marks = Vec::new();
-        stage::floor(&proj, &mut marks);
-        // Drums first: the body and sticks are above the heads, which are translucent.
         let kit = input.doc.score.settings.kit(&input.doc.kit);
-        for (index, drum) in kit.drums.iter().enumerate() {
-            let membrane = |p: DVec3| head_displacement(input.drums, index, input.time_s, p);
-            stage::drum(&proj, drum, &membrane, &mut marks);
-        }
-        for ghost in input.ghosts {
-            stage::ghost(&proj, &self.body, ghost, &mut marks);
-        }
-        if let Some(pose) = input.pose {
-            stage::body(&proj, &self.body, pose, &mut marks);
+        if let Some(format) = self.gpu {
+            let scene = super::solid_frame::Scene {
+                kit: &kit,
+                drums: input.drums,
+                time_s: input.time_s,
+                body: &self.body,
+                pose: input.pose,
+                ghosts: input.ghosts,
+            };
+            let frame =
+                super::solid_frame::frame(&scene, &self.camera, size, &mut self.heads, format);
+            super::gpu_view::paint(&painter, rect, frame);
+            for drum in &kit.drums {
+                stage::drum_label(&proj, drum, &mut marks);
+            }
+        } else {
+            stage::floor(&proj, &mut marks);
+            // Drums first: the body and sticks are above the heads, which are translucent.
+            for (index, drum) in kit.drums.iter().enumerate() {
+                let membrane = |p: DVec3| head_displacement(input.drums, index, input.time_s, p);
+                stage::drum(&proj, drum, &membrane, &mut marks);
+            }
+            for (ghost, tint) in input.ghosts {
+                stage::ghost(&proj, &self.body, ghost, *tint, &mut marks);
+            }
+            if let Some(pose) = input.pose {
+                stage::body(&proj, &self.body, pose, &mut marks);
+            }
         }
         if let Some(drums) = input.drums {
             stage::contacts(&proj, drums.contacts(), input.time_s, &mut marks);
@@ -364,14 +389,14 @@ impl Viewport {
             egui::FontId::proportional(11.0),
             Color32::from_gray(170),
         );
-        self.legend(ui, rect);
+        self.legend(ui, rect, input.overlays);
     }
 
     /// What the trajectories' colours mean, in the view's top right corner.
-    fn legend(&self, ui: &mut egui::Ui, rect: Rect) {
+    fn legend(&self, ui: &mut egui::Ui, rect: Rect, overlays: &[(&str, Rgba)]) {
         let area = Rect::from_min_size(
             rect.right_top() + Vec2::new(-128.0, 6.0),
-            Vec2::new(120.0, 90.0),
+            Vec2::new(120.0, 130.0),
         );
         let label = |ui: &mut egui::Ui, text: &str, colour: Color32| {
             let text = egui::RichText::new(text).size(11.0).color(colour);
@@ -409,6 +434,9 @@ impl Viewport {
                     label(ui, name, TARGET_COLOURS[h]);
                 }
             }
+        }
+        for (name, colour) in overlays {
+            label(ui, name, colour32(colour.with_alpha(255)));
         }
     }
 

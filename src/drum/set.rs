@@ -422,29 +422,44 @@ impl DrumSet {
     /// point `point` at `time_s` (the frame before it, every 10 ms; coupled modes only);
     /// 0 off the head, for an unknown drum, or outside the recorded time.
     pub fn recorded_displacement(&self, drum: usize, time_s: f64, point: DVec3) -> f64 {
-        let Some(head) = self.heads.get(drum) else {
+        let (Some(q), Some(shapes)) = (
+            self.recorded_modes(drum, time_s),
+            self.coupled_shapes_at(drum, point),
+        ) else {
             return 0.0;
         };
-        let local = head.modes.local(point);
+        recorded_sum(q, &shapes)
+    }
+
+    /// The recorded amplitudes (m) of drum `drum`'s coupled modes in the frame before
+    /// `time_s`; None for an unknown drum, outside the recorded time, or a head at rest.
+    pub fn recorded_modes(&self, drum: usize, time_s: f64) -> Option<&[f32]> {
+        let head = self.heads.get(drum)?;
         let frame_s = MEMBRANE_FRAME_STEPS as f64 * self.dt_s;
         let per_frame: usize = self.heads.iter().map(|h| h.coupled.len()).sum();
         let frames = self.membrane.len() / per_frame.max(1);
         let f = ((time_s - self.first_time_s) / frame_s).floor();
-        if !head.modes.contains(local) || !(0.0..frames as f64).contains(&f) {
-            return 0.0;
+        if !(0.0..frames as f64).contains(&f) {
+            return None;
         }
         let offset: usize = self.heads[..drum].iter().map(|h| h.coupled.len()).sum();
         let q = &self.membrane[f as usize * per_frame + offset..][..head.coupled.len()];
-        if q.iter().all(|q| q.abs() < 1e-9) {
-            return 0.0;
+        (!q.iter().all(|q| q.abs() < 1e-9)).then_some(q)
+    }
+
+    /// The shapes of drum `drum`'s coupled modes at the performer-frame point `point`, in
+    /// the order of [`DrumSet::recorded_modes`]; None off the head or for an unknown drum.
+    /// Computed once per point, they turn each frame's amplitudes into a displacement
+    /// with [`recorded_sum`].
+    pub fn coupled_shapes_at(&self, drum: usize, point: DVec3) -> Option<Vec<f64>> {
+        let head = self.heads.get(drum)?;
+        let local = head.modes.local(point);
+        if !head.modes.contains(local) {
+            return None;
         }
         let mut shapes = vec![0.0; head.modes.modes().len()];
         head.modes.shapes_at(local, &mut shapes);
-        head.coupled
-            .iter()
-            .zip(q)
-            .map(|(&k, &q)| f64::from(q) * shapes[k])
-            .sum()
+        Some(head.coupled.iter().map(|&k| shapes[k]).collect())
     }
 
     /// The modes of drum `drum` (all of them, coupled or not).
@@ -487,4 +502,14 @@ impl DrumSet {
     pub fn contact_law(&self) -> &HertzContact {
         &self.law
     }
+}
+
+/// A displacement (m) from recorded modal amplitudes and the shapes at one point
+/// ([`DrumSet::recorded_modes`], [`DrumSet::coupled_shapes_at`]).
+pub fn recorded_sum(amplitudes: &[f32], shapes: &[f64]) -> f64 {
+    amplitudes
+        .iter()
+        .zip(shapes)
+        .map(|(&q, &s)| f64::from(q) * s)
+        .sum()
 }

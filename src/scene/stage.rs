@@ -118,7 +118,12 @@ pub fn drum(proj: &Projector, drum: &Drum, membrane: &dyn Fn(DVec3) -> f64, out:
             });
         }
     }
-    if let Some((q, _)) = proj.project(centre) {
+    drum_label(proj, drum, out);
+}
+
+/// A drum's name at the centre of its head.
+pub fn drum_label(proj: &Projector, drum: &Drum, out: &mut Vec<Mark>) {
+    if let Some((q, _)) = proj.project(drum.centre()) {
         out.push(Mark::Label {
             at: q,
             anchor: Anchor::Centre,
@@ -138,10 +143,16 @@ pub fn body(proj: &Projector, model: &BodyModel, pose: &Pose, out: &mut Vec<Mark
     capsules(proj, model, pose, None, out);
 }
 
+/// Colour of the target pose overlaid on the simulated one (the composed tips through
+/// the IK): a faint green.
+pub const TARGET_POSE: Rgba = Rgba([120, 220, 140, 90]);
+/// Colour of the previous rendering's pose overlaid on the current one: a faint amber.
+pub const PREVIOUS_POSE: Rgba = Rgba([240, 170, 80, 90]);
+
 /// A ghost of the body in `pose` (e.g. at a selected beat's impact), every segment in
-/// translucent [`GHOST`].
-pub fn ghost(proj: &Projector, model: &BodyModel, pose: &Pose, out: &mut Vec<Mark>) {
-    capsules(proj, model, pose, Some(GHOST), out);
+/// translucent `tint` ([`GHOST`], [`TARGET_POSE`], [`PREVIOUS_POSE`]).
+pub fn ghost(proj: &Projector, model: &BodyModel, pose: &Pose, tint: Rgba, out: &mut Vec<Mark>) {
+    capsules(proj, model, pose, Some(tint), out);
 }
 
 /// The body's capsules, in `tint` when given.

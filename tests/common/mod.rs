@@ -113,6 +113,29 @@ pub fn give_rendering(h: &mut Harness<'static, EditorApp>, score: &Path) {
     settle(h);
 }
 
+/// `loaded` rendered in one simulation pass (no timing compensation: quick, and enough
+/// for what the views show), with the built-in motion database.
+#[allow(dead_code)]
+pub fn render_once(loaded: &LoadedScore) -> timpanist::render::Rendering {
+    let db = timpanist::mocap::shipped::built_in().unwrap();
+    let params = RenderParams {
+        max_attempts: 1,
+        ..RenderParams::default()
+    };
+    render(loaded, &db, &params, &mut |_| true).unwrap()
+}
+
+/// The editor on `score` drawn with wgpu (a software GPU is enough), settled.
+#[allow(dead_code)]
+pub fn wgpu_editor(score: PathBuf, dir: &Path) -> Harness<'static, EditorApp> {
+    let options = options(Some(score), dir, false);
+    let mut h = builder()
+        .wgpu()
+        .build_eframe(move |_cc| EditorApp::with_options(options));
+    settle(&mut h);
+    h
+}
+
 /// Whether the File menu item `label` is disabled (opens and closes the menu).
 pub fn file_item_disabled(h: &mut Harness<'static, EditorApp>, label: &str) -> bool {
     use egui_kittest::kittest::{NodeT, Queryable};
