@@ -318,9 +318,12 @@ impl EditorApp {
         );
         if self.transport.playback.is_playing() || self.pipeline.is_composing() {
             ctx.request_repaint_after(std::time::Duration::from_millis(30));
-        } else if self.transport.playback.has_device() || self.transport.playback.is_recovering() {
-            // Watch the device while idle too (a lost one is looked for every second).
+        } else if self.transport.playback.is_recovering() {
+            // A lost device is looked for every second, and taken once its stream runs.
             ctx.request_repaint_after(device_watch::RETRY / 4);
+        } else if self.transport.playback.has_device() {
+            // Watch the device while idle too.
+            ctx.request_repaint_after(device_watch::RETRY);
         }
     }
 }

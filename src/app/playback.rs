@@ -63,7 +63,7 @@ impl DeviceEvent {
     /// A line for the status bar.
     pub fn message(&self) -> String {
         match self {
-            DeviceEvent::Lost(notice) => notice.clone(),
+            DeviceEvent::Lost(_) => "sound device lost: playing silently until it returns".into(),
             DeviceEvent::Back => "sound device back: playing on it again".into(),
         }
     }
