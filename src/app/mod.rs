@@ -12,6 +12,7 @@ mod api;
 mod chrome;
 mod clipboard;
 mod command;
+mod device_watch;
 mod dialogs;
 mod document;
 mod export;
@@ -23,6 +24,7 @@ mod inspector;
 mod jobs;
 mod keys;
 mod osc_out;
+mod output;
 pub mod picking;
 mod pipeline;
 pub mod playback;
@@ -317,6 +319,9 @@ impl EditorApp {
             ctx.send_viewport_cmd(egui::ViewportCommand::Title(title.clone()));
             self.shown_title = title;
         }
+        if let Some(event) = self.transport.playback.check_device() {
+            self.messages.status = event.message();
+        }
         let tick = self
             .transport
             .follow(self.doc.as_ref().map(|d| &d.loaded.score));
@@ -330,6 +335,12 @@ impl EditorApp {
         );
         if self.transport.playback.is_playing() || self.pipeline.is_composing() {
             ctx.request_repaint_after(std::time::Duration::from_millis(30));
+        } else if self.transport.playback.is_recovering() {
+            // A lost device is looked for every second, and taken once its stream runs.
+            ctx.request_repaint_after(device_watch::RETRY / 4);
+        } else if self.transport.playback.has_device() {
+            // Watch the device while idle too.
+            ctx.request_repaint_after(device_watch::RETRY);
         }
     }
 }

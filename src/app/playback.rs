@@ -11,13 +11,19 @@
 //! Slow motion ([`Playback::set_speed`] below 1): the clock runs on the wall clock
 //! scaled by the speed and the tape stays paused — the mix cannot be heard slowed down
 //! in sync, so it is muted (and [`SLOW_MOTION_NOTICE`] says so).
+//!
+//! A device that goes away while in use ([`Playback::check_device`], once per frame):
+//! when the tape has not been asked for audio for [`STALL`](super::device_watch::STALL)
+//! the silent clock takes over from where the sound stopped (the playhead keeps running)
+//! with [`LOST_NOTICE`]; a background thread then tries to open the device again every
+//! second, and once a new stream runs, the tape goes on on it from the clock's position
+//! with the same audio. Nothing on the UI thread waits for a device.
 
-use super::tape::{StereoSource, TapeData, TapeHandle};
-use kira::backend::cpal::CpalBackendSettings;
-use kira::backend::cpal::cpal::traits::{DeviceTrait, HostTrait};
-use kira::backend::cpal::cpal::{self, BufferSize};
-use kira::{AudioManager, AudioManagerSettings, DefaultBackend};
+use super::device_watch::{Retry, Stall};
+use super::output::Output;
+use super::tape::{Source, StereoSource, TapeHandle};
 use std::sync::Arc;
+use std::sync::mpsc::{Receiver, TryRecvError};
 use std::time::Instant;
 
 /// Sample rate of the audio given to [`Playback::set_audio`], Hz.
@@ -25,6 +31,9 @@ pub const AUDIO_RATE_HZ: u32 = super::tape::SOURCE_RATE_HZ;
 
 /// The notice shown when there is no sound device.
 pub const SILENT_NOTICE: &str = "No sound device: silent playback";
+
+/// The start of the notice shown while the device in use has gone.
+pub const LOST_NOTICE: &str = "Sound device lost: silent playback";
 
 /// The notice shown while playing slower than real time.
 pub const SLOW_MOTION_NOTICE: &str = "slow motion: audio muted";
@@ -41,13 +50,51 @@ pub enum PlaybackError {
     OddSampleCount(usize),
 }
 
+/// What happened to the device, for the status bar.
+#[derive(Clone, Debug, PartialEq)]
+pub enum DeviceEvent {
+    /// The device in use went away (the notice says why): playback is silent.
+    Lost(String),
+    /// It is back: playback sounds again.
+    Back,
+}
+
+impl DeviceEvent {
+    /// A line for the status bar.
+    pub fn message(&self) -> String {
+        match self {
+            DeviceEvent::Lost(_) => "sound device lost: playing silently until it returns".into(),
+            DeviceEvent::Back => "sound device back: playing on it again".into(),
+        }
+    }
+}
+
+/// Opens the device again (on a background thread).
+type Opener = Arc<dyn Fn() -> Result<Output, String> + Send + Sync>;
+
+/// Finding the device again after it went.
+struct Recovery {
+    opener: Opener,
+    retry: Retry,
+    /// The attempt in flight.
+    attempt: Option<Receiver<Result<Output, String>>>,
+    /// An output that opened, kept until its stream runs (or stalls and is dropped).
+    candidate: Option<(Output, Stall)>,
+}
+
 /// The playback clock and, when a device exists, the audio output.
 pub struct Playback {
-    /// The tape playing on the device (`None` without one).
-    tape: Option<TapeHandle>,
-    manager: Option<AudioManager<DefaultBackend>>,
+    /// The device with the tape on it (`None` without one).
+    output: Option<Output>,
+    /// Watches the output's heartbeat.
+    stall: Option<Stall>,
+    /// How to open the device again if it goes (`None` for the silent clock).
+    opener: Option<Opener>,
+    /// Set while the device has gone.
+    recovery: Option<Recovery>,
     notice: Option<String>,
-    has_audio: bool,
+    /// The audio set, kept to give a reopened device.
+    source: Option<Source>,
     /// Position when the clock last started or stopped, s.
     anchor_s: f64,
     /// When the clock last started; `None` when paused.
@@ -66,37 +113,47 @@ impl Playback {
     /// Open the output device named `device` (the default one when `None`, or when no
     /// device has that name any more, with a notice) with `buffer_frames` frames per
     /// buffer (the device's choice when `None`), and start the tape on it (paused); a
-    /// silent clock if no device opens.
+    /// silent clock if no device opens. Should the device go later, the same is opened
+    /// again when it returns.
     pub fn open(device: Option<&str>, buffer_frames: Option<u32>) -> Playback {
-        let mut p = Playback::silent();
-        let (settings, missing) = backend_settings(device, buffer_frames);
-        let settings = AudioManagerSettings {
-            backend_settings: settings,
-            ..AudioManagerSettings::default()
-        };
-        match AudioManager::<DefaultBackend>::new(settings) {
-            Ok(mut manager) => match manager.play(TapeData::new()) {
-                Ok(tape) => {
-                    p.tape = Some(tape);
-                    p.manager = Some(manager);
-                    p.notice = missing.map(|name| {
-                        format!("audio device \"{name}\" not found: playing on the default device")
-                    });
-                }
-                Err(e) => p.notice = Some(format!("{SILENT_NOTICE} (could not play: {e})")),
+        match Output::open(device, buffer_frames) {
+            Ok((output, missing)) => {
+                let notice = missing.map(|name| {
+                    format!("audio device \"{name}\" not found: playing on the default device")
+                });
+                let device = device.map(str::to_string);
+                let opener: Opener = Arc::new(move || {
+                    Output::open(device.as_deref(), buffer_frames).map(|(output, _)| output)
+                });
+                Playback::on_output(output, notice, opener)
+            }
+            Err(e) => Playback {
+                notice: Some(format!("{SILENT_NOTICE} ({e})")),
+                ..Playback::silent()
             },
-            Err(e) => p.notice = Some(format!("{SILENT_NOTICE} ({e})")),
         }
-        p
+    }
+
+    /// Playback on `output`, showing `notice`, reopening with `opener` if it goes.
+    fn on_output(output: Output, notice: Option<String>, opener: Opener) -> Playback {
+        Playback {
+            stall: Some(Stall::new(output.tape.frames_processed(), Instant::now())),
+            output: Some(output),
+            opener: Some(opener),
+            notice,
+            ..Playback::silent()
+        }
     }
 
     /// A silent clock without trying any device.
     pub fn silent() -> Playback {
         Playback {
-            tape: None,
-            manager: None,
+            output: None,
+            stall: None,
+            opener: None,
+            recovery: None,
             notice: Some(SILENT_NOTICE.to_string()),
-            has_audio: false,
+            source: None,
             anchor_s: 0.0,
             started: None,
             speed: 1.0,
@@ -110,12 +167,28 @@ impl Playback {
 
     /// Whether a sound device is in use.
     pub fn has_device(&self) -> bool {
-        self.tape.is_some()
+        self.output.is_some()
+    }
+
+    /// Whether the device in use has been asked for audio for about a second since it
+    /// opened (a stream that has just opened may wait before it runs; see
+    /// [`device_watch`](super::device_watch)). Read by [`check_device`](Self::check_device).
+    pub fn device_runs(&self) -> bool {
+        self.stall.as_ref().is_some_and(Stall::is_running)
+    }
+
+    /// Whether the device in use went away and is being looked for.
+    pub fn is_recovering(&self) -> bool {
+        self.recovery.is_some()
     }
 
     /// Whether audio has been set.
     pub fn has_audio(&self) -> bool {
-        self.has_audio
+        self.source.is_some()
+    }
+
+    fn tape(&mut self) -> Option<&mut TapeHandle> {
+        self.output.as_mut().map(|o| &mut o.tape)
     }
 
     /// Set the audio to play (stereo interleaved samples at [`AUDIO_RATE_HZ`], shared, not
@@ -127,10 +200,10 @@ impl Playback {
         if !n.is_multiple_of(2) {
             return Err(PlaybackError::OddSampleCount(n));
         }
-        if let Some(tape) = &mut self.tape {
-            tape.set_source(audio);
+        if let Some(tape) = self.tape() {
+            tape.set_source(Arc::clone(&audio));
         }
-        self.has_audio = true;
+        self.source = Some(audio);
         Ok(())
     }
 
@@ -138,13 +211,13 @@ impl Playback {
     pub fn play_from(&mut self, t_s: f64) {
         self.anchor_s = t_s.max(0.0);
         self.started = Some(Instant::now());
-        let real_time = self.is_real_time();
-        if let Some(tape) = &mut self.tape {
+        let (real_time, at) = (self.is_real_time(), self.anchor_s);
+        if let Some(tape) = self.tape() {
             if real_time {
-                tape.play_from(self.anchor_s);
+                tape.play_from(at);
             } else {
                 tape.pause();
-                tape.seek(self.anchor_s);
+                tape.seek(at);
             }
         }
     }
@@ -173,7 +246,7 @@ impl Playback {
     pub fn pause(&mut self) {
         self.anchor_s = self.position_s();
         self.started = None;
-        if let Some(tape) = &mut self.tape {
+        if let Some(tape) = self.tape() {
             tape.pause();
         }
     }
@@ -184,8 +257,9 @@ impl Playback {
             self.play_from(t_s);
         } else {
             self.anchor_s = t_s.max(0.0);
-            if let Some(tape) = &mut self.tape {
-                tape.seek(self.anchor_s);
+            let at = self.anchor_s;
+            if let Some(tape) = self.tape() {
+                tape.seek(at);
             }
         }
     }
@@ -198,11 +272,106 @@ impl Playback {
     /// The current position, s: the tape's while it plays on a device at real time,
     /// else the wall clock's times the speed.
     pub fn position_s(&self) -> f64 {
-        match (self.started, &self.tape) {
-            (Some(_), Some(tape)) if self.is_real_time() => tape.position_s(),
+        match (self.started, &self.output) {
+            (Some(_), Some(output)) if self.is_real_time() => output.tape.position_s(),
             (Some(t0), _) => self.anchor_s + t0.elapsed().as_secs_f64() * self.speed,
             (None, _) => self.anchor_s,
         }
+    }
+
+    /// Watch the device (call once per frame, and about once a second when idle): take
+    /// the silent clock when it has gone, look for it again while it is gone, and go back
+    /// to it when it has returned. What changed, if anything. Never waits.
+    pub fn check_device(&mut self) -> Option<DeviceEvent> {
+        let now = Instant::now();
+        if let (Some(output), Some(stall)) = (&mut self.output, &mut self.stall) {
+            let alive_at = stall.observe(output.tape.frames_processed(), now)?;
+            let reason = output
+                .last_error()
+                .unwrap_or_else(|| "the device stopped asking for audio".into());
+            return Some(self.lose(alive_at, &reason));
+        }
+        let recovery = self.recovery.as_mut()?;
+        if let Some((output, stall)) = &mut recovery.candidate {
+            let stalled = stall.observe(output.tape.frames_processed(), now);
+            if stall.has_moved() {
+                let (output, ..) = recovery.candidate.take()?;
+                self.resume(output, now);
+                return Some(DeviceEvent::Back);
+            }
+            if stalled.is_some() {
+                // It opened but never ran: let it go (off this thread) and try again.
+                let (dead, ..) = recovery.candidate.take()?;
+                std::thread::spawn(move || drop(dead));
+            }
+            return None;
+        }
+        if let Some(rx) = &recovery.attempt {
+            match rx.try_recv() {
+                Ok(Ok(output)) => {
+                    let stall = Stall::new(output.tape.frames_processed(), now);
+                    recovery.candidate = Some((output, stall));
+                    recovery.attempt = None;
+                    return None;
+                }
+                Ok(Err(_)) | Err(TryRecvError::Disconnected) => recovery.attempt = None,
+                Err(TryRecvError::Empty) => return None,
+            }
+        }
+        if recovery.retry.due(now) {
+            let (tx, rx) = std::sync::mpsc::channel();
+            let opener = Arc::clone(&recovery.opener);
+            std::thread::spawn(move || {
+                // The receiver may be gone (playback dropped): then the output just drops.
+                let _ = tx.send(opener());
+            });
+            recovery.attempt = Some(rx);
+        }
+        None
+    }
+
+    /// The device went (its heartbeat last moved at `alive_at`): the silent clock takes
+    /// over from the tape's position then, and recovery starts.
+    fn lose(&mut self, alive_at: Instant, reason: &str) -> DeviceEvent {
+        let Some(output) = self.output.take() else {
+            return DeviceEvent::Lost(self.notice.clone().unwrap_or_default());
+        };
+        self.stall = None;
+        if self.is_playing() && self.is_real_time() {
+            self.anchor_s = output.tape.position_s();
+            self.started = Some(alive_at);
+        }
+        // Dropping kira's manager only flags its stream thread; still, never on this one.
+        std::thread::spawn(move || drop(output));
+        let notice = format!("{LOST_NOTICE} ({reason}); looking for it every second");
+        self.notice = Some(notice.clone());
+        self.recovery = self.opener.clone().map(|opener| Recovery {
+            opener,
+            retry: Retry::default(),
+            attempt: None,
+            candidate: None,
+        });
+        DeviceEvent::Lost(notice)
+    }
+
+    /// The device is back as `output` (its stream running): give it the audio and go on
+    /// from the clock's position.
+    fn resume(&mut self, mut output: Output, now: Instant) {
+        if let Some(source) = &self.source {
+            output.tape.set_source(Arc::clone(source));
+        }
+        let at = self.position_s();
+        if self.is_playing() && self.is_real_time() {
+            output.tape.play_from(at);
+            self.anchor_s = at;
+            self.started = Some(now);
+        } else {
+            output.tape.seek(at);
+        }
+        self.stall = Some(Stall::new(output.tape.frames_processed(), now));
+        self.output = Some(output);
+        self.recovery = None;
+        self.notice = None;
     }
 }
 
@@ -212,40 +381,15 @@ impl Default for Playback {
     }
 }
 
-/// The names of the output devices the system has now (listed afresh each call, so a
-/// device plugged in or out shows at the next call).
-pub fn output_devices() -> Vec<String> {
-    let host = cpal::default_host();
-    host.output_devices()
-        .map(|devices| devices.map(|d| d.to_string()).collect())
-        .unwrap_or_default()
-}
-
-/// The backend settings for `device` and `buffer_frames`, and the name asked for when no
-/// device has it.
-fn backend_settings(
-    device: Option<&str>,
-    buffer_frames: Option<u32>,
-) -> (CpalBackendSettings, Option<String>) {
-    let host = cpal::default_host();
-    let found = device.and_then(|name| host.output_devices().ok()?.find(|d| d.to_string() == name));
-    let missing = device.filter(|_| found.is_none()).map(str::to_string);
-    let config = buffer_frames.and_then(|frames| {
-        let chosen = found.clone().or_else(|| host.default_output_device())?;
-        let mut config = chosen.default_output_config().ok()?.config();
-        config.buffer_size = BufferSize::Fixed(frames);
-        Some(config)
-    });
-    let settings = CpalBackendSettings {
-        device: found,
-        config,
-    };
-    (settings, missing)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use kira::Frame;
+    use kira::info::MockInfoBuilder;
+    use kira::sound::Sound;
+    use std::sync::Mutex;
+    use std::sync::atomic::{AtomicU32, Ordering};
+    use std::sync::mpsc;
     use std::time::Duration;
 
     /// The silent clock runs from where it was started, pauses, and seeks.
@@ -310,5 +454,106 @@ mod tests {
             p.set_audio(Arc::new(vec![0.0; 3])),
             Err(PlaybackError::OddSampleCount(3))
         ));
+    }
+
+    /// 10 ms of output from `sound`, as a 48 kHz device asks; the frames.
+    fn ten_ms(sound: &mut dyn Sound) -> Vec<Frame> {
+        let mut out = vec![Frame::ZERO; 480];
+        sound.process(&mut out, 1.0 / 48_000.0, &MockInfoBuilder::new().build());
+        out
+    }
+
+    /// Call `check_device` every 20 ms until `done` says yes (at most `limit_s`).
+    fn poll_until<T>(
+        p: &mut Playback,
+        limit_s: f64,
+        mut done: impl FnMut(&mut Playback, Option<DeviceEvent>) -> Option<T>,
+    ) -> T {
+        let t0 = Instant::now();
+        loop {
+            let event = p.check_device();
+            if let Some(v) = done(p, event) {
+                return v;
+            }
+            assert!(
+                t0.elapsed().as_secs_f64() < limit_s,
+                "nothing after {limit_s} s"
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+
+    /// The device going mid-play, with outputs on no device whose sounds the test plays
+    /// by hand: the silent clock takes over from where the sound stopped (the playhead
+    /// keeps running) with the notice; the device is looked for once a second, off this
+    /// thread; an attempt that fails is let go; one that opens is back once its stream is
+    /// asked for audio, gets the audio and plays on from the clock's position, and the
+    /// notice goes.
+    #[test]
+    fn a_lost_device_falls_back_to_the_clock_and_comes_back() {
+        let (output, mut sound) = Output::detached();
+        let (tx, rx) = mpsc::channel::<Box<dyn Sound>>();
+        let tx = Mutex::new(tx);
+        let attempts = Arc::new(AtomicU32::new(0));
+        let counted = Arc::clone(&attempts);
+        let opener: Opener = Arc::new(move || {
+            if counted.fetch_add(1, Ordering::SeqCst) == 0 {
+                return Err("not there yet".into());
+            }
+            let (output, sound) = Output::detached();
+            tx.lock().unwrap().send(sound).unwrap();
+            Ok(output)
+        });
+        let mut p = Playback::on_output(output, None, opener);
+        p.set_audio(Arc::new(vec![0.5; 2 * 48_000 * 20])).unwrap();
+        p.play_from(1.0);
+        let mut last = Vec::new();
+        for _ in 0..120 {
+            last = ten_ms(sound.as_mut());
+            assert_eq!(p.check_device(), None);
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        assert!(last.iter().all(|f| f.left == 0.5), "the audio plays");
+        assert!((p.position_s() - 2.2).abs() < 1e-9, "{}", p.position_s());
+        assert!(p.device_runs());
+
+        // The device stops asking for audio.
+        let stopped = Instant::now();
+        let notice = poll_until(&mut p, 2.0, |_, e| match e {
+            Some(DeviceEvent::Lost(n)) => Some(n),
+            _ => None,
+        });
+        let waited = stopped.elapsed().as_secs_f64();
+        assert!(notice.starts_with(LOST_NOTICE), "{notice}");
+        assert_eq!(p.notice(), Some(notice.as_str()));
+        assert!(!p.has_device() && p.is_recovering() && p.is_playing());
+        let t = p.position_s();
+        assert!(
+            t >= 2.2 + waited - 0.01 && t < 2.2 + waited + 0.05,
+            "{t} after {waited} s"
+        );
+
+        // The first attempt fails; the second opens an output, back once it is asked for
+        // audio.
+        let mut comes_back = poll_until(&mut p, 3.0, |p, e| {
+            assert_eq!(e, None);
+            assert!(!p.has_device());
+            rx.try_recv().ok()
+        });
+        assert_eq!(attempts.load(Ordering::SeqCst), 2);
+        assert_eq!(p.check_device(), None, "not back until its stream runs");
+        ten_ms(comes_back.as_mut());
+        let resumed_at = p.position_s();
+        assert_eq!(p.check_device(), Some(DeviceEvent::Back));
+        assert!(p.has_device() && !p.is_recovering() && p.notice().is_none());
+        for _ in 0..10 {
+            last = ten_ms(comes_back.as_mut());
+        }
+        assert!(last.iter().all(|f| f.left == 0.5), "the audio plays again");
+        let t = p.position_s();
+        assert!(
+            (t - (resumed_at + 0.1)).abs() < 0.02,
+            "{t} vs {resumed_at} + 0.1"
+        );
     }
 }

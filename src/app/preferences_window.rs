@@ -88,7 +88,7 @@ impl EditorApp {
         }
         let s = &mut self.settings;
         if s.use_device && s.listed_at.is_none_or(|t| t.elapsed() >= DEVICE_POLL) {
-            s.devices = playback::output_devices();
+            s.devices = super::output::output_devices();
             s.listed_at = Some(Instant::now());
         }
         ctx.request_repaint_after(DEVICE_POLL);

@@ -80,6 +80,9 @@ struct Shared {
     applied: AtomicU64,
     /// Cleared when the handle is dropped: the sound is then finished.
     handle_alive: AtomicBool,
+    /// Output frames processed so far: the heartbeat of the audio thread, which stops
+    /// when the device does.
+    frames: AtomicU64,
 }
 
 /// The tape before it plays: give it to [`kira::AudioManager::play`] (once) to get its
@@ -98,6 +101,7 @@ impl TapeData {
             position: AtomicU64::new(0.0f64.to_bits()),
             applied: AtomicU64::new(0),
             handle_alive: AtomicBool::new(true),
+            frames: AtomicU64::new(0),
         });
         TapeData {
             sound: TapeSound {
@@ -204,6 +208,12 @@ impl TapeHandle {
         } else {
             self.asked_s + self.asked_at.map_or(0.0, |t| t.elapsed().as_secs_f64())
         }
+    }
+
+    /// The output frames the audio thread has processed so far (paused or not): it stops
+    /// counting when the device stops asking for audio.
+    pub fn frames_processed(&self) -> u64 {
+        self.shared.frames.load(Ordering::Relaxed)
     }
 
     /// Drop the sources the audio thread has let go of, and send commands that did not
@@ -377,6 +387,9 @@ impl Sound for TapeSound {
             step = 1.0;
         }
         let ramp = (dt / FADE_S).min(1.0);
+        self.shared
+            .frames
+            .fetch_add(out.len() as u64, Ordering::Relaxed);
         for frame in out {
             if self.fading.is_none() {
                 self.take_commands();
@@ -685,5 +698,19 @@ mod tests {
         }
         let t = h.position_s();
         assert!(t > 0.5 && t < 0.6, "{t}");
+    }
+
+    /// The heartbeat counts every frame asked for, paused or playing, and only those.
+    #[test]
+    fn the_heartbeat_counts_frames_asked_for() {
+        let (mut sound, mut h) = tape();
+        assert_eq!(h.frames_processed(), 0);
+        run(sound.as_mut(), 1000, DT);
+        assert_eq!(h.frames_processed(), 1000);
+        h.set_source(constant(0.5, 48_000));
+        h.play_from(0.0);
+        run(sound.as_mut(), 500, DT);
+        assert_eq!(h.frames_processed(), 1500);
+        assert_eq!(h.frames_processed(), 1500, "no frames asked, no beats");
     }
 }
