@@ -9,6 +9,7 @@ use egui_kittest::kittest::Queryable;
 use std::path::Path;
 use std::time::{Duration, Instant};
 use timpanist::app::EditorApp;
+use timpanist::app::playback::SLOW_MOTION_NOTICE as SLOW;
 
 fn harness(dir: &Path) -> Harness<'static, EditorApp> {
     harness_on(dir, "etude-modes")
@@ -37,12 +38,12 @@ fn slow_motion() {
     let mut h = harness(dir.path());
     let none = egui::Modifiers::NONE;
     assert_eq!(h.state().playback().speed(), 1.0);
-    assert!(h.query_by_label("slow motion: audio muted").is_none());
+    assert!(h.query_by_label(SLOW).is_none());
     for expected in [0.5, 0.25, 0.1, 0.1] {
         press(&mut h, none, egui::Key::OpenBracket);
         assert_eq!(h.state().playback().speed(), expected);
     }
-    h.get_by_label("slow motion: audio muted");
+    h.get_by_label(SLOW);
     press(&mut h, none, egui::Key::CloseBracket);
     assert_eq!(h.state().playback().speed(), 0.25);
     press(&mut h, none, egui::Key::Space);
@@ -58,7 +59,7 @@ fn slow_motion() {
         press(&mut h, none, egui::Key::CloseBracket);
     }
     assert!(h.state().playback().is_real_time());
-    assert!(h.query_by_label("slow motion: audio muted").is_none());
+    assert!(h.query_by_label(SLOW).is_none());
 }
 
 /// `.` and `,` step the playhead by video frames (1/60 s, pausing playback);
@@ -296,4 +297,44 @@ fn target_and_previous_rendering_overlaid() {
     );
     assert!(h.query_by_label("previous rendering").is_none());
     assert!(h.query_by_label("target pose (IK)").is_some());
+}
+
+/// In slow motion each contact the playhead passes is played once, at full speed (the
+/// mix itself is muted); at real time none is (the mix plays). The first contact after
+/// 0.5 s is played over.
+#[test]
+fn strikes_sound_in_slow_motion() {
+    use std::sync::Arc;
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness_on(dir.path(), "improvisation");
+    let rendering = common::render_once(h.state().loaded().unwrap());
+    let first = (rendering.drums.contacts().iter())
+        .map(|c| c.start_s)
+        .find(|t| *t > 0.5)
+        .unwrap();
+    h.state_mut().set_rendering(Arc::new(rendering));
+    common::settle(&mut h);
+    let none = egui::Modifiers::NONE;
+    let play_over_first_contact = |h: &mut Harness<'static, EditorApp>| {
+        h.state_mut().seek(first - 0.03);
+        h.key_press(egui::Key::Space);
+        let t = Instant::now();
+        while h.state().playback().played_once() == 0 && t.elapsed() < Duration::from_secs(3) {
+            h.step();
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        h.key_press(egui::Key::Space);
+        h.step();
+    };
+    play_over_first_contact(&mut h);
+    assert_eq!(
+        h.state().playback().played_once(),
+        0,
+        "real time plays the mix"
+    );
+    press(&mut h, none, egui::Key::OpenBracket);
+    press(&mut h, none, egui::Key::OpenBracket);
+    assert_eq!(h.state().playback().speed(), 0.25);
+    play_over_first_contact(&mut h);
+    assert_eq!(h.state().playback().played_once(), 1);
 }

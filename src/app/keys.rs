@@ -121,7 +121,7 @@ pub const SHORTCUTS: &[Shortcut] = &[
         Key::OpenBracket,
         Action::Speed(-1),
         "[",
-        "slower playback (1, 1/2, 1/4, 1/10; audio muted below 1)",
+        "slower playback (1, 1/2, 1/4, 1/10; below 1 each strike sounds as it passes)",
     ),
     chord(
         NONE,

@@ -39,6 +39,7 @@ mod selection;
 mod session;
 mod settings_panel;
 mod solid_frame;
+mod strike_sounds;
 pub mod tape;
 mod tempo_lane;
 mod time_axis;

@@ -54,6 +54,25 @@ impl Output {
         (output, sound)
     }
 
+    /// Play `frames` (stereo at `rate_hz`) once, over the tape; false without a device.
+    pub fn play_once(&mut self, frames: &[[f32; 2]], rate_hz: u32) -> bool {
+        use kira::Frame;
+        use kira::sound::static_sound::{StaticSoundData, StaticSoundSettings};
+        let Some(manager) = self.manager.as_mut() else {
+            return false;
+        };
+        let data = StaticSoundData {
+            sample_rate: rate_hz,
+            frames: frames
+                .iter()
+                .map(|&[left, right]| Frame { left, right })
+                .collect(),
+            settings: StaticSoundSettings::default(),
+            slice: None,
+        };
+        manager.play(data).is_ok()
+    }
+
     /// The last stream error the backend reported since the last call (the older ones
     /// are dropped), as text.
     pub fn last_error(&mut self) -> Option<String> {

@@ -10,7 +10,9 @@
 //!
 //! Slow motion ([`Playback::set_speed`] below 1): the clock runs on the wall clock
 //! scaled by the speed and the tape stays paused — the mix cannot be heard slowed down
-//! in sync, so it is muted (and [`SLOW_MOTION_NOTICE`] says so).
+//! in sync, so it is muted, and each contact the playhead passes is played at full speed
+//! instead ([`Playback::play_once`], `super::strike_sounds`; [`SLOW_MOTION_NOTICE`] says
+//! so).
 //!
 //! A device that goes away while in use ([`Playback::check_device`], once per frame):
 //! when the tape has not been asked for audio for [`STALL`](super::device_watch::STALL)
@@ -36,7 +38,8 @@ pub const SILENT_NOTICE: &str = "No sound device: silent playback";
 pub const LOST_NOTICE: &str = "Sound device lost: silent playback";
 
 /// The notice shown while playing slower than real time.
-pub const SLOW_MOTION_NOTICE: &str = "slow motion: audio muted";
+pub const SLOW_MOTION_NOTICE: &str =
+    "slow motion: the mix is muted, each strike sounds as it passes";
 
 /// The playback speeds offered, fastest first (1 = real time).
 pub const SPEEDS: [f64; 4] = [1.0, 0.5, 0.25, 0.1];
@@ -101,6 +104,8 @@ pub struct Playback {
     started: Option<Instant>,
     /// Score seconds per wall-clock second (1: real time, with sound).
     speed: f64,
+    /// Sounds given to [`Playback::play_once`] (played or, silent, only counted).
+    played_once: usize,
 }
 
 impl Playback {
@@ -157,7 +162,22 @@ impl Playback {
             anchor_s: 0.0,
             started: None,
             speed: 1.0,
+            played_once: 0,
         }
+    }
+
+    /// Play `frames` (stereo at [`AUDIO_RATE_HZ`]) once on the device, over whatever the
+    /// tape does (slow motion's strikes); counted, and only counted on the silent clock.
+    pub fn play_once(&mut self, frames: &[[f32; 2]]) {
+        self.played_once += 1;
+        if let Some(output) = &mut self.output {
+            output.play_once(frames, AUDIO_RATE_HZ);
+        }
+    }
+
+    /// How many sounds [`Playback::play_once`] was given.
+    pub fn played_once(&self) -> usize {
+        self.played_once
     }
 
     /// Why playback is silent, if it is.

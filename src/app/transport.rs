@@ -1,10 +1,12 @@
 //! The transport: the playhead, the loop region and the playback clock it follows, and
 //! Space's rule — play at once if the audio past the playhead is rendered, else wait for
 //! it (the rendering worker delivers the edited part first, then the rest). Also slow
-//! motion (the speeds of [`SPEEDS`], audio muted below 1) and stepping the playhead by a
+//! motion (the speeds of [`SPEEDS`]; below 1 the mix is muted and each contact passed
+//! sounds at full speed, `super::strike_sounds`) and stepping the playhead by a
 //! video frame ([`FRAME_S`]) or to the previous or next contact.
 
 use super::playback::{Playback, PlaybackError, SPEEDS};
+use super::strike_sounds::StrikeSounds;
 use super::tape::StereoSource;
 use crate::render::Rendering;
 use crate::score::Score;
@@ -29,6 +31,8 @@ pub struct Transport {
     audio_ready_s: f64,
     /// Space was pressed where the audio is not ready yet: play once it is.
     waiting_to_play: bool,
+    /// The contacts heard one by one in slow motion.
+    strikes: StrikeSounds,
 }
 
 impl Transport {
@@ -41,6 +45,7 @@ impl Transport {
             looping: false,
             audio_ready_s: f64::INFINITY,
             waiting_to_play: false,
+            strikes: StrikeSounds::default(),
         }
     }
 
@@ -51,6 +56,7 @@ impl Transport {
         self.playhead_s = 0.0;
         self.loop_ticks = None;
         self.waiting_to_play = false;
+        self.strikes.clear();
     }
 
     /// Move the playhead to `t_s` (clamped at 0), s.
@@ -96,6 +102,7 @@ impl Transport {
         };
         self.playback
             .set_audio(Arc::clone(rendering) as Arc<dyn StereoSource>)?;
+        self.strikes.set(rendering);
         self.audio_ready_s = ready_s;
         if self.waiting_to_play && self.playhead_s + PLAY_AHEAD_S <= self.audio_ready_s {
             self.waiting_to_play = false;
@@ -162,7 +169,15 @@ impl Transport {
         if !self.playback.is_playing() {
             return None;
         }
+        let before = self.playhead_s;
         self.playhead_s = self.playback.position_s();
+        if self.playback.speed() < 1.0 {
+            let passed = self.strikes.crossed(before, self.playhead_s).to_vec();
+            for t in passed {
+                let sound = self.strikes.snippet(t);
+                self.playback.play_once(&sound);
+            }
+        }
         let score = score?;
         let map = score.tempo_map();
         if self.looping
