@@ -226,17 +226,7 @@ fn trajectories_coloured_by_speed_or_phase() {
     assert_eq!(h.state().trajectory_colour(), TrailColour::Plain);
     h.get_by_label("left target");
     assert!(h.query_by_label("tip speed, m/s").is_none());
-    let choose = |h: &mut Harness<'static, EditorApp>, item: &str| {
-        h.get_by_label("View").click();
-        h.run();
-        h.get_by_label(item).click();
-        common::settle(h);
-        // Close the menu if the choice left it open.
-        if h.query_by_label(item).is_some() {
-            h.key_press(egui::Key::Escape);
-            common::settle(h);
-        }
-    };
+    let choose = |h: &mut Harness<'static, EditorApp>, item: &str| common::choose(h, "View", item);
     choose(&mut h, "Trajectories coloured by speed");
     assert_eq!(h.state().trajectory_colour(), TrailColour::Speed);
     h.get_by_label("tip speed, m/s");
@@ -266,14 +256,7 @@ fn target_and_previous_rendering_overlaid() {
     let mut louder = loaded;
     louder.score.beats[1].dynamic = timpanist::score::Dynamic::Ff;
     let after = common::render_once(&louder);
-    let toggle = |h: &mut Harness<'static, EditorApp>, item: &str| {
-        h.get_by_label("View").click();
-        h.run();
-        h.get_by_label(item).click();
-        h.run();
-        h.key_press(egui::Key::Escape);
-        common::settle(h);
-    };
+    let toggle = |h: &mut Harness<'static, EditorApp>, item: &str| common::choose(h, "View", item);
     toggle(
         &mut h,
         "Overlay the target pose (composed tips through the IK)",

@@ -8,7 +8,6 @@ mod common;
 
 use eframe::egui;
 use egui_kittest::Harness;
-use egui_kittest::kittest::Queryable;
 use timpanist::app::EditorApp;
 
 fn window() -> (Harness<'static, EditorApp>, tempfile::TempDir) {
@@ -39,11 +38,6 @@ fn main_window_snapshot() {
 #[test]
 fn flat_view_snapshot() {
     let (mut h, _dir) = window();
-    h.get_by_label("View").click();
-    h.run();
-    h.get_by_label("Flat 3D view (no lighting)").click();
-    h.run();
-    h.key_press(egui::Key::Escape);
-    common::settle(&mut h);
+    common::choose(&mut h, "View", "Flat 3D view (no lighting)");
     snapshot(&mut h, "main_window_flat");
 }

@@ -463,13 +463,12 @@ impl CallbackTrait for Callback {
         pass: &mut wgpu::RenderPass<'static>,
         resources: &CallbackResources,
     ) {
-        let Some(targets) = resources
-            .get::<Resources>()
-            .and_then(|r| r.targets.as_ref())
-        else {
+        let Some(res) = resources.get::<Resources>() else {
             return;
         };
-        let res = resources.get::<Resources>().expect("checked above");
+        let Some(targets) = &res.targets else {
+            return;
+        };
         pass.set_pipeline(&res.blit);
         pass.set_bind_group(0, &targets.blit_group, &[]);
         pass.draw(0..3, 0..1);

@@ -37,9 +37,8 @@ pub struct HeadShapes {
 impl HeadShapes {
     /// Each drum's displacement (m) at its grid points at `time_s`, zeros at rest.
     fn displacements(&mut self, kit: &Kit, drums: Option<&DrumSet>, time_s: f64) -> Vec<Vec<f64>> {
-        let grids: Vec<_> = kit.drums.iter().map(solid::head_grid).collect();
         let Some(drums) = drums else {
-            return grids.iter().map(|g| vec![0.0; g.len()]).collect();
+            return vec![vec![0.0; solid::HEAD_GRID_POINTS]; kit.drums.len()];
         };
         let key = (
             std::ptr::from_ref(drums) as usize,
@@ -47,8 +46,7 @@ impl HeadShapes {
             drums.contacts().len(),
         );
         if self.key != Some(key) {
-            self.shapes = grids
-                .iter()
+            self.shapes = (kit.drums.iter().map(solid::head_grid))
                 .enumerate()
                 .map(|(d, grid)| {
                     grid.iter()

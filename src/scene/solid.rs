@@ -57,6 +57,8 @@ const CAP_ROWS: usize = 4;
 /// Rings and sectors of a head's grid.
 pub const HEAD_RINGS: usize = 8;
 pub const HEAD_SECTORS: usize = 32;
+/// Points of a head's grid ([`head_grid`]).
+pub const HEAD_GRID_POINTS: usize = (HEAD_RINGS + 1) * (HEAD_SECTORS + 1);
 /// Radius of a felt mallet ball drawn at each stick's tip, m.
 pub const MALLET_RADIUS_M: f64 = 0.018;
 /// Radius of a stick's shaft as drawn, m.
@@ -169,7 +171,7 @@ pub fn floor(out: &mut Mesh) {
 pub fn head_grid(drum: &Drum) -> Vec<DVec3> {
     let centre = drum.centre();
     let r = drum.radius_m();
-    let mut points = Vec::with_capacity((HEAD_RINGS + 1) * (HEAD_SECTORS + 1));
+    let mut points = Vec::with_capacity(HEAD_GRID_POINTS);
     for ring in 0..=HEAD_RINGS {
         let rho = r * ring as f64 / HEAD_RINGS as f64;
         for k in 0..=HEAD_SECTORS {
@@ -236,12 +238,8 @@ pub fn drum(drum: &Drum, displacement: &[f64], out: &mut Mesh, shadows: &mut Mes
         let dr = r / HEAD_RINGS as f64;
         let radial = (height(ring + 1, k) - height(ring.saturating_sub(1), k))
             / (dr * (1 + usize::from(ring > 0 && ring < HEAD_RINGS)) as f64);
-        let n = DVec3::new(
-            -radial * (TAU * k as f64 / HEAD_SECTORS as f64).cos(),
-            -radial * (TAU * k as f64 / HEAD_SECTORS as f64).sin(),
-            1.0,
-        )
-        .normalize();
+        let angle = TAU * k as f64 / HEAD_SECTORS as f64;
+        let n = DVec3::new(-radial * angle.cos(), -radial * angle.sin(), 1.0).normalize();
         out.push(
             *p + DVec3::Z * heights[i],
             n,
@@ -381,7 +379,6 @@ mod tests {
         let size = DVec2::new(900.0, 500.0);
         let m = view_projection(&cam, size);
         let proj = cam.projector(size);
-        let mut last_depth = -1.0;
         for p in [
             DVec3::new(0.0, 0.4, 0.8),
             DVec3::new(0.3, 0.7, 1.1),
@@ -393,8 +390,6 @@ mod tests {
             let screen = DVec2::new((ndc.x + 1.0) * 0.5 * size.x, (1.0 - ndc.y) * 0.5 * size.y);
             assert!((screen - px).length() < 1e-6, "{screen} vs {px}");
             assert!((0.0..1.0).contains(&ndc.z));
-            let _ = last_depth;
-            last_depth = ndc.z;
         }
         let eye = cam.basis().eye;
         let near = m * (eye + cam.basis().forward * 0.5).extend(1.0);
@@ -441,7 +436,7 @@ mod tests {
         let kit = Kit::standard();
         let d = &kit.drums[2];
         let points = head_grid(d);
-        assert_eq!(points.len(), (HEAD_RINGS + 1) * (HEAD_SECTORS + 1));
+        assert_eq!(points.len(), HEAD_GRID_POINTS);
         let (mut rest, mut shadows) = (Mesh::default(), Mesh::default());
         drum(d, &vec![0.0; points.len()], &mut rest, &mut shadows);
         let head_z = d.placement.head_height_m as f32;

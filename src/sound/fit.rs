@@ -231,6 +231,7 @@ pub fn fit(
         .map(|n| measure(&n.samples, n.rate_hz).ok_or_else(|| FitError::NoPitch(n.name.clone())))
         .collect::<Result<_, _>>()?;
     let kits: Vec<Kit> = measured.iter().map(|m| kit_for(m.pitch_hz)).collect();
+    let thump_seen: Vec<bool> = kits.iter().map(thump_measurable).collect();
     let mut cal = start.clone();
     cal.fitted_from = notes.iter().map(|n| n.name.clone()).collect();
     // The listed partials: each recording's T60 at the kit's ratio, geometric mean.
@@ -267,12 +268,14 @@ pub fn fit(
         let mut t60_ratios: [Vec<f64>; 7] = Default::default();
         let mut thump_steps = Vec::new();
 
-        for ((note, target), kit) in notes.iter().zip(&measured).zip(&kits) {
+        for (((note, target), kit), &thump_seen) in
+            notes.iter().zip(&measured).zip(&kits).zip(&thump_seen)
+        {
             let audio = stroke(kit, Dynamic::Mf, &cal, NOTE_S)?;
             let model = measure(&audio, super::SAMPLE_RATE_HZ)
                 .ok_or_else(|| FitError::NoPitch(format!("the model's {}", note.name)))?;
 
-            if thump_measurable(kit) {
+            if thump_seen {
                 thump_steps.push(target.thump_db - model.thump_db);
             }
             let mut bands_db = [0.0; 7];

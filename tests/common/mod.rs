@@ -136,6 +136,21 @@ pub fn wgpu_editor(score: PathBuf, dir: &Path) -> Harness<'static, EditorApp> {
     h
 }
 
+/// Open the menu `menu`, click its item `item`, and close the menu if the item left it
+/// open (a checkbox does).
+#[allow(dead_code)]
+pub fn choose(h: &mut Harness<'static, EditorApp>, menu: &str, item: &str) {
+    use egui_kittest::kittest::Queryable;
+    h.get_by_label(menu).click();
+    h.run();
+    h.get_by_label(item).click();
+    settle(h);
+    if h.query_by_label(item).is_some() {
+        h.key_press(egui::Key::Escape);
+        settle(h);
+    }
+}
+
 /// Whether the File menu item `label` is disabled (opens and closes the menu).
 pub fn file_item_disabled(h: &mut Harness<'static, EditorApp>, label: &str) -> bool {
     use egui_kittest::kittest::{NodeT, Queryable};
