@@ -75,8 +75,10 @@ fn demo_scores_strike_every_beat_on_time() {
             path.display()
         );
     }
+    // The compensation aims a pressed stroke shallower and tries further (before it did,
+    // 7 of the 302 lasted 8.0–8.8 ms).
     assert!(
-        long * 100 <= 3 * all.len(),
+        long * 100 <= all.len(),
         "{long} of {} contacts over 8 ms",
         all.len()
     );
@@ -187,7 +189,7 @@ fn assert_joints_within_limits(path: &Path, r: &Rendering) {
 
 /// The ladder moved to the outer drums (the right hand on the 23-inch, the left on the
 /// 32-inch, whose slack head swings back hardest): forces still follow the dynamics, no
-/// stick falls back on a head, every stroke within 3 ms.
+/// stick falls back on a head, every contact lasts 2–8 ms, every stroke within 3 ms.
 #[test]
 fn ladder_on_the_outer_drums() {
     let mut loaded = LoadedScore::load(&root().join("scores/dynamics-ladder.ron")).unwrap();
@@ -199,6 +201,10 @@ fn ladder_on_the_outer_drums() {
     forces_follow_dynamics(&r.events);
     let scored: Vec<_> = r.events.iter().filter(|e| e.beat.is_some()).collect();
     assert!(scored.iter().all(|e| e.recontacts == 0), "re-contacts");
+    assert!(
+        scored.iter().all(|e| (2.0..=8.0).contains(&e.duration_ms)),
+        "a contact outside 2–8 ms"
+    );
     let worst = scored
         .iter()
         .map(|e| (e.contact_s - e.scheduled_s.unwrap()).abs())

@@ -4,9 +4,10 @@
 //! than [`CLUSTER_GAP_S`] (either hand) are settled together: from a saved state before
 //! the cluster, the body and the drums are simulated a little past its last stroke, the
 //! contacts measured, the cluster's shifts and depths corrected and the span simulated
-//! again, a few times; the best attempt is kept (fewest strokes missed, then far off
-//! their force, then re-contacts — the stick falling back on a head —, then the worst
-//! timing) and the performance moves on. Each
+//! again, a few times; the best attempt is kept (fewest strokes missed, then re-contacts —
+//! the stick falling back on a head —, then contacts out of time, forces far off their
+//! aim, contacts pressed too long, forces a little off, then the worst timing) and the
+//! performance moves on. Each
 //! cluster starts from its predecessors' settled shifts and depths (same hand, mode and
 //! dynamic), so repeated material settles at once.
 //!
@@ -35,6 +36,11 @@ const MAX_SHIFT_S: f64 = 0.035;
 const GRAZE_FRACTION: f64 = 0.25;
 /// The deepest a stroke aims below the head, m.
 const MAX_DEPTH_M: f64 = 0.06;
+/// A stroke off its aimed force by more than this fraction is far off: its cluster gets
+/// more attempts.
+const FAR_FRACTION: f64 = 0.15;
+/// How much shallower a stroke on its force aims when its contact lasted too long.
+const PRESSED_DEPTH: f64 = 0.85;
 /// The shift moves to a cluster's over at most this long before its first dip, s.
 const TRANSITION_S: f64 = 0.06;
 /// Within a lead-in, a state is saved every this many seconds (so an edit there resumes
@@ -58,6 +64,9 @@ pub struct Aims {
     pub max_attempts: usize,
     /// Depth of a stroke with no settled predecessor, m.
     pub first_depth_m: f64,
+    /// A contact longer than this, s, is the hand pressing the stick into the head: the
+    /// stroke aims shallower and its attempt ranks below one without.
+    pub max_contact_s: f64,
 }
 
 /// A cluster's start or end, or a point in a lead-in: a state the performance can resume
@@ -340,7 +349,12 @@ impl Performance {
         self.commits.push(commit.clone());
         let last_s = self.targets.knots(cluster.end - 1, 0.0)[1].0;
         let until = (((last_s + LOOKAHEAD_S) * rate).ceil() as usize).clamp(commit.samples, n);
-        type Attempt = ((usize, usize, bool, usize, f64), Vec<f64>, Vec<f64>, usize);
+        type Attempt = (
+            (usize, usize, bool, usize, usize, usize, f64),
+            Vec<f64>,
+            Vec<f64>,
+            usize,
+        );
         let mut best: Option<Attempt> = None;
         // Per stroke of the cluster, the (depth, peak force) its attempts met, for the
         // secant on the depth.
@@ -378,17 +392,23 @@ impl Performance {
             let mut worst = 0.0f64;
             // Strokes whose force is off its aim by more than the tolerance.
             let mut off_force = 0;
+            // Strokes far off it.
+            let mut far = 0;
+            // Strokes whose contact lasts too long.
+            let mut long = 0;
             for ((i, m), tried) in cluster.clone().zip(&matches).zip(&mut tried) {
                 match m {
                     Some(c) => {
                         worst = worst.max((contacts[*c].start_s - strokes[i].time_s).abs());
                         let ratio = contacts[*c].peak_force_n / aims.force_n[i];
                         tried.push((self.targets.depth(i), contacts[*c].peak_force_n));
+                        long += usize::from(contacts[*c].duration_s() > aims.max_contact_s);
                         if ratio < GRAZE_FRACTION {
                             // A graze is not a stroke: as bad as none.
                             missed += 1;
                         } else if (ratio - 1.0).abs() > aims.force_tolerance {
                             off_force += 1;
+                            far += usize::from((ratio - 1.0).abs() > FAR_FRACTION);
                         }
                     }
                     None => missed += 1,
@@ -402,9 +422,10 @@ impl Performance {
                 })
                 .count();
             // A stroke that does not sound is worse than a stick falling back on a head,
-            // that worse than a contact out of time, and that worse than a force off.
+            // that worse than a contact out of time, that worse than a force far off, that
+            // worse than a pressed (long) contact, and that worse than a force a little off.
             let late = worst > aims.acceptable_s;
-            let key = (missed, recontacts, late, off_force, worst);
+            let key = (missed, recontacts, late, far, long, off_force, worst);
             if best.as_ref().is_none_or(|b| key <= b.0) {
                 best = Some((
                     key,
@@ -413,10 +434,14 @@ impl Performance {
                     attempt,
                 ));
             }
-            let clean = missed + recontacts + off_force == 0;
+            let clean = missed + recontacts + long + off_force == 0;
             let on_time = clean && worst <= aims.tolerance_s;
             let acceptable = clean && !late && attempt >= aims.settle_attempts;
-            if on_time || acceptable || attempt >= aims.max_attempts {
+            // A cluster that sounds but has a force far off or a pressed contact gets up
+            // to twice the attempts.
+            let ran_out = attempt >= aims.max_attempts
+                && (missed > 0 || far + long == 0 || attempt >= 2 * aims.max_attempts);
+            if on_time || acceptable || ran_out {
                 break;
             }
             // Only the cluster's own contacts (the record is borrowed from the drums).
@@ -454,9 +479,11 @@ impl Performance {
     /// Late contacts play their target earlier; strokes off their force aim deeper or
     /// shallower (a deeper strike-through drives the stick faster into the head): by the
     /// secant through the two latest attempts' (depth, force) when they differ, else as
-    /// if the force grew with the square of the depth. A deeper aim reaches the head
-    /// earlier, by about the extra depth over the impact speed: the shift allows for that
-    /// so the two corrections do not fight.
+    /// if the force grew with the square of the depth. A stroke on its force whose
+    /// contact lasts too long (the arm pressing the stick into the giving head) aims
+    /// [`PRESSED_DEPTH`] as deep. A deeper aim reaches the head earlier, by about the
+    /// extra depth over the impact speed: the shift allows for that so the two
+    /// corrections do not fight.
     fn correct(
         &mut self,
         i: usize,
@@ -468,8 +495,16 @@ impl Performance {
         let aim = aims.force_n[i];
         let mut shift = self.shift_s[i] + contact.map_or(0.0, |c| c.start_s - scheduled_s);
         let force = contact.map(|c| c.peak_force_n);
-        if !force.is_some_and(|f| (f / aim - 1.0).abs() <= aims.force_tolerance) {
-            let old = self.targets.depth(i);
+        let old = self.targets.depth(i);
+        let on_force = force.is_some_and(|f| (f / aim - 1.0).abs() <= aims.force_tolerance);
+        let pressed = contact.is_some_and(|c| c.duration_s() > aims.max_contact_s);
+        if on_force && pressed {
+            let depth = (old * PRESSED_DEPTH).clamp(0.002, MAX_DEPTH_M);
+            if let Some(c) = contact {
+                shift -= (depth - old) / c.impact_speed_mps.max(0.5);
+            }
+            self.targets.set_depth(i, depth);
+        } else if !on_force {
             let ratio = force.map_or(2.0, |f| (aim / f.max(1e-3)).sqrt().clamp(0.6, 1.6));
             let depth = match tried {
                 [.., (d0, f0), (d1, f1)] if (d1 - d0).abs() > 1e-5 && (f1 - f0).abs() > 0.5 => {

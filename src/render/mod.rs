@@ -88,6 +88,10 @@ pub struct RenderParams {
     pub strike_half_width_s: f64,
     /// How the grip lets the stick go around each impact.
     pub release: Release,
+    /// A contact longer than this, s, counts as the arm pressing the stick into the head:
+    /// the compensation aims that stroke shallower and tries further (timpanists want
+    /// 2–8 ms).
+    pub max_contact_s: f64,
     /// Sound rendered after the last motion sample, s.
     pub tail_s: f64,
     /// Every PD gain multiplied by this.
@@ -146,6 +150,7 @@ impl Default for RenderParams {
             force_tolerance: 0.12,
             strike_half_width_s: 0.008,
             release: Release::DEFAULT,
+            max_contact_s: 0.008,
             tail_s: 2.5,
             gain_scale: 1.0,
         }
@@ -615,6 +620,7 @@ impl Run<'_> {
             settle_attempts: params.settle_attempts,
             max_attempts: params.max_attempts.max(1),
             first_depth_m: params.strike_depth_m,
+            max_contact_s: params.max_contact_s,
         };
         let began = Instant::now();
         let mut report = |f: f64| {
