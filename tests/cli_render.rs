@@ -48,6 +48,20 @@ fn cli_render_writes_wav_motion_and_events() {
         stdout.contains("real time") && stdout.contains("drums"),
         "{stdout}"
     );
+    // The attempts per cluster add up to the clusters.
+    let per_cluster = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("attempts per cluster: "))
+        .expect("attempts per cluster");
+    let settled: usize = per_cluster
+        .trim_end_matches(" clusters")
+        .split(", ")
+        .map(|p| p.split(" for ").nth(1).unwrap().parse::<usize>().unwrap())
+        .sum();
+    assert!(
+        stdout.contains(&format!("in {settled} clusters")),
+        "{stdout}"
+    );
     let mut reader = hound::WavReader::open(&wav).unwrap();
     assert_eq!(
         (reader.spec().sample_rate, reader.spec().channels),

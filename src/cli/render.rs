@@ -433,6 +433,16 @@ fn print_stats(r: &Rendering) {
         s.simulated_s,
         s.attempts
     );
+    let per_cluster: Vec<String> = s
+        .attempts_per_cluster
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| **n > 0)
+        .map(|(k, n)| format!("{} for {n}", k + 1))
+        .collect();
+    if !per_cluster.is_empty() {
+        println!("attempts per cluster: {} clusters", per_cluster.join(", "));
+    }
     println!(
         "time: compose {:.3} s, simulate {:.3} s (drums and contact {:.3} s), sound {:.3} s; \
          total {:.3} s",

@@ -131,6 +131,9 @@ pub struct Performance {
     /// Simulation attempts over clusters, and task-rate samples simulated in all.
     pub attempts: usize,
     pub simulated_samples: usize,
+    /// Clusters settled (since the start or resume) by the attempts they took: entry n
+    /// counts those that took n + 1.
+    pub attempts_per_cluster: Vec<usize>,
     /// Resumed within a lead-in: where that lead-in began (samples).
     lead_from: Option<usize>,
 }
@@ -150,6 +153,7 @@ impl Performance {
             commits: Vec::new(),
             attempts: 0,
             simulated_samples: 0,
+            attempts_per_cluster: Vec::new(),
             lead_from: None,
         }
     }
@@ -182,6 +186,7 @@ impl Performance {
         self.lead_from = commit.lead.map(|(from, _)| from);
         self.attempts = 0;
         self.simulated_samples = 0;
+        self.attempts_per_cluster.clear();
     }
 
     /// The latest commit from which the score of `new` strokes and `targets` can resume,
@@ -438,9 +443,9 @@ impl Performance {
             let on_time = clean && worst <= aims.tolerance_s;
             let acceptable = clean && !late && attempt >= aims.settle_attempts;
             // A cluster that sounds but has a force far off or a pressed contact gets up
-            // to twice the attempts.
+            // to half as many attempts again.
             let ran_out = attempt >= aims.max_attempts
-                && (missed > 0 || far + long == 0 || attempt >= 2 * aims.max_attempts);
+                && (missed > 0 || far + long == 0 || attempt >= aims.max_attempts * 3 / 2);
             if on_time || acceptable || ran_out {
                 break;
             }
@@ -453,6 +458,10 @@ impl Performance {
                 self.correct(i, contact.as_ref(), strokes[i].time_s, aims, tried);
             }
         }
+        if self.attempts_per_cluster.len() < attempt {
+            self.attempts_per_cluster.resize(attempt, 0);
+        }
+        self.attempts_per_cluster[attempt - 1] += 1;
         let (_, shifts, depths, kept) = best.expect("one attempt ran");
         if kept != attempt || diverged {
             for ((i, shift), depth) in cluster.clone().zip(shifts).zip(depths) {

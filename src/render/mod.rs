@@ -183,6 +183,8 @@ pub struct Stats {
     /// Stroke clusters settled and simulation attempts over them.
     pub clusters: usize,
     pub attempts: usize,
+    /// Clusters by the attempts they took: entry n counts those settled in n + 1.
+    pub attempts_per_cluster: Vec<usize>,
     /// Score time the rendering resumed a previous one's performance from, s.
     pub resumed_from_s: Option<f64>,
 }
@@ -641,6 +643,7 @@ impl Run<'_> {
         stats.simulated_s = performance.simulated_samples as f64 / comp.rate_hz;
         stats.clusters = performance.clusters_settled();
         stats.attempts = performance.attempts;
+        stats.attempts_per_cluster = performance.attempts_per_cluster.clone();
         Ok(complete)
     }
 
