@@ -485,8 +485,9 @@ fn a_render_error_shows_its_beat() {
 
 /// The live OSC output, turned on in the inspector and aimed at a UDP receiver on
 /// loopback, sends each contact of the rendering once as the silent playback clock
-/// passes it — the first one a moment before score time 0 included — and nothing
-/// beyond the playhead; every message decodes (rosc) to its event's drum, hand and time.
+/// passes it, from the first, and nothing beyond the playhead; every message decodes
+/// (rosc) to its event's drum, hand and time. (A contact a moment before score time 0 is
+/// `osc_out`'s unit test's case.)
 #[test]
 fn live_osc_sends_the_hits_as_they_sound() {
     let rx = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
@@ -519,7 +520,7 @@ fn live_osc_sends_the_hits_as_they_sound() {
         .iter()
         .filter(|e| e.contact_s <= stopped_s)
         .collect();
-    assert!(want.len() >= 3 && r.events[0].contact_s < 0.0, "{want:?}");
+    assert!(want.len() >= 3, "{want:?}");
     let mut buf = [0u8; 1536];
     let mut got = Vec::new();
     while let Ok(n) = rx.recv(&mut buf) {

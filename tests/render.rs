@@ -352,7 +352,17 @@ fn partial_render_then_rest_equals_a_whole_render() {
         partial.ready_s
     );
     let ready = 2 * (partial.ready_s * 48_000.0) as usize;
-    assert_eq!(partial.audio.samples[..ready], whole.audio.samples[..ready]);
+    // The whole score may peak louder after the partial's end, so its mix can be scaled
+    // down more: compare the mixes before the normalisation gain (to f32 rounding).
+    let (a, b) = (&partial.audio, &whole.audio);
+    let first_off = (0..ready).find(|&k| {
+        let (x, y) = (
+            f64::from(a.samples[k]) / a.gain,
+            f64::from(b.samples[k]) / b.gain,
+        );
+        (x - y).abs() > 1e-6 * x.abs().max(y.abs()) + 1e-12
+    });
+    assert_eq!(first_off, None, "gains {} and {}", a.gain, b.gain);
     let rest = render_after(&mut resume, None, &edited, &db, &params, &mut |_| true).unwrap();
     assert!(rest.complete && rest.stats.resumed_from_s.is_some());
     assert_same_performance(&rest, &whole);

@@ -1,7 +1,9 @@
 //! The targets the simulated body follows for a whole score, made from the composition:
 //! the felt ball's centre carried one ball radius above the composed tip (the database's
 //! tips touch the head surface at impact), a *strike-through* dip so each stroke aims a
-//! few millimetres into the head (players strike through the head, not onto it), and a
+//! few millimetres into the head (players strike through the head, not onto it), deepest
+//! a few milliseconds before the impact so the target is already rising as the felt meets
+//! the head (the player lifts out of the drum rather than pressing into it), and a
 //! per-hand time warp that plays each stroke earlier or later by the shift the timing
 //! compensation measured.
 //!
@@ -23,6 +25,8 @@ pub struct StrikeShape {
     pub ball_radius_m: f64,
     /// Half-width of the dip around an impact, s (narrowed for close strokes).
     pub half_width_s: f64,
+    /// How long before the impact the dip is deepest, s (at most half the half-width).
+    pub lead_s: f64,
     /// How the grip lets the stick go around each impact.
     pub release: Release,
 }
@@ -95,6 +99,8 @@ struct Dip {
     time_s: f64,
     /// Half-width, s.
     half_s: f64,
+    /// How long before the impact it is deepest, s.
+    lead_s: f64,
     /// Samples it lowers.
     samples: Range<usize>,
     /// How far below the head it aims, m.
@@ -154,14 +160,16 @@ impl Targets {
                     .map(|(_, o)| (o.time_s - s.time_s).abs())
                     .fold(f64::INFINITY, f64::min);
                 let half = shape.half_width_s.min(0.4 * gap);
-                let first = (((t - half) * rate).ceil().max(0.0) as usize).min(n);
-                let last = ((((t + half) * rate).floor().max(0.0) as usize) + 1)
+                let lead = shape.lead_s.clamp(0.0, 0.5 * half);
+                let first = (((t - lead - half) * rate).ceil().max(0.0) as usize).min(n);
+                let last = ((((t - lead + half) * rate).floor().max(0.0) as usize) + 1)
                     .min(n)
                     .max(first);
                 Dip {
                     hand,
                     time_s: t,
                     half_s: half,
+                    lead_s: lead,
                     samples: first..last,
                     depth_m: 0.0,
                 }
@@ -222,7 +230,7 @@ impl Targets {
         dip.depth_m = depth_m;
         let (raised, shaped) = (&self.raised[dip.hand], &mut self.shaped[dip.hand]);
         for k in dip.samples.clone() {
-            let x = (k as f64 / self.rate_hz - dip.time_s) / dip.half_s;
+            let x = (k as f64 / self.rate_hz - (dip.time_s - dip.lead_s)) / dip.half_s;
             let lowered = if x.abs() < 1.0 {
                 depth_m * 0.5 * (1.0 + (std::f64::consts::PI * x).cos())
             } else {
@@ -234,7 +242,7 @@ impl Targets {
 
     /// Whether the first `k` strokes' dips are placed as in `other` (depths aside).
     pub fn same_dips(&self, other: &Targets, k: usize) -> bool {
-        let placed = |d: &Dip| (d.hand, d.time_s, d.half_s, d.samples.clone());
+        let placed = |d: &Dip| (d.hand, d.time_s, d.half_s, d.lead_s, d.samples.clone());
         k <= self.dips.len()
             && k <= other.dips.len()
             && self.dips[..k]
@@ -243,11 +251,12 @@ impl Targets {
                 .all(|(a, b)| placed(a) == placed(b))
     }
 
-    /// The two knots that hold stroke `i`'s shift over its dip: (time from sample 0, s).
+    /// The two knots that hold stroke `i`'s shift over its dip and its impact: (time
+    /// from sample 0, s).
     pub fn knots(&self, i: usize, shift_s: f64) -> [(f64, f64); 2] {
         let dip = &self.dips[i];
         [
-            (dip.time_s - dip.half_s, shift_s),
+            (dip.time_s - dip.lead_s - dip.half_s, shift_s),
             (dip.time_s + dip.half_s, shift_s),
         ]
     }
@@ -471,18 +480,48 @@ mod tests {
         assert_eq!(Release::FIRM.held_at(0.0), 1.0);
     }
 
+    /// A dip of `hand` at (time, half-width, lead), s, over `samples`, not yet lowered.
+    fn dip(hand: usize, (time_s, half_s, lead_s): (f64, f64, f64), samples: Range<usize>) -> Dip {
+        Dip {
+            hand,
+            time_s,
+            half_s,
+            lead_s,
+            samples,
+            depth_m: 0.0,
+        }
+    }
+
+    /// A dip is deepest its lead before the impact (the target already rising as the felt
+    /// meets the head), holds its depth there and is back at the raised tip a half-width
+    /// either side; the knots hold the shift from the dip's start to past the impact.
+    #[test]
+    fn dip_is_deepest_its_lead_before_the_impact() {
+        let mut t = targets(100);
+        t.rate_hz = 1000.0;
+        t.dips = vec![dip(0, (0.050, 0.008, 0.004), 38..55)];
+        t.set_depth(0, 0.01);
+        let z: Vec<f64> = t.shaped[0].iter().map(|p| p.z).collect();
+        let deepest = (0..100).min_by(|&a, &b| z[a].total_cmp(&z[b])).unwrap();
+        assert_eq!(deepest, 46);
+        assert!((z[46] - 0.99).abs() < 1e-12, "{}", z[46]);
+        assert_eq!(z[38], 1.0);
+        assert_eq!(z[54], 1.0);
+        // At the impact it has risen halfway back.
+        assert!((z[50] - 0.995).abs() < 1e-9, "{}", z[50]);
+        let [(start, _), (end, _)] = t.knots(0, 0.002);
+        assert!(
+            (start - 0.038).abs() < 1e-12 && end > 0.050,
+            "{start} {end}"
+        );
+    }
+
     /// Each hand's grip is released around its own strokes only, through the warp.
     #[test]
     fn grip_follows_each_hands_strokes() {
         let mut t = targets(100);
         t.rate_hz = 250.0;
-        t.dips = vec![Dip {
-            hand: 1,
-            time_s: 0.2,
-            half_s: 0.012,
-            samples: 47..54,
-            depth_m: 0.0,
-        }];
+        t.dips = vec![dip(1, (0.2, 0.012, 0.0), 47..54)];
         t.held = grip_held(&t.dips, &Release::DEFAULT, 250.0, 100);
         assert!(t.held[0].iter().all(|&h| h == 1.0));
         assert_eq!(t.held[1][50], Release::DEFAULT.held);
