@@ -34,6 +34,8 @@ const MAX_SHIFT_S: f64 = 0.035;
 /// A contact weaker than this fraction of its stroke's aimed force is a graze, ranked with
 /// a stroke that did not sound when the compensation picks its best attempt.
 const GRAZE_FRACTION: f64 = 0.25;
+/// The shallowest a stroke aims below the head, m.
+const MIN_DEPTH_M: f64 = 0.002;
 /// The deepest a stroke aims below the head, m.
 const MAX_DEPTH_M: f64 = 0.06;
 /// A stroke off its aimed force by more than this fraction is far off: its cluster gets
@@ -316,7 +318,7 @@ impl Performance {
             let (shift, depth) = from.map_or((0.0, aims.first_depth_m), |j| {
                 let scale = aims.force_n[i].max(1e-3) / aims.force_n[j].max(1e-3);
                 let depth = self.targets.depth(j) * scale;
-                (self.shift_s[j], depth.clamp(0.002, MAX_DEPTH_M))
+                (self.shift_s[j], depth.clamp(MIN_DEPTH_M, MAX_DEPTH_M))
             });
             self.shift_s[i] = shift;
             self.targets.set_depth(i, depth);
@@ -516,15 +518,11 @@ impl Performance {
         let old = self.targets.depth(i);
         let on_force = force.is_some_and(|f| (f / aim - 1.0).abs() <= aims.force_tolerance);
         let pressed = contact.is_some_and(|c| c.duration_s() > aims.max_contact_s);
-        if on_force && pressed {
-            let depth = (old * PRESSED_DEPTH).clamp(0.002, MAX_DEPTH_M);
-            if let Some(c) = contact {
-                shift -= (depth - old) / c.impact_speed_mps.max(0.5);
-            }
-            self.targets.set_depth(i, depth);
+        let depth = if on_force && pressed {
+            Some(old * PRESSED_DEPTH)
         } else if !on_force {
             let ratio = force.map_or(2.0, |f| depth_for_force(aim / f.max(1e-3)).clamp(0.5, 2.0));
-            let depth = match tried {
+            Some(match tried {
                 [.., (d0, f0), (d1, f1)] if (d1 - d0).abs() > 1e-5 && (f1 - f0).abs() > 0.5 => {
                     let slope = (f1 - f0) / (d1 - d0);
                     if slope > 0.0 {
@@ -534,8 +532,11 @@ impl Performance {
                     }
                 }
                 _ => old * ratio,
-            }
-            .clamp(0.002, MAX_DEPTH_M);
+            })
+        } else {
+            None
+        };
+        if let Some(depth) = depth.map(|d| d.clamp(MIN_DEPTH_M, MAX_DEPTH_M)) {
             if let Some(c) = contact {
                 shift -= (depth - old) / c.impact_speed_mps.max(0.5);
             }
