@@ -33,31 +33,53 @@ pub fn bessel_j(m: u32, x: f64) -> f64 {
 /// The `n`-th positive zero j_mn of J_m (n from 1), to 1e-12.
 pub fn bessel_zero(m: u32, n: u32) -> f64 {
     assert!(n >= 1, "zeros are counted from 1");
-    // Zeros of J_m lie above m and are spaced by more than 2.5 (π asymptotically); scan
-    // in steps of 0.1 and bisect each sign change.
-    let mut found = 0;
-    let mut lo = f64::from(m).max(0.5);
-    let mut f_lo = bessel_j(m, lo);
-    loop {
-        let hi = lo + 0.1;
-        let f_hi = bessel_j(m, hi);
-        if f_lo == 0.0 || f_lo.signum() != f_hi.signum() {
-            found += 1;
-            if found == n {
-                return bisect(m, lo, hi, f_lo);
-            }
-        }
-        lo = hi;
-        f_lo = f_hi;
+    if let Some(&z) = exact_zeros(m).get(n as usize - 1) {
+        return z;
     }
+    scan_zeros(m, f64::INFINITY, n as usize)
+        .pop()
+        .expect("J_m has infinitely many zeros")
 }
 
 /// All positive zeros of J_m below `x_max`, rising.
 pub fn bessel_zeros_below(m: u32, x_max: f64) -> Vec<f64> {
+    if x_max <= EXACT_ZERO_LIMIT {
+        return exact_zeros(m)
+            .iter()
+            .copied()
+            .take_while(|&z| z < x_max)
+            .collect();
+    }
+    scan_zeros(m, x_max, usize::MAX)
+}
+
+/// The zeros of J_m below [`EXACT_ZERO_LIMIT`], found once per process and shared (every
+/// head of a kit asks for the same ones).
+fn exact_zeros(m: u32) -> Arc<Vec<f64>> {
+    type Cache = Mutex<BTreeMap<u32, Arc<Vec<f64>>>>;
+    static CACHE: OnceLock<Cache> = OnceLock::new();
+    let cache = CACHE.get_or_init(|| Mutex::new(BTreeMap::new()));
+    if let Some(z) = cache.lock().expect("cache lock").get(&m) {
+        return Arc::clone(z);
+    }
+    let zeros = Arc::new(scan_zeros(m, EXACT_ZERO_LIMIT, usize::MAX));
+    cache
+        .lock()
+        .expect("cache lock")
+        .entry(m)
+        .or_insert(zeros)
+        .clone()
+}
+
+/// The first `count` positive zeros of J_m below `x_max`, rising: zeros lie above m and
+/// are spaced by more than 2.5 (π asymptotically), so J_m is scanned in steps of 0.1 from
+/// max(m, 0.5) and each sign change bisected (the same grid whatever the bounds, so a
+/// zero is the same number however it was asked for).
+fn scan_zeros(m: u32, x_max: f64, count: usize) -> Vec<f64> {
     let mut out = Vec::new();
     let mut lo = f64::from(m).max(0.5);
     let mut f_lo = bessel_j(m, lo);
-    while lo < x_max {
+    while lo < x_max && out.len() < count {
         let hi = lo + 0.1;
         let f_hi = bessel_j(m, hi);
         if f_lo == 0.0 || f_lo.signum() != f_hi.signum() {

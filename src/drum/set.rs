@@ -93,6 +93,41 @@ struct Head {
 }
 
 impl Head {
+    /// `drum`'s head at rest, its modes below the Nyquist frequency of a step of `dt_s`
+    /// coupled.
+    fn new(drum: &crate::kit::Drum, config: &ModeConfig, dt_s: f64) -> Result<Head, DrumError> {
+        let nyquist = 0.5 / dt_s;
+        let modes = HeadModes::new(drum, config)?;
+        let coupled: Vec<usize> = (0..modes.modes().len())
+            .filter(|&k| modes.modes()[k].freq_hz < nyquist)
+            .collect();
+        let step_over = |dt: f64| -> Vec<ModeStep> {
+            coupled
+                .iter()
+                .map(|&k| {
+                    let m = &modes.modes()[k];
+                    ModeStep::new(m.freq_hz, m.t60_s, dt)
+                })
+                .collect()
+        };
+        let steps = step_over(dt_s);
+        let frame_steps = step_over(MEMBRANE_FRAME_STEPS as f64 * dt_s);
+        let inv_mass = coupled
+            .iter()
+            .map(|&k| 1.0 / modes.modes()[k].modal_mass_kg)
+            .collect();
+        Ok(Head {
+            x: vec![[0.0; 2]; coupled.len()],
+            lag: 0,
+            frame_steps,
+            modes,
+            coupled,
+            steps,
+            inv_mass,
+            bound_m: 0.0,
+        })
+    }
+
     /// Ring freely up to the set's step: the state `lag` steps on, by one exact step over
     /// the whole frame when it lags exactly a frame.
     fn catch_up(&mut self) {
@@ -194,42 +229,18 @@ impl DrumSet {
             return Err(DrumError::TimeStep(dt_s));
         }
         let law = HertzContact::of(mallet)?;
-        let nyquist = 0.5 / dt_s;
-        let heads = kit
-            .drums
-            .iter()
-            .map(|drum| {
-                let modes = HeadModes::new(drum, config)?;
-                let coupled: Vec<usize> = (0..modes.modes().len())
-                    .filter(|&k| modes.modes()[k].freq_hz < nyquist)
-                    .collect();
-                let step_over = |dt: f64| -> Vec<ModeStep> {
-                    coupled
-                        .iter()
-                        .map(|&k| {
-                            let m = &modes.modes()[k];
-                            ModeStep::new(m.freq_hz, m.t60_s, dt)
-                        })
-                        .collect()
-                };
-                let steps = step_over(dt_s);
-                let frame_steps = step_over(MEMBRANE_FRAME_STEPS as f64 * dt_s);
-                let inv_mass = coupled
-                    .iter()
-                    .map(|&k| 1.0 / modes.modes()[k].modal_mass_kg)
-                    .collect();
-                Ok(Head {
-                    x: vec![[0.0; 2]; coupled.len()],
-                    lag: 0,
-                    frame_steps,
-                    modes,
-                    coupled,
-                    steps,
-                    inv_mass,
-                    bound_m: 0.0,
-                })
-            })
-            .collect::<Result<Vec<_>, DrumError>>()?;
+        // Each head on its own thread: building a head's modes (Bessel zeros and radial
+        // tables) is most of a fresh render's set-up, and the heads share nothing.
+        let heads = std::thread::scope(|scope| {
+            let jobs: Vec<_> = kit
+                .drums
+                .iter()
+                .map(|drum| scope.spawn(move || Head::new(drum, config, dt_s)))
+                .collect();
+            jobs.into_iter()
+                .map(|job| job.join().expect("building a head panicked"))
+                .collect::<Result<Vec<_>, DrumError>>()
+        })?;
         let heads_len = heads.len();
         let most = heads
             .iter()

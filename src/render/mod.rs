@@ -410,7 +410,12 @@ pub fn render_composition(
             .ceil()
             .max(0.0) as usize
     });
-    let complete = run.settle(&mut state.performance, horizon, &mut stats, progress)?;
+    // The sounding heads are built on the other core while the body is simulated.
+    let complete = std::thread::scope(|scope| {
+        let source = params.modes.source;
+        scope.spawn(move || crate::sound::prepare_heads(kit, source, params.sound));
+        run.settle(&mut state.performance, horizon, &mut stats, progress)
+    })?;
     if !progress(Progress {
         stage: "sound",
         fraction: 0.93,

@@ -266,6 +266,19 @@ pub fn render_resuming(
     render_touched(kit, drums, &[], duration_s, model, previous)
 }
 
+/// Build (or find) the modal model's sounding head of every drum of `kit`, frequencies
+/// from `source`, under the shipped calibration: a render can do it on another core while
+/// it simulates, and its sound then finds them built. Nothing for the other models.
+pub fn prepare_heads(kit: &Kit, source: crate::drum::FrequencySource, model: SoundModel) {
+    if model != SoundModel::Modal {
+        return;
+    }
+    let calibration = calibration::Calibration::shipped();
+    for drum in &kit.drums {
+        modal::sound_head_of(drum, source, calibration);
+    }
+}
+
 /// [`render_resuming`] with hands damping heads at `touches`.
 pub fn render_touched(
     kit: &Kit,

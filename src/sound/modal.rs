@@ -11,7 +11,7 @@ use super::SAMPLE_RATE_HZ;
 use super::calibration::Calibration;
 use super::partials::SoundHead;
 use super::voices::{BankState, Voice, VoiceBank};
-use crate::drum::DrumSet;
+use crate::drum::{DrumSet, FrequencySource};
 use crate::kit::Drum;
 use glam::DVec2;
 use std::collections::HashMap;
@@ -33,9 +33,17 @@ pub fn sound_head(
     drums: &DrumSet,
     calibration: &Calibration,
 ) -> Option<Arc<SoundHead>> {
+    sound_head_of(drum, drums.config().source, calibration)
+}
+
+/// [`sound_head`] with the frequencies from `source`.
+pub fn sound_head_of(
+    drum: &Drum,
+    source: FrequencySource,
+    calibration: &Calibration,
+) -> Option<Arc<SoundHead>> {
     type Cache = Mutex<HashMap<String, Arc<SoundHead>>>;
     static CACHE: OnceLock<Cache> = OnceLock::new();
-    let source = drums.config().source;
     let key = format!("{drum:?}{source:?}{calibration:?}");
     let cache = CACHE.get_or_init(Default::default);
     if let Some(h) = cache.lock().expect("cache lock").get(&key) {
