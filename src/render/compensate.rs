@@ -66,9 +66,31 @@ pub struct Aims {
     pub max_attempts: usize,
     /// Depth of a stroke with no settled predecessor, m.
     pub first_depth_m: f64,
-    /// A contact longer than this, s, is the hand pressing the stick into the head: the
-    /// stroke aims shallower and its attempt ranks below one without.
+    /// A contact longer than this, s, with a mass behind it well above the free tip's
+    /// ([`pressed`]) is the hand pressing the stick into the head: the stroke aims
+    /// shallower and its attempt ranks below one without.
     pub max_contact_s: f64,
+    /// The stick tip's effective mass when nothing holds it into the head, kg.
+    pub free_tip_mass_kg: f64,
+}
+
+/// A contact pressed by the arm has more than this many times the free tip's mass behind it.
+const PRESSED_MASS_RATIO: f64 = 1.2;
+
+/// The mass that met the head in `contact`, kg: a half-sine force of peak F over τ that
+/// reverses a mass m arriving at speed v has m = F·τ/(π·v). A free stick gives about its
+/// tip's effective mass, one the arm presses into the head much more.
+pub fn contact_mass_kg(contact: &crate::drum::ContactEvent) -> f64 {
+    contact.peak_force_n * contact.duration_s()
+        / (std::f64::consts::PI * contact.impact_speed_mps.max(0.5))
+}
+
+/// Whether `contact` lasted too long because the arm pressed the stick into the head. A
+/// free stroke on a slack head lasts π·√(m/k) (the 32-inch drum in D2: about 8.5–8.9 ms)
+/// whatever the aim: no depth makes it shorter, so it is not corrected for.
+fn pressed(contact: &crate::drum::ContactEvent, aims: &Aims) -> bool {
+    contact.duration_s() > aims.max_contact_s
+        && contact_mass_kg(contact) > PRESSED_MASS_RATIO * aims.free_tip_mass_kg
 }
 
 /// A cluster's start or end, or a point in a lead-in: a state the performance can resume
@@ -418,7 +440,7 @@ impl Performance {
                         worst = worst.max((contacts[*c].start_s - strokes[i].time_s).abs());
                         let ratio = contacts[*c].peak_force_n / aims.force_n[i];
                         tried.push((self.targets.depth(i), contacts[*c].peak_force_n));
-                        long += usize::from(contacts[*c].duration_s() > aims.max_contact_s);
+                        long += usize::from(pressed(&contacts[*c], aims));
                         if ratio < GRAZE_FRACTION {
                             // A graze is not a stroke: as bad as none.
                             missed += 1;
@@ -517,7 +539,7 @@ impl Performance {
         let force = contact.map(|c| c.peak_force_n);
         let old = self.targets.depth(i);
         let on_force = force.is_some_and(|f| (f / aim - 1.0).abs() <= aims.force_tolerance);
-        let pressed = contact.is_some_and(|c| c.duration_s() > aims.max_contact_s);
+        let pressed = contact.is_some_and(|c| pressed(c, aims));
         let depth = if on_force && pressed {
             Some(old * PRESSED_DEPTH)
         } else if !on_force {

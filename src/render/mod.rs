@@ -635,6 +635,7 @@ impl Run<'_> {
             max_attempts: params.max_attempts.max(1),
             first_depth_m: params.strike_depth_m,
             max_contact_s: params.max_contact_s,
+            free_tip_mass_kg: crate::drum::contact::effective_mass_kg(self.mallet),
         };
         let began = Instant::now();
         let mut report = |f: f64| {
