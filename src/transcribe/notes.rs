@@ -83,16 +83,27 @@ fn principal(added: &[(f64, f64)], after: &[(f64, f64)], band: (f64, f64)) -> Op
     // A low drum whose (2,1) or (3,1) carries more than its (1,1) looks like a drum a
     // fifth or an octave higher: the lower one is heard when its (1,1) sounds in the
     // window and its partials explain nearly as much.
+    // Its (1,1) must be a peak of its own: in a short window a drum ringing a whole tone
+    // away spreads over the band, and that is not the lower drum sounding.
     let lower = [KETTLEDRUM_RATIOS[2], KETTLEDRUM_RATIOS[1]]
         .iter()
         .map(|r| best.0 / r)
         .find(|&c| {
             (band.0..=band.1).contains(&c)
-                && near(after, c) >= LOWER_SHARE * near(after, best.0)
+                && near_peak(after, c) >= LOWER_SHARE * near(after, best.0)
                 && score(c) >= LOWER_SCORE * best.1
         });
     let best = lower.unwrap_or(best.0);
     Some(peak_in(after, best * 0.99, best * 1.01).map_or(best, |p| p.0))
+}
+
+/// The largest local maximum of `spec` within [`PARTIAL_TOLERANCE`] of `f`, 0 if none.
+fn near_peak(spec: &[(f64, f64)], f: f64) -> f64 {
+    spec.windows(3)
+        .filter(|w| (w[1].0 / f - 1.0).abs() <= PARTIAL_TOLERANCE)
+        .filter(|w| w[1].1 > w[0].1 && w[1].1 >= w[2].1)
+        .map(|w| w[1].1)
+        .fold(0.0, f64::max)
 }
 
 /// `len_s` of `samples` from `start_s`, zero where it runs off either end.
