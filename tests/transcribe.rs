@@ -138,10 +138,10 @@ fn check(
 /// The six demo scores, rendered and transcribed, clean and after the damage a user's
 /// file has (−12 dB gain, white noise 50 dB below the peak, 0.35 s of silence in front).
 /// Clean (as the issue asks): F ≥ 0.95 at ±20 ms on every score and the right drum for
-/// 95 % of the matched strokes (measured: F 0.952–1, 296 of 300). Damaged: 85 % of the
-/// strokes found, F ≥ 0.6 on every score, the right drum for 88 % (measured: 284 of 302
-/// found, F 0.850 on the roll exercise, and 256 of 284 on the right drum: of the roll
-/// exercise's soft strokes 27 of 51).
+/// 95 % of the matched strokes (measured: F 0.952–1, 295 of 300). Damaged: 85 % of the
+/// strokes found, F ≥ 0.6 on every score, the right drum for 88 % (measured: 289 of 302
+/// found, F 0.896 on the roll exercise, and 265 of 289 on the right drum: of the roll
+/// exercise's soft strokes 37 of 56).
 #[test]
 fn rendered_demo_scores_transcribe_back() {
     let demos = rendered_demos();

@@ -147,7 +147,7 @@ type Column = (usize, DVec3, DVec3, f64);
 
 /// One iteration of the solver: the joint steps that move the `side` tip toward `target`,
 /// computed from `frames` (the forward kinematics of the pose the steps are applied to) and
-/// applied to `pose`. HIMC runs exactly this once per arm every simulation step, both arms
+/// applied to `pose`. HIMC runs exactly this once per arm at each nested solve, both arms
 /// from one forward-kinematics pass (the arms' chains share at most the trunk).
 ///
 /// **Joint limits.** A chain joint with a limit in `limits` that is on (or beyond) its
