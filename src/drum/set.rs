@@ -455,6 +455,26 @@ impl DrumSet {
         });
     }
 
+    /// A copy with what the sound needs (the contacts, the excitation, the heads) but not
+    /// the membranes' recorded motion, the bulk of a long performance's record.
+    pub fn for_sound(&self) -> DrumSet {
+        DrumSet {
+            dt_s: self.dt_s,
+            config: self.config,
+            law: self.law,
+            tip_mass_kg: self.tip_mass_kg,
+            heads: self.heads.clone(),
+            step: self.step,
+            contacts: self.contacts.clone(),
+            open: self.open,
+            excitation: self.excitation.clone(),
+            shapes: self.shapes.clone(),
+            first_time_s: self.first_time_s,
+            membrane: Vec::new(),
+            near: self.near.clone(),
+        }
+    }
+
     /// Finished and ongoing contacts, in start order.
     pub fn contacts(&self) -> &[ContactEvent] {
         &self.contacts

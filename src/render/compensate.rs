@@ -117,6 +117,9 @@ pub struct Stage<'a> {
     pub drum_time: Duration,
     /// Told the fraction of the score simulated; `false` cancels.
     pub report: &'a mut dyn FnMut(f64) -> bool,
+    /// Shown the performance each time a cluster is settled: everything it has simulated
+    /// is final then (later attempts rewind no further than the next cluster's lead-in).
+    pub settled: &'a mut dyn FnMut(&Performance),
 }
 
 struct Meeting<'a, 'b> {
@@ -267,6 +270,7 @@ impl Performance {
                 return Ok(false);
             }
             self.settle(cluster, strokes, aims, stage)?;
+            (stage.settled)(self);
         }
         let (now, n) = (self.sim.samples(), self.targets.len());
         self.warp.anchor(now as f64 / rate);

@@ -287,6 +287,10 @@ pub fn render(
     render_after(&mut None, None, loaded, db, params, progress)
 }
 
+/// While the body is simulated, the sound of what is settled is made on the other core
+/// each time this much more of the score is settled, s.
+pub const SOUND_AHEAD_S: f64 = 5.0;
+
 /// After an edit the editor first renders this far past the edited stroke, s, ready to
 /// play at once...
 pub const FIRST_STEP_S: f64 = 0.4;
@@ -410,12 +414,15 @@ pub fn render_composition(
             .ceil()
             .max(0.0) as usize
     });
-    // The sounding heads are built on the other core while the body is simulated.
-    let complete = std::thread::scope(|scope| {
-        let source = params.modes.source;
-        scope.spawn(move || crate::sound::prepare_heads(kit, source, params.sound));
-        run.settle(&mut state.performance, horizon, &mut stats, progress)
-    })?;
+    let previous_sound = std::mem::take(&mut state.sound);
+    let (complete, sound) = run.settle_sounding(
+        &mut state.performance,
+        horizon,
+        (&mut stats, progress),
+        (&skeleton, previous_sound),
+    );
+    state.sound = sound;
+    let complete = complete?;
     if !progress(Progress {
         stage: "sound",
         fraction: 0.93,
@@ -612,14 +619,71 @@ impl Run<'_> {
         Some((at, changed_s))
     }
 
+    /// [`settle`](Self::settle) with the modal sound of the settled clusters made on the
+    /// other core as the body is simulated (every [`SOUND_AHEAD_S`] of score, resuming
+    /// `sound`), so [`sound`](Self::sound) has only the rest left: the settled state and
+    /// the sound's state to resume (bit for bit what it would be made in one go: the sound
+    /// resumes where its record first differs).
+    fn settle_sounding(
+        &self,
+        performance: &mut Performance,
+        horizon: Option<usize>,
+        (stats, progress): (&mut Stats, &mut dyn FnMut(Progress) -> bool),
+        (skeleton, sound): (&Skeleton, SoundState),
+    ) -> (Result<bool, RenderError>, SoundState) {
+        let (kit, comp, model) = (self.kit, self.composition, self.params.sound);
+        std::thread::scope(|scope| {
+            let (jobs, queue) = std::sync::mpsc::channel::<(DrumSet, Vec<Touch>, f64)>();
+            let source = self.params.modes.source;
+            let worker = scope.spawn(move || {
+                crate::sound::prepare_heads(kit, source, model);
+                let mut sound = sound;
+                while let Ok(mut job) = queue.recv() {
+                    // Only the latest record counts: it holds every earlier one.
+                    while let Ok(newer) = queue.try_recv() {
+                        job = newer;
+                    }
+                    let (drums, touches, end_s) = job;
+                    sound = crate::sound::render_touched_on(
+                        kit,
+                        (&drums, &touches),
+                        end_s,
+                        model,
+                        Some(sound),
+                        crate::sound::Cores::One,
+                    )
+                    .map_or_else(|_| SoundState::default(), |(_, state)| state);
+                }
+                sound
+            });
+            let mut sent_s = comp.start_s;
+            let mut settled = |p: &Performance| {
+                let end_s = comp.time(p.sim.samples().max(1) - 1);
+                if model != SoundModel::Modal || end_s < sent_s + SOUND_AHEAD_S {
+                    return;
+                }
+                sent_s = end_s;
+                let (touches, _) = damping::touches(comp, p.sim.motion(), skeleton, kit, end_s);
+                // Without a receiver the job is dropped: the rest is made afterwards.
+                let _ = jobs.send((p.drums.for_sound(), touches, end_s.max(0.0)));
+            };
+            let complete = self.settle(performance, horizon, (stats, progress), &mut settled);
+            drop(jobs);
+            let sound = worker
+                .join()
+                .expect("the sound made beside the simulation panicked");
+            (complete, sound)
+        })
+    }
+
     /// Settle the strokes on their beats front to back (up to `horizon` samples, when
     /// given); true when the whole score is simulated.
     fn settle(
         &self,
         performance: &mut Performance,
         horizon: Option<usize>,
-        stats: &mut Stats,
-        progress: &mut dyn FnMut(Progress) -> bool,
+        (stats, progress): (&mut Stats, &mut dyn FnMut(Progress) -> bool),
+        settled: &mut dyn FnMut(&Performance),
     ) -> Result<bool, RenderError> {
         let (comp, params) = (self.composition, self.params);
         let aims = Aims {
@@ -648,6 +712,7 @@ impl Run<'_> {
             start_s: comp.start_s,
             drum_time: Duration::ZERO,
             report: &mut report,
+            settled,
         };
         let outcome = performance.run(&comp.strokes, &aims, &mut stage, horizon);
         stats.drums = stage.drum_time;

@@ -305,6 +305,73 @@ pub fn render_calibrated(
     (model, calibration): (SoundModel, &calibration::Calibration),
     previous: Option<SoundState>,
 ) -> Result<(Audio, SoundState), SoundError> {
+    render_on(
+        kit,
+        (drums, touches),
+        duration_s,
+        (model, calibration),
+        previous,
+        Cores::All,
+    )
+}
+
+/// How many cores a rendering of the sound may take.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cores {
+    /// Each drum on its own thread.
+    All,
+    /// The caller's thread only: for sound made beside a simulation that has the other core.
+    One,
+}
+
+/// `f` of each item, on a thread each with [`Cores::All`], else one after another; in
+/// order either way.
+fn each<T: Send, R: Send>(items: Vec<T>, cores: Cores, f: impl Fn(T) -> R + Sync) -> Vec<R> {
+    if cores == Cores::One {
+        return items.into_iter().map(f).collect();
+    }
+    std::thread::scope(|scope| {
+        let jobs: Vec<_> = items
+            .into_iter()
+            .map(|item| {
+                let f = &f;
+                scope.spawn(move || f(item))
+            })
+            .collect();
+        jobs.into_iter()
+            .map(|job| job.join().expect("a drum's synthesis panicked"))
+            .collect()
+    })
+}
+
+/// [`render_touched`] on `cores`.
+pub fn render_touched_on(
+    kit: &Kit,
+    (drums, touches): (&DrumSet, &[Touch]),
+    duration_s: f64,
+    model: SoundModel,
+    previous: Option<SoundState>,
+    cores: Cores,
+) -> Result<(Audio, SoundState), SoundError> {
+    render_on(
+        kit,
+        (drums, touches),
+        duration_s,
+        (model, calibration::Calibration::shipped()),
+        previous,
+        cores,
+    )
+}
+
+/// [`render_calibrated`] on `cores`.
+fn render_on(
+    kit: &Kit,
+    (drums, touches): (&DrumSet, &[Touch]),
+    duration_s: f64,
+    (model, calibration): (SoundModel, &calibration::Calibration),
+    previous: Option<SoundState>,
+    cores: Cores,
+) -> Result<(Audio, SoundState), SoundError> {
     if !(duration_s.is_finite() && (0.0..=86_400.0).contains(&duration_s)) {
         return Err(SoundError::Duration(duration_s));
     }
@@ -336,57 +403,50 @@ pub fn render_calibrated(
     // model's threads also build (or find) their drum's sounding head, which the
     // sympathetic pass then reuses.
     type Synthesised = (Result<usize, SoundError>, Option<Arc<SoundHead>>);
-    let results: Vec<Synthesised> = std::thread::scope(|scope| {
-        let jobs: Vec<_> = kit
-            .drums
+    let slots: Vec<_> = kit
+        .drums
+        .iter()
+        .zip(state.drums.iter_mut())
+        .enumerate()
+        .collect();
+    let results: Vec<Synthesised> = each(slots, cores, |(j, (drum, (mono, synth, heard)))| {
+        let own: Vec<f64> = touches
             .iter()
-            .zip(state.drums.iter_mut())
-            .enumerate()
-            .map(|(j, (drum, (mono, synth, heard)))| {
-                scope.spawn(move || -> Synthesised {
-                    let own: Vec<f64> = touches
-                        .iter()
-                        .filter(|t| t.drum == j)
-                        .map(|t| t.at_s)
-                        .collect();
-                    let mut head = None;
-                    let outcome = match model {
-                        SoundModel::Modal => {
-                            head = modal::sound_head(drum, drums, calibration);
-                            Ok(modal::resynthesise(
-                                head.as_deref(),
-                                (drums, &own),
-                                j,
-                                (mono, None),
-                                frames,
-                                synth,
-                            ))
-                        }
-                        SoundModel::Sample => {
-                            *mono = vec![0.0; frames];
-                            sample::render_drum(drum, drums, j, mono).map(|touched| {
-                                damp_replayed(mono, &own, drums, j);
-                                (touched, 0)
-                            })
-                        }
-                        SoundModel::Signal => {
-                            *mono = vec![0.0; frames];
-                            let touched = signal::render_drum(drums, j, mono);
-                            damp_replayed(mono, &own, drums, j);
-                            Ok((touched, 0))
-                        }
-                    };
-                    let from = outcome.map(|(touched, from)| {
-                        *heard = touched;
-                        from
-                    });
-                    (from, head)
-                })
-            })
+            .filter(|t| t.drum == j)
+            .map(|t| t.at_s)
             .collect();
-        jobs.into_iter()
-            .map(|job| job.join().expect("a drum's synthesis panicked"))
-            .collect()
+        let mut head = None;
+        let outcome = match model {
+            SoundModel::Modal => {
+                head = modal::sound_head(drum, drums, calibration);
+                Ok(modal::resynthesise(
+                    head.as_deref(),
+                    (drums, &own),
+                    j,
+                    (mono, None),
+                    frames,
+                    synth,
+                ))
+            }
+            SoundModel::Sample => {
+                *mono = vec![0.0; frames];
+                sample::render_drum(drum, drums, j, mono).map(|touched| {
+                    damp_replayed(mono, &own, drums, j);
+                    (touched, 0)
+                })
+            }
+            SoundModel::Signal => {
+                *mono = vec![0.0; frames];
+                let touched = signal::render_drum(drums, j, mono);
+                damp_replayed(mono, &own, drums, j);
+                Ok((touched, 0))
+            }
+        };
+        let from = outcome.map(|(touched, from)| {
+            *heard = touched;
+            from
+        });
+        (from, head)
     });
     let (froms, heads): (Vec<_>, modal::SoundHeads) = results.into_iter().unzip();
     let froms = froms.into_iter().collect::<Result<Vec<usize>, _>>()?;
@@ -394,22 +454,12 @@ pub fn render_calibrated(
     if model == SoundModel::Modal {
         let monos: Vec<&[f32]> = state.drums.iter().map(|(m, _, _)| m.as_slice()).collect();
         state.sympathy.resize(kit.drums.len(), Default::default());
-        let sympathy_froms: Vec<usize> = std::thread::scope(|scope| {
-            let jobs: Vec<_> = state
-                .sympathy
-                .iter_mut()
-                .enumerate()
-                .map(|(j, sym)| {
-                    let (heads, monos, froms) = (&heads, &monos, &froms);
-                    scope.spawn(move || {
-                        sympathy::resynthesise(kit, heads, j, (monos, froms), frames, sym)
-                    })
-                })
-                .collect();
-            jobs.into_iter()
-                .map(|job| job.join().expect("a drum's sympathy panicked"))
-                .collect()
-        });
+        let (heads, froms) = (&heads, &froms);
+        let sympathy_froms: Vec<usize> = each(
+            state.sympathy.iter_mut().enumerate().collect(),
+            cores,
+            |(j, sym)| sympathy::resynthesise(kit, heads, j, (&monos, froms), frames, sym),
+        );
         start = sympathy_froms.iter().fold(start, |s, f| s.min(*f));
     } else {
         state.sympathy.clear();
