@@ -288,12 +288,13 @@ pub fn render_touched(
     model: SoundModel,
     previous: Option<SoundState>,
 ) -> Result<(Audio, SoundState), SoundError> {
-    render_calibrated(
+    render_touched_on(
         kit,
         (drums, touches),
         duration_s,
-        (model, calibration::Calibration::shipped()),
+        model,
         previous,
+        Cores::All,
     )
 }
 
