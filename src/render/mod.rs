@@ -7,7 +7,8 @@
 //! `drum::DrumSet`, two-way), the strokes settled on the beat front to back
 //! ([`compensate`]: each cluster of strokes re-simulated from a saved state until its
 //! contacts are on time) → contacts matched to strokes ([`strikes`]) → sound from the
-//! recorded contact forces (`sound`). Deterministic: the same score and parameters give
+//! recorded contact forces (`sound`; what is settled is sounded on the other core while
+//! the body is still simulated, every [`SOUND_AHEAD_S`]). Deterministic: the same score and parameters give
 //! bit-identical audio and motion, also when a rendering resumes a previous one after an
 //! edit ([`render_after`]).
 
