@@ -82,9 +82,9 @@ fn principal(added: &[(f64, f64)], after: &[(f64, f64)], band: (f64, f64)) -> Op
         .max_by(|a, b| a.1.total_cmp(&b.1))?;
     // A low drum whose (2,1) or (3,1) carries more than its (1,1) looks like a drum a
     // fifth or an octave higher: the lower one is heard when its (1,1) sounds in the
-    // window and its partials explain nearly as much.
-    // Its (1,1) must be a peak of its own: in a short window a drum ringing a whole tone
-    // away spreads over the band, and that is not the lower drum sounding.
+    // window as a peak of its own (in a short window a drum ringing a whole tone away
+    // spreads over the band, and that is not the lower drum sounding) and its partials
+    // explain nearly as much.
     let lower = [KETTLEDRUM_RATIOS[2], KETTLEDRUM_RATIOS[1]]
         .iter()
         .map(|r| best.0 / r)
@@ -99,10 +99,10 @@ fn principal(added: &[(f64, f64)], after: &[(f64, f64)], band: (f64, f64)) -> Op
 
 /// The largest local maximum of `spec` within [`PARTIAL_TOLERANCE`] of `f`, 0 if none.
 fn near_peak(spec: &[(f64, f64)], f: f64) -> f64 {
-    spec.windows(3)
-        .filter(|w| (w[1].0 / f - 1.0).abs() <= PARTIAL_TOLERANCE)
-        .filter(|w| w[1].1 > w[0].1 && w[1].1 >= w[2].1)
-        .map(|w| w[1].1)
+    let (lo, hi) = (f * (1.0 - PARTIAL_TOLERANCE), f * (1.0 + PARTIAL_TOLERANCE));
+    peaks(spec, lo, hi, 0.0)
+        .iter()
+        .map(|p| p.1)
         .fold(0.0, f64::max)
 }
 
