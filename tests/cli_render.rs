@@ -13,6 +13,16 @@ fn root() -> &'static Path {
 
 /// `timpanist render` writes a WAV, the motion CSV and C3D, the events JSON with the
 /// issue's fields and a PNG plot, and prints its statistics.
+/// The standard output of a run that must have succeeded (else its standard error).
+fn succeeded(out: &std::process::Output) -> String {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
 #[test]
 fn cli_render_writes_wav_motion_and_events() {
     let dir = tempfile::tempdir().unwrap();
@@ -38,12 +48,7 @@ fn cli_render_writes_wav_motion_and_events() {
         .arg(dir.path().join("stems"))
         .output()
         .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = succeeded(&out);
     assert!(
         stdout.contains("real time") && stdout.contains("drums"),
         "{stdout}"
@@ -119,6 +124,32 @@ fn cli_render_writes_wav_motion_and_events() {
 
 /// A malformed score, or one with a stroke out of reach, fails with its name and the
 /// place or beat, a non-zero exit, and no WAV.
+/// `--body-hz 5000` steps the body at 5 kHz with the drums and the contact at 10 kHz
+/// (and says so); a rate it does not offer is refused.
+#[test]
+fn cli_render_steps_the_body_at_the_rate_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let wav = dir.path().join("out.wav");
+    let run = |hz: &str| {
+        Command::new(env!("CARGO_BIN_EXE_timpanist"))
+            .current_dir(root())
+            .args(["render", "scores/improvisation.ron", "--stats", "--wav"])
+            .arg(&wav)
+            .args(["--body-hz", hz])
+            .output()
+            .unwrap()
+    };
+    let out = run("5000");
+    let stdout = succeeded(&out);
+    assert!(
+        stdout.contains("at 5000 Hz (body), 10000 Hz (drums and contact)"),
+        "{stdout}"
+    );
+    let refused = run("3000");
+    assert!(!refused.status.success());
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("--body-hz"));
+}
+
 #[test]
 fn cli_render_refuses_bad_scores_cleanly() {
     let dir = tempfile::tempdir().unwrap();

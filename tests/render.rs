@@ -1,11 +1,16 @@
 //! The whole-score render (and the property test over random scores): every demo score
 //! sounds every stroke on time, renders bit-identically, never produces NaN or clipping;
-//! randomised scores never make the physics explode. The CLI's render is in cli_render.rs.
+//! randomised scores never make the physics explode; the body at a coarser step against the
+//! 10 kHz reference. The CLI's render is in cli_render.rs.
 
 use std::path::{Path, PathBuf};
 use timpanist::base::rng::Rng;
+use timpanist::body::sim::SimParams;
+use timpanist::drum::ContactEvent;
 use timpanist::kit::Kit;
 use timpanist::mocap::db::MotionDb;
+use timpanist::render::replay::replay;
+use timpanist::render::strikes::RECONTACT_MIN_N;
 use timpanist::render::{RenderError, RenderParams, Rendering, Resume, render, render_after};
 use timpanist::score::{Beat, Dynamic, Hand, ImpactLocation, LoadedScore, PlayingMode, Score};
 
@@ -599,4 +604,104 @@ fn the_face_turns_to_the_drum_about_to_be_struck() {
         "the face was {worst:.1}° off the drum about to be struck"
     );
     assert!(span.1 - span.0 > 20.0, "the face hardly turns: {span:?}");
+}
+
+/// The contacts of at least [`RECONTACT_MIN_N`] (grazes below it come and go with any
+/// change).
+fn recontact_sized(contacts: &[ContactEvent]) -> Vec<&ContactEvent> {
+    contacts
+        .iter()
+        .filter(|c| c.peak_force_n >= RECONTACT_MIN_N)
+        .collect()
+}
+
+/// The body stepped at 5 kHz with the stick–head contact and the drums still at 10 kHz
+/// (`SimParams::contact_substeps` = 2) against the 10 kHz reference, on the very same
+/// targets (each demo score's rendered targets replayed open loop, `render::replay`).
+/// Replayed at the reference settings, a rendering comes back bit for bit.
+///
+/// Issue 22 asks tip paths within 1 mm, contact times within 0.3 ms and peak forces within
+/// 5 % before a larger step may be the default. Measured here: tip paths 0.12–0.37 mm
+/// apart RMS but up to 4.4 mm at worst (the rebound after a contact and the top of a
+/// lift), contacts within 0.2 ms, peak forces within 6 % (the coarser step strikes 3–5 %
+/// faster): close, not within, so 10 kHz stays the default and this test holds the
+/// figures measured, with a margin.
+#[test]
+fn a_body_at_5_khz_with_the_contact_at_10_khz_stays_near_the_reference() {
+    let db = db();
+    let (mut worst_rms_m, mut worst_tip_m) = (0.0f64, 0.0f64);
+    let (mut worst_contact_s, mut worst_force) = (0.0f64, 0.0f64);
+    let mut compared = 0;
+    for path in demo_scores() {
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        let loaded = LoadedScore::load(&path).unwrap();
+        let params = RenderParams::for_score(&loaded.score.settings);
+        let rendering = render(&loaded, &db, &params, &mut |_| true).unwrap();
+        let again = replay(&rendering, &params.sim).unwrap();
+        assert!(
+            again.motion.tips == rendering.motion.tips,
+            "{name}: the replay at the reference settings differs from the rendering"
+        );
+        assert_eq!(again.drums.contacts(), rendering.drums.contacts(), "{name}");
+        let halved = SimParams {
+            contact_substeps: 2,
+            ..params.sim.clone()
+        };
+        let fast = replay(&rendering, &halved).unwrap();
+        for (a, b) in rendering.motion.tips.iter().zip(&fast.motion.tips) {
+            assert_eq!(a.len(), b.len(), "{name}");
+            let mut squares = 0.0;
+            for (p, q) in a.iter().zip(b) {
+                worst_tip_m = worst_tip_m.max(p.distance(*q));
+                squares += p.distance_squared(*q);
+            }
+            worst_rms_m = worst_rms_m.max((squares / a.len() as f64).sqrt());
+        }
+        let (reference, fast) = (
+            recontact_sized(rendering.drums.contacts()),
+            recontact_sized(fast.drums.contacts()),
+        );
+        assert_eq!(
+            reference.len(),
+            fast.len(),
+            "{name}: contacts of 5 N or more"
+        );
+        for (r, f) in reference.iter().zip(&fast) {
+            assert_eq!((r.side, r.drum), (f.side, f.drum), "{name}");
+            let start = (r.start_s - f.start_s).abs();
+            let length = (r.duration_s() - f.duration_s()).abs();
+            worst_contact_s = worst_contact_s.max(start).max(length);
+            worst_force = worst_force.max((f.peak_force_n / r.peak_force_n - 1.0).abs());
+        }
+        compared += reference.len();
+    }
+    println!(
+        "{compared} contacts: tip paths {:.2} mm RMS, {:.2} mm at worst; contact times \
+         {:.2} ms; peak forces {:.1} %",
+        worst_rms_m * 1e3,
+        worst_tip_m * 1e3,
+        worst_contact_s * 1e3,
+        worst_force * 100.0
+    );
+    assert!(compared > 250, "{compared}");
+    assert!(
+        worst_rms_m <= 0.5e-3,
+        "tip paths {:.2} mm RMS",
+        worst_rms_m * 1e3
+    );
+    assert!(
+        worst_tip_m <= 6e-3,
+        "tip paths {:.2} mm apart",
+        worst_tip_m * 1e3
+    );
+    assert!(
+        worst_contact_s <= 0.3e-3,
+        "contact times {:.2} ms apart",
+        worst_contact_s * 1e3
+    );
+    assert!(
+        worst_force <= 0.08,
+        "peak forces {:.1} % apart",
+        worst_force * 100.0
+    );
 }

@@ -600,6 +600,12 @@ impl DrumSet {
     pub fn contact_law(&self) -> &HertzContact {
         &self.law
     }
+
+    /// The stick tip's mass in the contact's implicit solve: the mallet's effective mass
+    /// at its tip, kg.
+    pub fn tip_mass_kg(&self) -> f64 {
+        self.tip_mass_kg
+    }
 }
 
 /// A displacement (m) from recorded modal amplitudes and the shapes at one point

@@ -18,6 +18,7 @@ pub mod evaluate;
 pub mod gaze;
 pub mod reach;
 pub mod reference;
+pub mod replay;
 pub mod strikes;
 
 use crate::body::Joint;
