@@ -15,7 +15,10 @@
 //!   nested in PD), held until the next solve and tracked with the same PD and
 //!   feed-forward as ID.
 //!
-//! Task rate 250 Hz and simulation rate 10 kHz by default (40 sub-steps). The run stops
+//! Task rate 250 Hz and simulation rate 10 kHz by default (40 sub-steps). The body may
+//! step coarser than the drums and the stick–head contact
+//! ([`SimParams::contact_substeps`]): the contact then runs its own sub-steps, the tips
+//! moving as point masses between the body's steps. The run stops
 //! with an error naming the time if the state becomes non-finite or diverges.
 
 use super::control::{Gains, limit_torques, pd_torque, pd_torques, rotation_error};
