@@ -18,8 +18,8 @@
 //! Task rate 250 Hz and simulation rate 10 kHz by default (40 sub-steps). The body may
 //! step coarser than the drums and the stick–head contact
 //! ([`SimParams::contact_substeps`]): the contact then runs its own sub-steps, the tips
-//! moving as point masses between the body's steps. The run stops
-//! with an error naming the time if the state becomes non-finite or diverges.
+//! moving as point masses between the body's steps. The run stops with an error naming
+//! the time if the state becomes non-finite or diverges.
 
 use super::control::{Gains, limit_torques, pd_torque, pd_torques, rotation_error};
 use super::dynamics::{Dynamics, State};
@@ -40,7 +40,8 @@ pub struct SimParams {
     /// `sim_hz / contact_substeps` while the contact and the drums keep `sim_hz`, each
     /// stick tip moving between the body's steps as a point of the contact's tip mass
     /// ([`Environment::tip_mass_kg`]) and the body feeling the mean force. 1 steps the
-    /// body at `sim_hz` too (the reference). Must divide `sim_hz` over the task rate.
+    /// body at `sim_hz` too (the reference). The largest divisor of the contact steps per
+    /// task interval (`sim_hz` over the task rate) not above it is used.
     pub contact_substeps: usize,
     /// Natural frequency of each joint's PD loop, Hz.
     pub frequency_hz: [f64; JOINT_COUNT],
