@@ -11,8 +11,6 @@ fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// `timpanist render` writes a WAV, the motion CSV and C3D, the events JSON with the
-/// issue's fields and a PNG plot, and prints its statistics.
 /// The standard output of a run that must have succeeded (else its standard error).
 fn succeeded(out: &std::process::Output) -> String {
     assert!(
@@ -23,6 +21,8 @@ fn succeeded(out: &std::process::Output) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
+/// `timpanist render` writes a WAV, the motion CSV and C3D, the events JSON with the
+/// issue's fields and a PNG plot, and prints its statistics.
 #[test]
 fn cli_render_writes_wav_motion_and_events() {
     let dir = tempfile::tempdir().unwrap();
@@ -122,8 +122,6 @@ fn cli_render_writes_wav_motion_and_events() {
     assert!(std::fs::read(&spectra).unwrap().starts_with(b"\x89PNG"));
 }
 
-/// A malformed score, or one with a stroke out of reach, fails with its name and the
-/// place or beat, a non-zero exit, and no WAV.
 /// `--body-hz 5000` steps the body at 5 kHz with the drums and the contact at 10 kHz
 /// (and says so); a rate it does not offer is refused.
 #[test]
@@ -150,6 +148,8 @@ fn cli_render_steps_the_body_at_the_rate_asked() {
     assert!(String::from_utf8_lossy(&refused.stderr).contains("--body-hz"));
 }
 
+/// A malformed score, or one with a stroke out of reach, fails with its name and the
+/// place or beat, a non-zero exit, and no WAV.
 #[test]
 fn cli_render_refuses_bad_scores_cleanly() {
     let dir = tempfile::tempdir().unwrap();

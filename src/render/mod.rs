@@ -495,15 +495,7 @@ impl Run<'_> {
     /// The simulation settings: the parameters', holding the composition's joint limits
     /// when they say so.
     fn sim_params(&self) -> SimParams {
-        let params = self.params;
-        if params.joint_limits {
-            SimParams {
-                limits: self.composition.limits,
-                ..params.sim.clone()
-            }
-        } else {
-            params.sim.clone()
-        }
+        held_within(&self.params.sim, self.params, self.composition.limits)
     }
 
     /// Resume `previous` at its latest saved state before the change, when it is of the
@@ -534,26 +526,15 @@ impl Run<'_> {
                 (performance, sound, Some(from), changed_s)
             }
             (previous, _) => {
-                let model =
-                    BodyModel::new(skeleton, params.mass_kg).holding_mallets(self.mallet.mass_kg);
                 let first = targets.reference(&Warp::default());
-                let sim_params = self.sim_params();
-                let initial = ik::posture_reaching(
-                    &model.skeleton,
-                    [first.tips[0][0], first.tips[1][0]],
-                    &sim_params.ik_limits(),
-                );
-                let sim = Simulator::new(
-                    &model,
+                let (sim, drums) = performer(
+                    (kit, self.mallet),
+                    params,
+                    &self.sim_params(),
+                    skeleton,
                     &first,
-                    params.control,
-                    &sim_params,
-                    &initial,
-                    &[params.gain_scale; crate::body::skeleton::JOINT_COUNT],
-                )
-                .map_err(|e| RenderError::of_simulation(e, start_s))?;
-                let dt = 1.0 / (rate * (params.sim.sim_hz / rate).round().max(1.0));
-                let drums = DrumSet::new(kit, self.mallet, &params.modes, dt)?;
+                    start_s,
+                )?;
                 let sound = previous
                     .filter(|r| r.kit == *kit && r.params.modes == params.modes)
                     .map(|r| r.sound)
@@ -796,6 +777,52 @@ impl Rendering {
         let mallet = self.kit.mallets.get(self.params.mallet);
         Skeleton::new(self.params.height_m, mallet.map_or(0.0, |m| m.length_m))
     }
+}
+
+/// `sim` holding the composition's joint `limits` when `params` say so
+/// ([`RenderParams::joint_limits`]).
+fn held_within(sim: &SimParams, params: &RenderParams, limits: JointLimits) -> SimParams {
+    if params.joint_limits {
+        SimParams {
+            limits,
+            ..sim.clone()
+        }
+    } else {
+        sim.clone()
+    }
+}
+
+/// What a performance starts from: the body (`skeleton`, the player's mass holding the
+/// kit's `mallet`) at rest in the posture that reaches `reference`'s first tip targets,
+/// following it with `params`' control and gains under `sim`; and the kit's drums at
+/// rest, stepped at `sim`'s rate. `start_s` is the score time of the reference's start.
+fn performer(
+    (kit, mallet): (&Kit, &crate::kit::Mallet),
+    params: &RenderParams,
+    sim: &SimParams,
+    skeleton: Skeleton,
+    reference: &Reference,
+    start_s: f64,
+) -> Result<(Simulator, DrumSet), RenderError> {
+    let model = BodyModel::new(skeleton, params.mass_kg).holding_mallets(mallet.mass_kg);
+    let initial = ik::posture_reaching(
+        &model.skeleton,
+        [reference.tips[0][0], reference.tips[1][0]],
+        &sim.ik_limits(),
+    );
+    let simulator = Simulator::new(
+        &model,
+        reference,
+        params.control,
+        sim,
+        &initial,
+        &[params.gain_scale; crate::body::skeleton::JOINT_COUNT],
+    )
+    .map_err(|e| RenderError::of_simulation(e, start_s))?;
+    let rate = reference.rate_hz;
+    let dt = 1.0 / (rate * (sim.sim_hz / rate).round().max(1.0));
+    let drums = DrumSet::new(kit, mallet, &params.modes, dt)?;
+    Ok((simulator, drums))
 }
 
 impl RenderError {

@@ -4,11 +4,8 @@
 //! [`SimParams::contact_substeps`], against the 10 kHz reference). With the rendering's
 //! own settings it gives back the rendering's motion and contacts bit for bit.
 
-use super::{RenderError, Rendering};
-use crate::body::ik;
-use crate::body::model::BodyModel;
-use crate::body::sim::{Environment, Motion, SimParams, Simulator};
-use crate::body::skeleton::JOINT_COUNT;
+use super::{RenderError, Rendering, held_within, performer};
+use crate::body::sim::{Environment, Motion, SimParams};
 use crate::drum::DrumSet;
 use glam::DVec3;
 
@@ -45,42 +42,23 @@ pub fn replay(rendering: &Rendering, sim: &SimParams) -> Result<Replay, RenderEr
         .mallets
         .get(params.mallet)
         .ok_or(RenderError::NoMallet(params.mallet))?;
-    let model =
-        BodyModel::new(rendering.skeleton(), params.mass_kg).holding_mallets(mallet.mass_kg);
-    let sim = SimParams {
-        limits: if params.joint_limits {
-            rendering.composition.limits
-        } else {
-            sim.limits
-        },
-        ..sim.clone()
-    };
+    let sim = held_within(sim, params, rendering.composition.limits);
     let reference = &rendering.reference;
-    let initial = ik::posture_reaching(
-        &model.skeleton,
-        [reference.tips[0][0], reference.tips[1][0]],
-        &sim.ik_limits(),
-    );
-    let of_sim = |e| RenderError::of_simulation(e, rendering.start_s);
-    let mut simulator = Simulator::new(
-        &model,
-        reference,
-        params.control,
+    let (mut simulator, mut drums) = performer(
+        (&rendering.kit, mallet),
+        params,
         &sim,
-        &initial,
-        &[params.gain_scale; JOINT_COUNT],
-    )
-    .map_err(of_sim)?;
-    let rate = reference.rate_hz;
-    let dt = 1.0 / (rate * (sim.sim_hz / rate).round().max(1.0));
-    let mut drums = DrumSet::new(&rendering.kit, mallet, &params.modes, dt)?;
+        rendering.skeleton(),
+        reference,
+        rendering.start_s,
+    )?;
     let mut heads = Heads {
         drums: &mut drums,
         start_s: rendering.start_s,
     };
     simulator
         .advance(&mut heads, reference, reference.tips[0].len())
-        .map_err(of_sim)?;
+        .map_err(|e| RenderError::of_simulation(e, rendering.start_s))?;
     Ok(Replay {
         motion: simulator.into_motion(),
         drums,
