@@ -4,7 +4,8 @@
 //! than [`CLUSTER_GAP_S`] (either hand) are settled together: from a saved state before
 //! the cluster, the body and the drums are simulated a little past its last stroke, the
 //! contacts measured, the cluster's shifts and depths corrected and the span simulated
-//! again, a few times; the best attempt is kept (fewest strokes missed, then re-contacts —
+//! again, a few times (not once more when a correction would only repeat an attempt);
+//! the best attempt is kept (fewest strokes missed, then re-contacts —
 //! the stick falling back on a head —, then contacts out of time, forces far off their
 //! aim, contacts pressed too long, forces a little off, then the worst timing) and the
 //! performance moves on. Each
@@ -45,6 +46,11 @@ const FAR_FRACTION: f64 = 0.15;
 const PRESSED_DEPTH: f64 = 0.85;
 /// The shift moves to a cluster's over at most this long before its first dip, s.
 const TRANSITION_S: f64 = 0.06;
+/// Placements of a cluster whose shifts and depths all differ by less than these (s, m)
+/// are the same attempt: settling stops rather than go round a cycle (a stroke pressed at
+/// the deepest aim and too weak one step shallower).
+const REPEAT_SHIFT_S: f64 = 1e-4;
+const REPEAT_DEPTH_M: f64 = 1e-4;
 /// Within a lead-in, a state is saved every this many seconds (so an edit there resumes
 /// close to it).
 pub const LEAD_COMMIT_EVERY_S: f64 = 0.05;
@@ -355,6 +361,13 @@ impl Performance {
         }
     }
 
+    /// The shift and depth of each stroke of `cluster`.
+    fn placement(&self, cluster: Range<usize>) -> Vec<(f64, f64)> {
+        cluster
+            .map(|i| (self.shift_s[i], self.targets.depth(i)))
+            .collect()
+    }
+
     /// The cluster's knots in the warp and its targets in the reference up to `until`.
     fn place(&mut self, cluster: Range<usize>, commit: &Commit, until: usize) {
         self.warp.truncate(commit.warp);
@@ -405,6 +418,9 @@ impl Performance {
         // Per stroke of the cluster, the (depth, peak force) its attempts met, for the
         // secant on the depth.
         let mut tried: Vec<Vec<(f64, f64)>> = vec![Vec::new(); cluster.len()];
+        // Every placement (shift and depth per stroke) attempted: one that comes round
+        // again would only repeat its attempt.
+        let mut placed: Vec<Vec<(f64, f64)>> = Vec::new();
         let mut attempt = 0;
         let mut diverged = false;
         loop {
@@ -495,8 +511,13 @@ impl Performance {
                 .iter()
                 .map(|m| m.map(|c| contacts[c].clone()))
                 .collect();
+            placed.push(self.placement(cluster.clone()));
             for ((i, contact), tried) in cluster.clone().zip(found).zip(&tried) {
                 self.correct(i, contact.as_ref(), strokes[i].time_s, aims, tried);
+            }
+            let next = self.placement(cluster.clone());
+            if placed.iter().any(|p| same_placement(p, &next)) {
+                break;
             }
         }
         if self.attempts_per_cluster.len() < attempt {
@@ -576,6 +597,14 @@ impl Performance {
     }
 }
 
+/// Whether two placements of a cluster are the same to [`REPEAT_SHIFT_S`] and
+/// [`REPEAT_DEPTH_M`] (an attempt of one would repeat the other's).
+fn same_placement(a: &[(f64, f64)], b: &[(f64, f64)]) -> bool {
+    a.iter().zip(b).all(|((sa, da), (sb, db))| {
+        (sa - sb).abs() < REPEAT_SHIFT_S && (da - db).abs() < REPEAT_DEPTH_M
+    })
+}
+
 /// How a stroke's peak force grows with its aimed depth below the head, about: F ∝ dᵉ
 /// (measured over the one-minute study's corrections: e ≈ 0.3–0.6; the approach the
 /// composed motion brings gives most of the force, the strike-through the rest).
@@ -609,4 +638,23 @@ pub fn clusters(strokes: &[PlannedStroke]) -> Vec<Range<usize>> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn placements_within_a_tenth_of_a_millisecond_and_millimetre_are_one() {
+        let a = [(-0.008318, 0.060), (0.001, 0.02)];
+        // The drift of a cycle between a pressed stroke at the deepest aim and a weak one.
+        let again = [(-0.008316, 0.060), (0.001, 0.02)];
+        assert!(same_placement(&a, &again));
+        let later = [(-0.008118, 0.060), (0.001, 0.02)];
+        assert!(!same_placement(&a, &later), "0.2 ms apart");
+        let deeper = [(-0.008318, 0.0602), (0.001, 0.02)];
+        assert!(!same_placement(&a, &deeper), "0.2 mm apart");
+        let other = [(-0.008318, 0.060), (0.001, 0.021)];
+        assert!(!same_placement(&a, &other), "another stroke moved");
+    }
 }
