@@ -448,3 +448,42 @@ fn a_new_beat_goes_on_a_drum_of_its_hand() {
         );
     }
 }
+
+/// The inspector's Pitch field tunes the selected beats' drum (one undo step), and a beat
+/// asking its drum for another pitch than the score's first says what it will sound.
+#[test]
+fn inspector_sets_pitch_and_names_a_pedal_change() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(Some(demo()), dir.path());
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::A);
+    settle(&mut h);
+    h.get_by_label("Pitch").click();
+    settle(&mut h);
+    // The 26-inch drum's range is B♭2–F3; the demo leaves it at its D3.
+    h.get_by_label("as tuned (D3)");
+    h.get_by_label("C3").click();
+    settle(&mut h);
+    let doc = h.state().loaded().unwrap();
+    assert!(
+        doc.score
+            .beats
+            .iter()
+            .all(|b| b.pitch == Some("C3".parse().unwrap()))
+    );
+    assert_eq!(doc.score.kit(&doc.kit).drums[2].tuning.to_string(), "C3");
+    assert_eq!(h.state().undo_steps(), 1);
+    // The second beat alone asks for E3: the drum still plays the score at C3.
+    let at = common::steady_timeline_point(&mut h, 960, Hand::Auto);
+    h.hover_at(at);
+    settle(&mut h);
+    h.drag_at(at);
+    settle(&mut h);
+    h.drop_at(at);
+    settle(&mut h);
+    assert_eq!(h.state().selection().beats.len(), 1);
+    h.get_by_label("Pitch").click();
+    settle(&mut h);
+    h.get_by_label("E3").click();
+    settle(&mut h);
+    h.get_by_label_contains("sounds C3, not E3");
+}

@@ -226,3 +226,47 @@ fn headless_edit_says_how_to_get_the_editor() {
         "{stderr}"
     );
 }
+
+/// A score asking a drum for a second pitch renders at the first and says which beats
+/// sound otherwise than written (pedal changes are not simulated).
+#[test]
+fn cli_render_names_the_beats_a_pedal_change_would_need() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(root().join("scores/improvisation.ron"))
+        .unwrap()
+        .replace("../kits/", &format!("{}/kits/", root().display()));
+    // The solo kit's one drum (F3): its first beat asks D3, its second E3.
+    let mut beats = 0;
+    let text: String = text
+        .lines()
+        .map(|l| {
+            let line = if l.trim_start().starts_with("Beat(") && beats < 2 {
+                beats += 1;
+                let pitch = if beats == 1 { "D3" } else { "E3" };
+                l.replacen(
+                    "location:",
+                    &format!("pitch: Some(\"{pitch}\"), location:"),
+                    1,
+                )
+            } else {
+                l.to_string()
+            };
+            line + "\n"
+        })
+        .collect();
+    let score = dir.path().join("pedal.ron");
+    std::fs::write(&score, text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_timpanist"))
+        .args(["render"])
+        .arg(&score)
+        .arg("--wav")
+        .arg(dir.path().join("pedal.wav"))
+        .output()
+        .unwrap();
+    succeeded(&out);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("beat 1 asks drum 0 for E3 but the drum plays the score at D3"),
+        "{stderr}"
+    );
+}

@@ -706,3 +706,49 @@ fn a_body_at_5_khz_with_the_contact_at_10_khz_stays_near_the_reference() {
         worst_force * 100.0
     );
 }
+
+/// A beat's pitch tunes its drum: one stroke on the 32-inch drum (kit tuning F2) named D2,
+/// F2 or A2 sounds that pitch's (1,1) — the simulated head retuned (its tension by
+/// f ∝ √T), and every sound model with it. Before, every stroke sounded the kit tuning
+/// (the Bach chorale's A2 notes on the 29-inch drum sounded B♭2).
+#[test]
+fn a_beats_pitch_tunes_its_drum_in_every_sound_model() {
+    use timpanist::base::choices::SoundModel;
+    let db = db();
+    let kit = Kit::standard();
+    for name in ["D2", "F2", "A2"] {
+        let pitch: timpanist::base::pitch::Pitch = name.parse().unwrap();
+        let mut score = Score::new("one pitched stroke");
+        score.beats = vec![Beat {
+            hand: Hand::Left,
+            pitch: Some(pitch),
+            ..Beat::plain(0, 0)
+        }];
+        let loaded = LoadedScore {
+            score,
+            kit: kit.clone(),
+            kit_source: "standard".into(),
+            notices: Vec::new(),
+        };
+        for sound in [SoundModel::Modal, SoundModel::Sample, SoundModel::Signal] {
+            let params = RenderParams {
+                sound,
+                tail_s: 2.0,
+                ..RenderParams::default()
+            };
+            let r = render(&loaded, &db, &params, &mut |_| true).unwrap();
+            assert_eq!(r.kit.drums[0].tuning, pitch);
+            let mono = r.audio.mono();
+            let heard = timpanist::sound::analysis::profile(&mono, r.audio.rate_hz)
+                .and_then(|p| p.principal_hz)
+                .unwrap_or_else(|| panic!("{name}, {sound:?}: no (1,1) found"));
+            // The big head's (1,1) is heard over its first second, while the
+            // kettle-lifted (0,1) and a loud stroke's glide still pull it a little.
+            assert!(
+                (heard / pitch.hz() - 1.0).abs() < 0.02,
+                "{name}, {sound:?}: heard {heard:.1} Hz, asked {:.1} Hz",
+                pitch.hz()
+            );
+        }
+    }
+}

@@ -44,6 +44,43 @@ fn pick<T: PartialEq + Copy>(
     picked
 }
 
+/// The pitch the selected beats (all on `drum`) name: the drum's range, or none (the drum
+/// as it is tuned for the score); and, when it differs from the pitch the drum plays the
+/// score at (a pedal change, not simulated), a note saying so.
+fn pitch_row(
+    ui: &mut egui::Ui,
+    doc: &LoadedScore,
+    sel: &Selection,
+    drum: usize,
+    out: &mut Vec<Command>,
+) {
+    let beats = sel.beats.iter().filter_map(|&i| doc.score.beats.get(i));
+    let kit = doc.score.settings.kit(&doc.kit);
+    let played = crate::score::tuning::drum_pitches(&doc.score, &kit)[drum];
+    let d = &kit.drums[drum];
+    let mut pitches = vec![(None, format!("as tuned ({played})"))];
+    let mut p = Some(d.lowest);
+    while let Some(pitch) = p.filter(|&p| p <= d.highest) {
+        pitches.push((Some(pitch), pitch.to_string()));
+        p = pitch.transposed(1);
+    }
+    let current = common(beats.clone().map(|b| b.pitch));
+    if let Some(pitch) = pick(ui, "Pitch", current, &pitches) {
+        set_beats(doc, sel, out, |b| b.pitch = pitch);
+    }
+    if let Some(asked) = beats.filter_map(|b| b.pitch).find(|&p| p != played) {
+        ui.label("");
+        ui.label(
+            egui::RichText::new(format!(
+                "sounds {played}, not {asked}: a drum plays the whole score at its first \
+                 pitch (pedal changes are not simulated)"
+            ))
+            .color(ui.visuals().warn_fg_color),
+        );
+        ui.end_row();
+    }
+}
+
 fn set_beats(doc: &LoadedScore, sel: &Selection, out: &mut Vec<Command>, f: impl FnMut(&mut Beat)) {
     let (after, beats) = selection::modify(&doc.score.beats, &sel.beats, f);
     out.push(Command::Gesture);
@@ -106,7 +143,15 @@ pub fn show(ui: &mut egui::Ui, doc: &LoadedScore, sel: &Selection, out: &mut Vec
                 .map(|(i, d)| (i, format!("{i}: {}", d.name)))
                 .collect();
             if let Some(d) = pick(ui, "Drum", common(beats.iter().map(|b| b.drum)), &drums) {
-                set_beats(doc, sel, out, |b| b.drum = d);
+                let drum = &doc.kit.drums[d];
+                set_beats(doc, sel, out, |b| {
+                    b.drum = d;
+                    // A pitch the new drum cannot reach goes back to its tuning.
+                    b.pitch = b.pitch.filter(|&p| drum.in_range(p));
+                });
+            }
+            if let Some(drum) = common(beats.iter().map(|b| b.drum)) {
+                pitch_row(ui, doc, sel, drum, out);
             }
             let spots = [
                 (ImpactLocation::PlayingSpot, "playing spot".to_string()),

@@ -252,7 +252,7 @@ impl EditorApp {
             return;
         }
         let score = doc.loaded.score.clone();
-        let kit = score.settings.kit(&doc.loaded.kit).into_owned();
+        let kit = score.kit(&doc.loaded.kit).into_owned();
         let rendering = self.pipeline.rendering().map(|(r, _)| r.clone());
         let target = path.to_path_buf();
         let label = format!("exporting {}", path.display());

@@ -103,7 +103,7 @@ pub(super) fn export_score(
     for n in &loaded.notices {
         eprintln!("note: {n}");
     }
-    let bytes = encode(output, &loaded.score, &loaded.kit);
+    let bytes = encode(output, &loaded.score, &loaded.score.kit(&loaded.kit));
     ron_file::write_atomic(output, &bytes)?;
     println!(
         "{} -> {}: {} beats, {:.1} s",

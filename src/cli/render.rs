@@ -190,6 +190,24 @@ pub struct Choices {
 /// Load and render `score` as `choices` ask, with the progress bar on stderr; the notes
 /// of loading and the substituted motion units printed. The score, its rendering and the
 /// wall time it took.
+/// The beats that will sound at another pitch than they name (a drum keeps its first
+/// pitch: `score::tuning`), the first few of them.
+fn pedal_notes(path: &Path, loaded: &LoadedScore) {
+    const SHOWN: usize = 3;
+    let kit = loaded.score.settings.kit(&loaded.kit);
+    let changes = crate::score::tuning::pedal_changes(&loaded.score, &kit);
+    for change in changes.iter().take(SHOWN) {
+        eprintln!("note: {}: {change}", path.display());
+    }
+    if changes.len() > SHOWN {
+        eprintln!(
+            "note: {} more beats ask a drum for another pitch than its first ({} in all)",
+            changes.len() - SHOWN,
+            changes.len()
+        );
+    }
+}
+
 pub fn rendered(
     score: &Path,
     source: &DbSource,
@@ -207,6 +225,7 @@ pub fn rendered(
     for notice in &loaded.notices {
         eprintln!("note: {notice}");
     }
+    pedal_notes(score, &loaded);
     let db = super::compose::load_db(source)?;
     if stats {
         println!("database: {source}");

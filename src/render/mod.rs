@@ -359,7 +359,7 @@ pub fn compose(
     db: &MotionDb,
     params: &RenderParams,
 ) -> Result<Composition, RenderError> {
-    let kit: &Kit = &loaded.score.settings.kit(&loaded.kit);
+    let kit: &Kit = &loaded.score.kit(&loaded.kit);
     Ok(perform::trajectories(
         &loaded.score,
         kit,
@@ -379,7 +379,7 @@ pub fn render_composition(
     params: &RenderParams,
     progress: &mut dyn FnMut(Progress) -> bool,
 ) -> Result<Rendering, RenderError> {
-    let kit: &Kit = &loaded.score.settings.kit(&loaded.kit);
+    let kit: &Kit = &loaded.score.kit(&loaded.kit);
     let mallet = kit
         .mallets
         .get(params.mallet)

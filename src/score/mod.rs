@@ -9,6 +9,7 @@ pub mod meter;
 mod migrate;
 pub mod settings;
 pub mod tempo;
+pub mod tuning;
 pub mod validate;
 pub mod view;
 
@@ -179,6 +180,12 @@ pub struct LoadedScore {
 }
 
 impl Score {
+    /// `kit` as this score plays it: the settings' drum changes applied, then each drum
+    /// retuned to the pitch its beats name ([`tuning`]).
+    pub fn kit<'k>(&self, kit: &'k Kit) -> std::borrow::Cow<'k, Kit> {
+        tuning::tuned(self, self.settings.kit(kit))
+    }
+
     /// An empty score in 4/4 at 100 bpm on the standard kit.
     pub fn new(title: &str) -> Score {
         Score {
