@@ -269,4 +269,15 @@ fn cli_render_names_the_beats_a_pedal_change_would_need() {
         stderr.contains("beat 1 asks drum 0 for E3 but the drum plays the score at D3"),
         "{stderr}"
     );
+    // `check` finds the score valid and says the same.
+    let out = Command::new(env!("CARGO_BIN_EXE_timpanist"))
+        .arg("check")
+        .arg(&score)
+        .output()
+        .unwrap();
+    let stdout = succeeded(&out);
+    assert!(
+        stdout.contains("1 beat(s) ask a drum for another pitch than its first; beat 1"),
+        "{stdout}"
+    );
 }

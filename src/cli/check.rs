@@ -64,5 +64,12 @@ fn check_file(path: &Path) -> Result<String, Vec<String>> {
     for n in notices {
         summary.push_str(&format!(" (note: {n})"));
     }
+    let pedals = crate::score::tuning::pedal_changes(&score, &score.settings.kit(&kit));
+    if let Some(first) = pedals.first() {
+        summary.push_str(&format!(
+            " (note: {} beat(s) ask a drum for another pitch than its first; {first})",
+            pedals.len()
+        ));
+    }
     Ok(summary)
 }
