@@ -472,6 +472,10 @@ fn inspector_sets_pitch_and_names_a_pedal_change() {
     );
     assert_eq!(doc.score.kit(&doc.kit).drums[2].tuning.to_string(), "C3");
     assert_eq!(h.state().undo_steps(), 1);
+    // The drums' table shows the pitch the drum plays the score at.
+    h.get_by_label("Drums and membranes").click();
+    settle(&mut h);
+    h.get_by_label("C3 (kit D3)");
     // The second beat alone asks for E3: the drum still plays the score at C3.
     let at = common::steady_timeline_point(&mut h, 960, Hand::Auto);
     h.hover_at(at);

@@ -137,6 +137,8 @@ pub fn show(ui: &mut egui::Ui, doc: &LoadedScore, out: &mut Vec<Command>) {
 fn drums(ui: &mut egui::Ui, doc: &LoadedScore, settings: &mut Settings) -> bool {
     let mut started = false;
     let kit = settings.kit(&doc.kit);
+    // What each drum plays the score at (the pitch its beats name, `score::tuning`).
+    let pitches = crate::score::tuning::drum_pitches(&doc.score, &kit);
     ui.collapsing("Drums and membranes", |ui| {
         egui::Grid::new("drums").striped(true).show(ui, |ui| {
             for h in ["#", "drum", "tuning", "diameter", "tension", "modes"] {
@@ -146,7 +148,11 @@ fn drums(ui: &mut egui::Ui, doc: &LoadedScore, settings: &mut Settings) -> bool 
             for (i, d) in kit.drums.iter().enumerate() {
                 ui.label(i.to_string());
                 ui.label(&d.name);
-                ui.label(d.tuning.to_string());
+                ui.label(if pitches[i] == d.tuning {
+                    d.tuning.to_string()
+                } else {
+                    format!("{} (kit {})", pitches[i], d.tuning)
+                });
                 let (mut diameter, mut tension) = (d.diameter_m, d.membrane.tension_n_per_m);
                 let r = ui.add(
                     egui::DragValue::new(&mut diameter)
