@@ -478,16 +478,8 @@ fn inspector_sets_pitch_and_names_a_pedal_change() {
     h.get_by_label("C3 (kit D3)");
     // The second beat alone asks for E3: the drum still plays the score at C3.
     let at = common::steady_timeline_point(&mut h, 960, Hand::Auto);
-    h.hover_at(at);
-    settle(&mut h);
-    h.drag_at(at);
-    settle(&mut h);
-    h.drop_at(at);
-    settle(&mut h);
+    common::click(&mut h, at);
     assert_eq!(h.state().selection().beats.len(), 1);
-    h.get_by_label("Pitch").click();
-    settle(&mut h);
-    h.get_by_label("E3").click();
-    settle(&mut h);
+    common::choose(&mut h, "Pitch", "E3");
     h.get_by_label_contains("sounds C3, not E3");
 }

@@ -119,7 +119,7 @@ impl EditorApp {
             })
             .unwrap_or_default();
         if points.is_empty() {
-            let kit = doc.loaded.score.kit(&doc.loaded.kit);
+            let kit = doc.loaded.score.settings.kit(&doc.loaded.kit);
             for drum in &kit.drums {
                 let (c, r) = (drum.centre(), 0.5 * drum.diameter_m);
                 points.extend([c, c + DVec3::X * r, c - DVec3::X * r]);

@@ -55,9 +55,9 @@ fn pitch_row(
     out: &mut Vec<Command>,
 ) {
     let beats = sel.beats.iter().filter_map(|&i| doc.score.beats.get(i));
-    let kit = doc.score.settings.kit(&doc.kit);
-    let played = crate::score::tuning::drum_pitches(&doc.score, &kit)[drum];
+    let kit = doc.score.kit(&doc.kit);
     let d = &kit.drums[drum];
+    let played = d.tuning;
     let mut pitches = vec![(None, format!("as tuned ({played})"))];
     let mut p = Some(d.lowest);
     while let Some(pitch) = p.filter(|&p| p <= d.highest) {

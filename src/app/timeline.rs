@@ -251,7 +251,7 @@ impl TimelineView {
                     let hand = LANES[g.lane_at(p.y)];
                     // Like the last selected beat, else on the first drum the lane's hand
                     // prefers (the far drums are out of the other hand's reach).
-                    let kit = input.doc.score.kit(&input.doc.kit);
+                    let kit = input.doc.score.settings.kit(&input.doc.kit);
                     let template = input
                         .selection
                         .beats

@@ -315,7 +315,7 @@ impl Viewport {
         let painter = ui.painter_at(rect);
         painter.rect_filled(rect, 4.0, colour32(stage::BACKGROUND));
         let mut marks = Vec::new();
-        let kit = input.doc.score.kit(&input.doc.kit);
+        let kit = input.doc.score.settings.kit(&input.doc.kit);
         if let Some(format) = self.gpu {
             let scene = super::solid_frame::Scene {
                 kit: &kit,

@@ -64,7 +64,7 @@ fn check_file(path: &Path) -> Result<String, Vec<String>> {
     for n in notices {
         summary.push_str(&format!(" (note: {n})"));
     }
-    let pedals = crate::score::tuning::pedal_changes(&score, &score.settings.kit(&kit));
+    let pedals = score.pedal_changes(&kit);
     if let Some(first) = pedals.first() {
         summary.push_str(&format!(
             " (note: {} beat(s) ask a drum for another pitch than its first; {first})",

@@ -187,15 +187,11 @@ pub struct Choices {
     pub body_hz: Option<f64>,
 }
 
-/// Load and render `score` as `choices` ask, with the progress bar on stderr; the notes
-/// of loading and the substituted motion units printed. The score, its rendering and the
-/// wall time it took.
 /// The beats that will sound at another pitch than they name (a drum keeps its first
 /// pitch: `score::tuning`), the first few of them.
 fn pedal_notes(path: &Path, loaded: &LoadedScore) {
     const SHOWN: usize = 3;
-    let kit = loaded.score.settings.kit(&loaded.kit);
-    let changes = crate::score::tuning::pedal_changes(&loaded.score, &kit);
+    let changes = loaded.score.pedal_changes(&loaded.kit);
     for change in changes.iter().take(SHOWN) {
         eprintln!("note: {}: {change}", path.display());
     }
@@ -208,6 +204,9 @@ fn pedal_notes(path: &Path, loaded: &LoadedScore) {
     }
 }
 
+/// Load and render `score` as `choices` ask, with the progress bar on stderr; the notes
+/// of loading and the substituted motion units printed. The score, its rendering and the
+/// wall time it took.
 pub fn rendered(
     score: &Path,
     source: &DbSource,

@@ -186,6 +186,12 @@ impl Score {
         tuning::tuned(self, self.settings.kit(kit))
     }
 
+    /// The beats asking their drum for another pitch than it plays this score at
+    /// ([`tuning::pedal_changes`] of `kit` with the settings' drum changes).
+    pub fn pedal_changes(&self, kit: &Kit) -> Vec<tuning::PedalChange> {
+        tuning::pedal_changes(self, &self.settings.kit(kit))
+    }
+
     /// An empty score in 4/4 at 100 bpm on the standard kit.
     pub fn new(title: &str) -> Score {
         Score {
