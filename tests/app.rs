@@ -450,7 +450,7 @@ fn a_new_beat_goes_on_a_drum_of_its_hand() {
 }
 
 /// The inspector's Pitch field tunes the selected beats' drum (one undo step), and a beat
-/// asking its drum for another pitch than the score's first says what it will sound.
+/// asking its drum for another pitch than the one before it shows the pedal change.
 #[test]
 fn inspector_sets_pitch_and_names_a_pedal_change() {
     let dir = tempfile::tempdir().unwrap();
@@ -476,10 +476,20 @@ fn inspector_sets_pitch_and_names_a_pedal_change() {
     h.get_by_label("Drums and membranes").click();
     settle(&mut h);
     h.get_by_label("C3 (kit D3)");
-    // The second beat alone asks for E3: the drum still plays the score at C3.
+    // The second beat alone asks for E3: a pedal change from C3, made in the time since
+    // the drum's first stroke.
     let at = common::steady_timeline_point(&mut h, 960, Hand::Auto);
     common::click(&mut h, at);
     assert_eq!(h.state().selection().beats.len(), 1);
     common::choose(&mut h, "Pitch", "E3");
-    h.get_by_label_contains("sounds C3, not E3");
+    h.get_by_label_contains("pedal change from C3 to E3");
+    let doc = h.state().loaded().unwrap();
+    // To E3 for that beat, and back to C3 for the next.
+    let changes = doc.score.pedal_changes(&doc.kit);
+    let pitches: Vec<String> = changes
+        .iter()
+        .map(|c| format!("{}-{}", c.from, c.to))
+        .collect();
+    assert_eq!(pitches, ["C3-E3", "E3-C3"], "{changes:?}");
+    assert_eq!(doc.score.retunes(&doc.kit).len(), 2);
 }

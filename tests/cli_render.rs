@@ -227,10 +227,10 @@ fn headless_edit_says_how_to_get_the_editor() {
     );
 }
 
-/// A score asking a drum for a second pitch renders at the first and says which beats
-/// sound otherwise than written (pedal changes are not simulated).
+/// A score asking a drum for a second pitch renders, retuning the drum between the two
+/// beats, and says so.
 #[test]
-fn cli_render_names_the_beats_a_pedal_change_would_need() {
+fn cli_render_names_the_pedal_changes() {
     let dir = tempfile::tempdir().unwrap();
     let text = std::fs::read_to_string(root().join("scores/improvisation.ron"))
         .unwrap()
@@ -266,7 +266,7 @@ fn cli_render_names_the_beats_a_pedal_change_would_need() {
     succeeded(&out);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("beat 1 asks drum 0 for E3 but the drum plays the score at D3"),
+        stderr.contains("beat 1: drum 0 is retuned from D3 to E3 in the"),
         "{stderr}"
     );
     // `check` finds the score valid and says the same.
@@ -277,7 +277,7 @@ fn cli_render_names_the_beats_a_pedal_change_would_need() {
         .unwrap();
     let stdout = succeeded(&out);
     assert!(
-        stdout.contains("1 beat(s) ask a drum for another pitch than its first; beat 1"),
+        stdout.contains("(note: 1 pedal change(s), ") && stdout.contains("; beat 1: drum 0"),
         "{stdout}"
     );
 }

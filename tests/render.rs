@@ -715,7 +715,6 @@ fn a_body_at_5_khz_with_the_contact_at_10_khz_stays_near_the_reference() {
 fn a_beats_pitch_tunes_its_drum_in_every_sound_model() {
     use timpanist::base::choices::SoundModel;
     let db = db();
-    let kit = Kit::standard();
     for name in ["D2", "F2", "A2"] {
         let pitch: timpanist::base::pitch::Pitch = name.parse().unwrap();
         let mut score = Score::new("one pitched stroke");
@@ -724,19 +723,9 @@ fn a_beats_pitch_tunes_its_drum_in_every_sound_model() {
             pitch: Some(pitch),
             ..Beat::plain(0, 0)
         }];
-        let loaded = LoadedScore {
-            score,
-            kit: kit.clone(),
-            kit_source: "standard".into(),
-            notices: Vec::new(),
-        };
+        let loaded = on_the_standard_kit(score);
         for sound in [SoundModel::Modal, SoundModel::Sample, SoundModel::Signal] {
-            let params = RenderParams {
-                sound,
-                tail_s: 2.0,
-                ..RenderParams::default()
-            };
-            let r = render(&loaded, &db, &params, &mut |_| true).unwrap();
+            let r = with_a_tail(&loaded, &db, sound);
             assert_eq!(r.kit.drums[0].tuning, pitch);
             let mono = r.audio.mono();
             let heard = timpanist::sound::analysis::profile(&mono, r.audio.rate_hz)
@@ -751,4 +740,111 @@ fn a_beats_pitch_tunes_its_drum_in_every_sound_model() {
             );
         }
     }
+}
+
+/// A pedal change within a score: the 32-inch drum (kit tuning F2) struck in D2, then
+/// 3 s later in A2. The player damps the head and retunes it between the two strokes:
+/// in every sound model each stroke sounds its own pitch and the drum's stem is silent
+/// just before the second; an edit after the change resumes bit for bit as a whole
+/// render of the edited score.
+#[test]
+fn a_pedal_change_retunes_the_drum_between_its_strokes() {
+    use timpanist::base::choices::SoundModel;
+    use timpanist::base::pitch::Pitch;
+    let db = db();
+    let mut score = Score::new("a pedal change");
+    let quarter_s = 60.0 / score.tempo_map().bpm_at(0.0);
+    let ticks = (3.0 / quarter_s * f64::from(score.ticks_per_quarter)).round() as u64;
+    let second_s = ticks as f64 / f64::from(score.ticks_per_quarter) * quarter_s;
+    let (d2, a2): (Pitch, Pitch) = ("D2".parse().unwrap(), "A2".parse().unwrap());
+    score.beats = vec![
+        Beat {
+            hand: Hand::Left,
+            pitch: Some(d2),
+            ..Beat::plain(0, 0)
+        },
+        Beat {
+            hand: Hand::Left,
+            pitch: Some(a2),
+            ..Beat::plain(ticks, 0)
+        },
+    ];
+    let loaded = on_the_standard_kit(score);
+    let retunes = loaded.score.retunes(&loaded.kit);
+    assert_eq!(retunes.len(), 1);
+    for sound in [SoundModel::Modal, SoundModel::Sample, SoundModel::Signal] {
+        let r = with_a_tail(&loaded, &db, sound);
+        assert_eq!(r.drums.retunes(), retunes);
+        let rate = r.audio.rate_hz;
+        let at = |s: f64| (s * f64::from(rate)) as usize;
+        let mono = r.audio.mono();
+        for (window, pitch) in [
+            (&mono[..at(second_s - 0.3)], d2),
+            (&mono[at(second_s - 0.05)..], a2),
+        ] {
+            let heard = timpanist::sound::analysis::profile(window, rate)
+                .and_then(|p| p.principal_hz)
+                .unwrap_or_else(|| panic!("{sound:?}: no (1,1) found"));
+            assert!(
+                (heard / pitch.hz() - 1.0).abs() < 0.02,
+                "{sound:?}: heard {heard:.1} Hz, asked {pitch} ({:.1} Hz)",
+                pitch.hz()
+            );
+        }
+        // The drum's own stem: damped before the change, silent until the second stroke.
+        let stems = timpanist::sound::stems(
+            &r.kit,
+            (&r.drums, &r.touches),
+            r.audio.frames() as f64 / f64::from(rate),
+            sound,
+        )
+        .unwrap();
+        let stem = stems[0].mono();
+        let peak = |s: &[f32]| s.iter().fold(0.0f32, |m, x| m.max(x.abs()));
+        let (struck, before) = (
+            peak(&stem[..at(1.0)]),
+            peak(&stem[at(second_s - 0.09)..at(second_s - 0.02)]),
+        );
+        assert!(
+            before <= struck * 1e-3,
+            "{sound:?}: {before:e} just before the second stroke against {struck:e}"
+        );
+    }
+    // Resumed after an edit later than the change, as the editor does.
+    let params = RenderParams::default();
+    let mut resume: Option<Resume> = None;
+    render_after(&mut resume, None, &loaded, &db, &params, &mut |_| true).unwrap();
+    let mut edited = loaded.clone();
+    edited.score.beats[1].dynamic = Dynamic::Ff;
+    let whole = render(&edited, &db, &params, &mut |_| true).unwrap();
+    let resumed = render_after(&mut resume, None, &edited, &db, &params, &mut |_| true).unwrap();
+    assert!(resumed.stats.resumed_from_s.is_some_and(|s| s > 0.0));
+    assert!(
+        resumed.audio.samples == whole.audio.samples,
+        "the resumed sound differs"
+    );
+}
+
+/// `score` on the standard kit.
+fn on_the_standard_kit(score: Score) -> LoadedScore {
+    LoadedScore {
+        score,
+        kit: Kit::standard(),
+        kit_source: "standard".into(),
+        notices: Vec::new(),
+    }
+}
+
+/// `loaded` rendered with `sound` and a 2 s tail.
+fn with_a_tail(
+    loaded: &LoadedScore,
+    db: &MotionDb,
+    sound: timpanist::base::choices::SoundModel,
+) -> Rendering {
+    let params = RenderParams {
+        sound,
+        tail_s: 2.0,
+        ..RenderParams::default()
+    };
+    render(loaded, db, &params, &mut |_| true).unwrap()
 }

@@ -45,8 +45,8 @@ fn pick<T: PartialEq + Copy>(
 }
 
 /// The pitch the selected beats (all on `drum`) name: the drum's range, or none (the drum
-/// as it is tuned for the score); and, when it differs from the pitch the drum plays the
-/// score at (a pedal change, not simulated), a note saying so.
+/// as it is tuned then); and, for the selected beats that change the drum's pitch, the
+/// pedal change (flagged when it is quick).
 fn pitch_row(
     ui: &mut egui::Ui,
     doc: &LoadedScore,
@@ -57,8 +57,9 @@ fn pitch_row(
     let beats = sel.beats.iter().filter_map(|&i| doc.score.beats.get(i));
     let kit = doc.score.kit(&doc.kit);
     let d = &kit.drums[drum];
-    let played = d.tuning;
-    let mut pitches = vec![(None, format!("as tuned ({played})"))];
+    let sounding = doc.score.sounding_pitches(&doc.kit);
+    let tuned = sel.beats.first().and_then(|&i| sounding.get(i)).copied();
+    let mut pitches = vec![(None, format!("as tuned ({})", tuned.unwrap_or(d.tuning)))];
     let mut p = Some(d.lowest);
     while let Some(pitch) = p.filter(|&p| p <= d.highest) {
         pitches.push((Some(pitch), pitch.to_string()));
@@ -68,15 +69,21 @@ fn pitch_row(
     if let Some(pitch) = pick(ui, "Pitch", current, &pitches) {
         set_beats(doc, sel, out, |b| b.pitch = pitch);
     }
-    if let Some(asked) = beats.filter_map(|b| b.pitch).find(|&p| p != played) {
+    let changes = doc.score.pedal_changes(&doc.kit);
+    if let Some(change) = changes.iter().find(|c| sel.beats.contains(&c.beat)) {
         ui.label("");
-        ui.label(
-            egui::RichText::new(format!(
-                "sounds {played}, not {asked}: a drum plays the whole score at its first \
-                 pitch (pedal changes are not simulated)"
-            ))
-            .color(ui.visuals().warn_fg_color),
+        let text = format!(
+            "pedal change from {} to {}, {:.2} s after the drum's last stroke",
+            change.from,
+            change.to,
+            change.gap_s()
         );
+        let color = if change.is_quick() {
+            ui.visuals().warn_fg_color
+        } else {
+            ui.visuals().weak_text_color()
+        };
+        ui.label(egui::RichText::new(text).color(color));
         ui.end_row();
     }
 }

@@ -65,9 +65,10 @@ fn check_file(path: &Path) -> Result<String, Vec<String>> {
         summary.push_str(&format!(" (note: {n})"));
     }
     let pedals = score.pedal_changes(&kit);
-    if let Some(first) = pedals.first() {
+    if let Some(first) = pedals.iter().find(|c| c.is_quick()).or(pedals.first()) {
+        let quick = pedals.iter().filter(|c| c.is_quick()).count();
         summary.push_str(&format!(
-            " (note: {} beat(s) ask a drum for another pitch than its first; {first})",
+            " (note: {} pedal change(s), {quick} quick; {first})",
             pedals.len()
         ));
     }

@@ -187,8 +187,7 @@ pub struct Choices {
     pub body_hz: Option<f64>,
 }
 
-/// The beats that will sound at another pitch than they name (a drum keeps its first
-/// pitch: `score::tuning`), the first few of them.
+/// The score's pedal changes (`score::tuning`), the first few of them.
 fn pedal_notes(path: &Path, loaded: &LoadedScore) {
     const SHOWN: usize = 3;
     let changes = loaded.score.pedal_changes(&loaded.kit);
@@ -197,9 +196,10 @@ fn pedal_notes(path: &Path, loaded: &LoadedScore) {
     }
     if changes.len() > SHOWN {
         eprintln!(
-            "note: {} more beats ask a drum for another pitch than its first ({} in all)",
+            "note: {} more pedal changes ({} in all, {} of them quick)",
             changes.len() - SHOWN,
-            changes.len()
+            changes.len(),
+            changes.iter().filter(|c| c.is_quick()).count()
         );
     }
 }

@@ -24,8 +24,9 @@ use super::contact::HertzContact;
 use super::modes::HeadModes;
 use super::oscillator::ModeStep;
 use super::{DrumError, ModeConfig};
-use crate::kit::{Kit, Mallet, Side};
+use crate::kit::{Kit, Mallet, Retune, Side};
 use glam::{DVec2, DVec3};
+use std::sync::Arc;
 
 /// One touch of a stick tip on a head, from the first step with force to the first
 /// step without.
@@ -70,10 +71,27 @@ pub struct Excitation {
     pub force_n: f64,
 }
 
+/// A head's mechanics at one tuning (its pedal setting).
+#[derive(Debug)]
+struct Tuning {
+    /// Score time from which it holds, s (−∞ for the tuning the performance starts at).
+    from_s: f64,
+    /// The modes at this tuning: the same modes in the same order as the head's first
+    /// (their shapes do not depend on the tension), ringing at other frequencies.
+    modes: HeadModes,
+    steps: Vec<ModeStep>,
+    frame_steps: Vec<ModeStep>,
+}
+
 /// One head's mechanical state: the modes below the simulation Nyquist frequency.
 #[derive(Clone, Debug)]
 struct Head {
+    /// The modes at the first tuning: where the head is and its mode shapes.
     modes: HeadModes,
+    /// Every tuning of the performance, in time order (pedal changes: [`Retune`]), and
+    /// the one `steps` and `frame_steps` hold.
+    tunings: Arc<Vec<Tuning>>,
+    tuning: usize,
     /// Indices (into `modes.modes()`) of the coupled modes.
     coupled: Vec<usize>,
     steps: Vec<ModeStep>,
@@ -101,31 +119,49 @@ impl Head {
         let coupled: Vec<usize> = (0..modes.modes().len())
             .filter(|&k| modes.modes()[k].freq_hz < nyquist)
             .collect();
-        let step_over = |dt: f64| -> Vec<ModeStep> {
-            coupled
-                .iter()
-                .map(|&k| {
-                    let m = &modes.modes()[k];
-                    ModeStep::new(m.freq_hz, m.t60_s, dt)
-                })
-                .collect()
-        };
-        let steps = step_over(dt_s);
-        let frame_steps = step_over(MEMBRANE_FRAME_STEPS as f64 * dt_s);
         let inv_mass = coupled
             .iter()
             .map(|&k| 1.0 / modes.modes()[k].modal_mass_kg)
             .collect();
+        let first = Tuning::of(modes.clone(), &coupled, f64::NEG_INFINITY, dt_s);
         Ok(Head {
             x: vec![[0.0; 2]; coupled.len()],
             lag: 0,
-            frame_steps,
+            steps: first.steps.clone(),
+            frame_steps: first.frame_steps.clone(),
+            tunings: Arc::new(vec![first]),
+            tuning: 0,
             modes,
             coupled,
-            steps,
             inv_mass,
             bound_m: 0.0,
         })
+    }
+
+    /// Hold tuning `k` from now on (the state is left as it is).
+    fn set_tuning(&mut self, k: usize) {
+        if k != self.tuning {
+            self.tuning = k;
+            self.steps.clone_from(&self.tunings[k].steps);
+            self.frame_steps.clone_from(&self.tunings[k].frame_steps);
+        }
+    }
+
+    /// At score time `time_s`, s: a pedal change that has come is carried out — the
+    /// head rung up to now at its old tuning, then damped to rest (the player stops it
+    /// before moving the pedal) and retuned.
+    fn retune_at(&mut self, time_s: f64) {
+        let Some(next) = self.tunings.get(self.tuning + 1) else {
+            return;
+        };
+        if next.from_s > time_s {
+            return;
+        }
+        self.catch_up();
+        let due = self.tunings.iter().rposition(|t| t.from_s <= time_s);
+        self.set_tuning(due.unwrap_or(0));
+        self.x.fill([0.0; 2]);
+        self.bound_m = 0.0;
     }
 
     /// Ring freely up to the set's step: the state `lag` steps on, by one exact step over
@@ -167,12 +203,34 @@ impl Head {
     }
 }
 
+impl Tuning {
+    /// The exact steps of the `coupled` modes of `modes` over one step of `dt_s` and over
+    /// a membrane frame, holding from `from_s`.
+    fn of(modes: HeadModes, coupled: &[usize], from_s: f64, dt_s: f64) -> Tuning {
+        let step_over = |dt: f64| -> Vec<ModeStep> {
+            coupled
+                .iter()
+                .map(|&k| {
+                    let m = &modes.modes()[k];
+                    ModeStep::new(m.freq_hz, m.t60_s, dt)
+                })
+                .collect()
+        };
+        Tuning {
+            steps: step_over(dt_s),
+            frame_steps: step_over(MEMBRANE_FRAME_STEPS as f64 * dt_s),
+            from_s,
+            modes,
+        }
+    }
+}
+
 /// A [`DrumSet`]'s state at one step, without its history (which it only truncates).
 #[derive(Clone, Debug, PartialEq)]
 pub struct DrumCheckpoint {
     step: u64,
-    /// Per head: the coupled modes' states, their lag and their bound.
-    heads: Vec<(Vec<[f64; 2]>, u64, f64)>,
+    /// Per head: the coupled modes' states, their lag, their bound and its tuning.
+    heads: Vec<(Vec<[f64; 2]>, u64, f64, usize)>,
     contacts: usize,
     /// Each tip's ongoing contact as it was.
     open: [Option<(usize, ContactEvent)>; 2],
@@ -210,6 +268,8 @@ pub struct DrumSet {
     membrane: Vec<f32>,
     /// Scratch: whether a tip came near each head this step.
     near: Vec<bool>,
+    /// The pedal changes the heads carry out, in time order.
+    retunes: Vec<Retune>,
 }
 
 /// Steps between recorded membrane frames (10 ms at 10 kHz).
@@ -261,7 +321,41 @@ impl DrumSet {
             first_time_s: 0.0,
             membrane: Vec::new(),
             near: vec![false; heads_len],
+            retunes: Vec::new(),
         })
+    }
+
+    /// This set (at rest, before its first step) carrying out the pedal changes
+    /// `retunes` of `kit`'s drums (the kit it was built from): at each, the head is
+    /// damped to rest and retuned ([`Drum::retuned`](crate::kit::Drum::retuned)).
+    pub fn retuned(mut self, kit: &Kit, retunes: &[Retune]) -> Result<DrumSet, DrumError> {
+        let mut retunes = retunes.to_vec();
+        retunes.retain(|r| r.drum < self.heads.len());
+        retunes.sort_by(|a, b| a.at_s.total_cmp(&b.at_s));
+        for (j, head) in self.heads.iter_mut().enumerate() {
+            let mut tunings = vec![Tuning::of(
+                head.modes.clone(),
+                &head.coupled,
+                f64::NEG_INFINITY,
+                self.dt_s,
+            )];
+            for r in retunes.iter().filter(|r| r.drum == j) {
+                let modes = HeadModes::new(&kit.drums[j].retuned(r.pitch), &self.config)?;
+                debug_assert!(modes.modes().iter().zip(head.modes.modes()).all(|(a, b)| (
+                    a.m,
+                    a.n,
+                    a.orientation
+                ) == (
+                    b.m,
+                    b.n,
+                    b.orientation
+                )));
+                tunings.push(Tuning::of(modes, &head.coupled, r.at_s, self.dt_s));
+            }
+            head.tunings = Arc::new(tunings);
+        }
+        self.retunes = retunes;
+        Ok(self)
     }
 
     /// One simulation step at `time_s`: `tips[i]` = (position m, velocity m/s) of tip i
@@ -271,6 +365,11 @@ impl DrumSet {
         let dt = self.dt_s;
         if self.step == 0 {
             self.first_time_s = time_s;
+        }
+        if !self.retunes.is_empty() {
+            for head in &mut self.heads {
+                head.retune_at(time_s);
+            }
         }
         if self.step.is_multiple_of(MEMBRANE_FRAME_STEPS) {
             for head in &mut self.heads {
@@ -426,7 +525,7 @@ impl DrumSet {
             heads: self
                 .heads
                 .iter()
-                .map(|h| (h.x.clone(), h.lag, h.bound_m))
+                .map(|h| (h.x.clone(), h.lag, h.bound_m, h.tuning))
                 .collect(),
             contacts: self.contacts.len(),
             open: self.open.map(|o| o.map(|k| (k, self.contacts[k].clone()))),
@@ -439,7 +538,8 @@ impl DrumSet {
     /// modes, ongoing contacts and the records are as they were then.
     pub fn rewind(&mut self, checkpoint: &DrumCheckpoint) {
         self.step = checkpoint.step;
-        for (head, (x, lag, bound)) in self.heads.iter_mut().zip(&checkpoint.heads) {
+        for (head, (x, lag, bound, tuning)) in self.heads.iter_mut().zip(&checkpoint.heads) {
+            head.set_tuning(*tuning);
             head.x.clone_from(x);
             head.lag = *lag;
             head.bound_m = *bound;
@@ -472,6 +572,7 @@ impl DrumSet {
             first_time_s: self.first_time_s,
             membrane: Vec::new(),
             near: self.near.clone(),
+            retunes: self.retunes.clone(),
         }
     }
 
@@ -560,9 +661,22 @@ impl DrumSet {
         Some(head.coupled.iter().map(|&k| shapes[k]).collect())
     }
 
-    /// The modes of drum `drum` (all of them, coupled or not).
+    /// The modes of drum `drum` (all of them, coupled or not) at the tuning the
+    /// performance starts at.
     pub fn head(&self, drum: usize) -> Option<&HeadModes> {
         self.heads.get(drum).map(|h| &h.modes)
+    }
+
+    /// The modes of drum `drum` at the tuning it holds at score time `time_s`, s.
+    pub fn head_at(&self, drum: usize, time_s: f64) -> Option<&HeadModes> {
+        let head = self.heads.get(drum)?;
+        let k = head.tunings.iter().rposition(|t| t.from_s <= time_s);
+        Some(&head.tunings[k.unwrap_or(0)].modes)
+    }
+
+    /// The pedal changes the heads carry out, in time order.
+    pub fn retunes(&self) -> &[Retune] {
+        &self.retunes
     }
 
     /// Number of heads.
@@ -658,5 +772,81 @@ mod tests {
         for (a, b) in lazy.membrane.iter().zip(&stepped.membrane) {
             assert!((a - b).abs() <= 1e-9, "{a} vs {b}");
         }
+    }
+
+    /// A pedal change damps the head to rest and retunes it at its time: the struck head
+    /// rings before it, is still after it, rings at the new pitch when struck again, and
+    /// a rewind across the change replays it bit for bit.
+    #[test]
+    fn a_pedal_change_damps_and_retunes_the_head() {
+        use crate::base::pitch::Pitch;
+        use strike::ScriptedStick;
+        let kit = Kit::standard();
+        let mallet = &kit.mallets[0];
+        let a2: Pitch = "A2".parse().unwrap();
+        let retune = Retune {
+            drum: 2,
+            at_s: 0.3,
+            after_s: 0.05,
+            pitch: a2,
+        };
+        let dt = 1e-4;
+        let mut drums = DrumSet::new(&kit, mallet, &ModeConfig::default(), dt)
+            .unwrap()
+            .retuned(&kit, &[retune])
+            .unwrap();
+        assert_eq!(drums.retunes(), [retune]);
+        let drum = &kit.drums[2];
+        let point = drum.point_on_head(0.6, 0.0);
+        let parked = ScriptedStick::parked(mallet);
+        // Strike at t = 0 and at t = 0.5 with the right stick; the left stays parked.
+        let record = |drums: &mut DrumSet, from: usize, to: usize| -> Vec<f64> {
+            let mut stick = ScriptedStick::above(drum, mallet, point, 3.0, 0.001);
+            let mut out = Vec::new();
+            for n in from..to {
+                let t = n as f64 * dt;
+                if n == 5000 {
+                    stick = ScriptedStick::above(drum, mallet, point, 3.0, 0.001);
+                }
+                let tip = if n < 300 || (5000..5300).contains(&n) {
+                    stick.tip()
+                } else {
+                    parked.tip()
+                };
+                let f = drums.step(t, [parked.tip(), tip]);
+                stick.advance(f[1], dt);
+                out.push(drums.displacement_at(2, point));
+            }
+            out
+        };
+        let before = record(&mut drums, 0, 2500);
+        let checkpoint = drums.checkpoint();
+        let after = record(&mut drums, 2500, 7000);
+        let rings = |d: &[f64]| d.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        assert!(rings(&before[2000..]) > 1e-5, "struck, it rings");
+        assert_eq!(
+            rings(&after[500..2500]),
+            0.0,
+            "damped at 0.3 s until struck again"
+        );
+        assert!(rings(&after[2600..]) > 1e-5, "struck again, it rings");
+        // The (1,1) now rings at A2 (the kit's 26-inch drum is D3).
+        let k11 = drums.heads[2]
+            .coupled
+            .iter()
+            .position(|&k| {
+                let m = &drums.heads[2].modes.modes()[k];
+                (m.m, m.n) == (1, 1)
+            })
+            .unwrap();
+        let hz = drums.heads[2].steps[k11].omega0 / std::f64::consts::TAU;
+        assert!((hz / a2.hz() - 1.0).abs() < 0.01, "{hz} Hz");
+        let f11 = |t: f64| drums.head_at(2, t).unwrap().modes()[k11].freq_hz;
+        assert!((f11(0.29) / drum.tuning.hz() - 1.0).abs() < 0.01);
+        assert!((f11(0.31) / a2.hz() - 1.0).abs() < 0.01);
+        // Back before the change: the old tuning, and the same future again.
+        drums.rewind(&checkpoint);
+        assert_eq!(drums.heads[2].tuning, 0);
+        assert_eq!(record(&mut drums, 2500, 7000), after);
     }
 }

@@ -96,7 +96,7 @@ impl ScriptedStick {
         self.position += self.velocity * dt_s;
     }
 
-    fn tip(&self) -> (DVec3, DVec3) {
+    pub(crate) fn tip(&self) -> (DVec3, DVec3) {
         (self.position, self.velocity)
     }
 }

@@ -181,6 +181,45 @@ impl Drum {
     pub fn tension_for(&self, pitch: Pitch) -> f64 {
         self.membrane.tension_n_per_m * (pitch.hz() / self.tuning.hz()).powi(2)
     }
+
+    /// This drum with its pedal set to `pitch`: the head's tension set by
+    /// [`tension_for`](Drum::tension_for), all else as it is.
+    pub fn retuned(&self, pitch: Pitch) -> Drum {
+        let mut drum = self.clone();
+        if pitch != self.tuning {
+            drum.membrane.tension_n_per_m = self.tension_for(pitch);
+            drum.tuning = pitch;
+        }
+        drum
+    }
+}
+
+/// A pedal change during a performance: from `at_s` on, drum `drum` plays at `pitch`
+/// (its head retuned by [`Drum::retuned`]). The player damps the head before it: the
+/// change lies between the drum's last stroke at its old pitch (`after_s`) and its
+/// first at the new one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Retune {
+    /// Index of the drum in the kit.
+    pub drum: usize,
+    /// Score time from which the new pitch holds, s.
+    pub at_s: f64,
+    /// Score time the drum's last stroke at the old pitch ends, s.
+    pub after_s: f64,
+    pub pitch: Pitch,
+}
+
+/// The drum `drum` of `kit` as it is tuned at score time `time_s` (s) under the pedal
+/// changes `retunes` (in time order): the kit's drum, retuned by the latest change of
+/// that drum at or before `time_s`. None for an unknown drum.
+pub fn drum_at(kit: &Kit, retunes: &[Retune], drum: usize, time_s: f64) -> Option<Drum> {
+    let base = kit.drums.get(drum)?;
+    Some(
+        match retunes.iter().rfind(|r| r.drum == drum && r.at_s <= time_s) {
+            Some(r) => base.retuned(r.pitch),
+            None => base.clone(),
+        },
+    )
 }
 
 impl Kit {

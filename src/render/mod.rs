@@ -28,7 +28,7 @@ use crate::body::model::BodyModel;
 use crate::body::sim::{Motion, Pipeline, Reference, SimError, SimParams, Simulator};
 use crate::body::skeleton::Skeleton;
 use crate::drum::{DrumError, DrumSet, ModeConfig};
-use crate::kit::Kit;
+use crate::kit::{Kit, Retune};
 use crate::mocap::db::MotionDb;
 use crate::motion::compose::{ComposeParams, Composition};
 use crate::motion::perform;
@@ -318,6 +318,7 @@ pub struct Resume {
     rate_hz: f64,
     params: RenderParams,
     kit: Kit,
+    retunes: Vec<Retune>,
 }
 
 /// [`render`], resuming from `resume` (when given, and for the same kit and parameters)
@@ -380,6 +381,7 @@ pub fn render_composition(
     progress: &mut dyn FnMut(Progress) -> bool,
 ) -> Result<Rendering, RenderError> {
     let kit: &Kit = &loaded.score.kit(&loaded.kit);
+    let retunes = loaded.score.retunes(&loaded.kit);
     let mallet = kit
         .mallets
         .get(params.mallet)
@@ -403,6 +405,7 @@ pub fn render_composition(
     let targets = Targets::new(&composition, &shape, params.strike_depth_m);
     let run = Run {
         kit,
+        retunes: &retunes,
         mallet,
         params,
         composition: &composition,
@@ -477,6 +480,8 @@ pub fn render_composition(
 /// One rendering's fixed inputs.
 struct Run<'a> {
     kit: &'a Kit,
+    /// The score's pedal changes.
+    retunes: &'a [Retune],
     /// The kit's mallet the params name.
     mallet: &'a crate::kit::Mallet,
     params: &'a RenderParams,
@@ -528,7 +533,7 @@ impl Run<'_> {
             (previous, _) => {
                 let first = targets.reference(&Warp::default());
                 let (sim, drums) = performer(
-                    (kit, self.mallet),
+                    (kit, self.retunes, self.mallet),
                     params,
                     &self.sim_params(),
                     skeleton,
@@ -555,6 +560,7 @@ impl Run<'_> {
                 rate_hz: rate,
                 params: params.clone(),
                 kit: kit.clone(),
+                retunes: self.retunes.to_vec(),
             },
             resumed_from_s,
             changed_s,
@@ -569,6 +575,7 @@ impl Run<'_> {
         let comp = self.composition;
         let same = previous.params == *self.params
             && previous.kit == *self.kit
+            && previous.retunes == self.retunes
             && previous.limits == comp.limits
             && previous.start_s == comp.start_s
             && previous.rate_hz == comp.rate_hz;
@@ -619,7 +626,7 @@ impl Run<'_> {
             let (jobs, queue) = std::sync::mpsc::channel::<(DrumSet, Vec<Touch>, f64)>();
             let source = self.params.modes.source;
             let worker = scope.spawn(move || {
-                crate::sound::prepare_heads(kit, source, model);
+                crate::sound::prepare_heads(kit, self.retunes, source, model);
                 let mut sound = sound;
                 while let Ok(mut job) = queue.recv() {
                     // Only the latest record counts: it holds every earlier one.
@@ -797,7 +804,7 @@ fn held_within(sim: &SimParams, params: &RenderParams, limits: JointLimits) -> S
 /// following it with `params`' control and gains under `sim`; and the kit's drums at
 /// rest, stepped at `sim`'s rate. `start_s` is the score time of the reference's start.
 fn performer(
-    (kit, mallet): (&Kit, &crate::kit::Mallet),
+    (kit, retunes, mallet): (&Kit, &[Retune], &crate::kit::Mallet),
     params: &RenderParams,
     sim: &SimParams,
     skeleton: Skeleton,
@@ -821,7 +828,7 @@ fn performer(
     .map_err(|e| RenderError::of_simulation(e, start_s))?;
     let rate = reference.rate_hz;
     let dt = 1.0 / (rate * (sim.sim_hz / rate).round().max(1.0));
-    let drums = DrumSet::new(kit, mallet, &params.modes, dt)?;
+    let drums = DrumSet::new(kit, mallet, &params.modes, dt)?.retuned(kit, retunes)?;
     Ok((simulator, drums))
 }
 

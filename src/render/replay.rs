@@ -45,7 +45,7 @@ pub fn replay(rendering: &Rendering, sim: &SimParams) -> Result<Replay, RenderEr
     let sim = held_within(sim, params, rendering.composition.limits);
     let reference = &rendering.reference;
     let (mut simulator, mut drums) = performer(
-        (&rendering.kit, mallet),
+        (&rendering.kit, rendering.drums.retunes(), mallet),
         params,
         &sim,
         rendering.skeleton(),

@@ -186,10 +186,21 @@ impl Score {
         tuning::tuned(self, self.settings.kit(kit))
     }
 
-    /// The beats asking their drum for another pitch than it plays this score at
-    /// ([`tuning::pedal_changes`] of `kit` with the settings' drum changes).
+    /// The pedal changes this score asks of `kit` ([`tuning::pedal_changes`] of its
+    /// [`kit`](Score::kit)), in time order.
     pub fn pedal_changes(&self, kit: &Kit) -> Vec<tuning::PedalChange> {
-        tuning::pedal_changes(self, &self.settings.kit(kit))
+        tuning::pedal_changes(self, &self.kit(kit))
+    }
+
+    /// The pitch each beat sounds on `kit` ([`tuning::sounding_pitches`] of its
+    /// [`kit`](Score::kit)).
+    pub fn sounding_pitches(&self, kit: &Kit) -> Vec<crate::base::pitch::Pitch> {
+        tuning::sounding_pitches(self, &self.kit(kit))
+    }
+
+    /// The retunings that carry out this score's pedal changes on `kit`, in time order.
+    pub fn retunes(&self, kit: &Kit) -> Vec<crate::kit::Retune> {
+        tuning::retunes(self, &self.kit(kit))
     }
 
     /// An empty score in 4/4 at 100 bpm on the standard kit.

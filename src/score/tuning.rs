@@ -1,41 +1,84 @@
 //! What each drum is tuned to for a score: the pitch its beats name (`Beat::pitch`; a
-//! beat naming none plays the drum as it is tuned). A drum is retuned to the pitch of its
-//! earliest beat that names one, for the whole performance — its head's tension set to
-//! `Drum::tension_for` that pitch (f ∝ √T), so the simulated membrane, the contact and
-//! every sound model play it; a drum no beat names a pitch for keeps the kit tuning. A
-//! drum named several pitches (a pedal change within the score) keeps the first: pedal
-//! changes are not simulated, and [`pedal_changes`] names the beats that then sound at
-//! another pitch than written.
+//! beat naming none plays the drum as it is tuned then). A drum starts at the pitch of
+//! its earliest beat that names one — its head's tension set by `Drum::retuned` (f ∝ √T),
+//! so the simulated membrane, the contact and every sound model play it; a drum no beat
+//! names a pitch for keeps the kit tuning. A later beat naming another pitch is a pedal
+//! change ([`pedal_changes`]): the player damps the head after the drum's last stroke at
+//! the old pitch and retunes it [`RETUNE_LEAD_S`] before the beat (half-way between them
+//! when they are closer), a [`Retune`] the mechanics and the sound carry out.
 
 use super::Score;
 use crate::base::pitch::Pitch;
-use crate::kit::Kit;
+use crate::kit::{Kit, Retune};
 use std::borrow::Cow;
 
-/// A beat that asks its drum for another pitch than the one the drum plays the score at.
+/// The new pitch holds this long before the first beat asking for it, s.
+pub const RETUNE_LEAD_S: f64 = 0.1;
+/// A pedal change with less time than this after the drum's last stroke is flagged as
+/// quick: the head must be damped and the pedal moved in between, s.
+pub const QUICK_PEDAL_S: f64 = 0.5;
+
+/// A beat asking its drum for another pitch than it plays just before: a pedal change.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PedalChange {
     /// Index of the beat in the score.
     pub beat: usize,
     pub drum: usize,
+    /// The pitch the drum played before.
+    pub from: Pitch,
     /// What the beat asks.
-    pub asked: Pitch,
-    /// What the drum is tuned to (its first beat's pitch).
-    pub played: Pitch,
+    pub to: Pitch,
+    /// Score time the drum's previous stroke ends, s.
+    pub after_s: f64,
+    /// Score time of the beat, s.
+    pub before_s: f64,
+}
+
+impl PedalChange {
+    /// Time the player has for the change, s.
+    pub fn gap_s(&self) -> f64 {
+        self.before_s - self.after_s
+    }
+
+    /// Whether the change has less than [`QUICK_PEDAL_S`].
+    pub fn is_quick(&self) -> bool {
+        self.gap_s() < QUICK_PEDAL_S
+    }
+
+    /// The retuning the performance carries out for it.
+    pub fn retune(&self) -> Retune {
+        let gap = self.gap_s().max(0.0);
+        Retune {
+            drum: self.drum,
+            at_s: (self.before_s - RETUNE_LEAD_S).max(self.after_s + 0.5 * gap),
+            after_s: self.after_s,
+            pitch: self.to,
+        }
+    }
 }
 
 impl std::fmt::Display for PedalChange {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "beat {} asks drum {} for {} but the drum plays the score at {} (its first \
-             beat's pitch: pedal changes within a score are not simulated)",
-            self.beat, self.drum, self.asked, self.played
-        )
+            "beat {}: drum {} is retuned from {} to {} in the {:.2} s before it",
+            self.beat,
+            self.drum,
+            self.from,
+            self.to,
+            self.gap_s()
+        )?;
+        if self.is_quick() {
+            write!(
+                f,
+                " (a quick change: under {QUICK_PEDAL_S} s to damp the head and move the pedal)"
+            )?;
+        }
+        Ok(())
     }
 }
 
-/// Per drum of `kit`, the pitch it plays `score` at: that of its earliest beat naming
+/// Per drum of `kit`, the pitch it starts `score` at: that of its earliest beat naming
 /// one, else the kit tuning.
 pub fn drum_pitches(score: &Score, kit: &Kit) -> Vec<Pitch> {
     let mut first: Vec<Option<(u64, Pitch)>> = vec![None; kit.drums.len()];
@@ -54,7 +97,7 @@ pub fn drum_pitches(score: &Score, kit: &Kit) -> Vec<Pitch> {
         .collect()
 }
 
-/// `kit` with each drum retuned to the pitch it plays `score` at (borrowed as it is when
+/// `kit` with each drum retuned to the pitch it starts `score` at (borrowed as it is when
 /// every drum keeps its kit tuning).
 pub fn tuned<'k>(score: &Score, kit: Cow<'k, Kit>) -> Cow<'k, Kit> {
     let pitches = drum_pitches(score, &kit);
@@ -63,33 +106,76 @@ pub fn tuned<'k>(score: &Score, kit: Cow<'k, Kit>) -> Cow<'k, Kit> {
     }
     let mut kit = kit.into_owned();
     for (drum, pitch) in kit.drums.iter_mut().zip(pitches) {
-        if pitch != drum.tuning {
-            drum.membrane.tension_n_per_m = drum.tension_for(pitch);
-            drum.tuning = pitch;
-        }
+        *drum = drum.retuned(pitch);
     }
     Cow::Owned(kit)
 }
 
-/// The beats of `score` asking their drum for another pitch than the one it plays the
-/// score at (`kit` as the score names it, before [`tuned`]).
+/// The pedal changes `score` asks of `kit` as it plays the score ([`tuned`]), in time
+/// order: each beat naming another pitch than its drum plays just before it.
 pub fn pedal_changes(score: &Score, kit: &Kit) -> Vec<PedalChange> {
-    let pitches = drum_pitches(score, kit);
-    score
+    walk(score, kit).0
+}
+
+/// The pitch each beat of `score` sounds on `kit` as it plays the score ([`tuned`]): its
+/// own, else the one its drum is tuned to then (the kit tuning for a beat on a drum the
+/// kit lacks).
+pub fn sounding_pitches(score: &Score, kit: &Kit) -> Vec<Pitch> {
+    walk(score, kit).1
+}
+
+/// The beats of `score` in time order, each drum's pitch followed through them: the pedal
+/// changes and the pitch each beat sounds.
+fn walk(score: &Score, kit: &Kit) -> (Vec<PedalChange>, Vec<Pitch>) {
+    let map = score.tempo_map();
+    let mut order: Vec<usize> = (0..score.beats.len()).collect();
+    order.sort_by_key(|&i| score.beats[i].tick);
+    // Per drum: the pitch it plays and when its latest stroke ends (s).
+    let mut now: Vec<(Pitch, Option<f64>)> = kit.drums.iter().map(|d| (d.tuning, None)).collect();
+    let mut changes = Vec::new();
+    let mut sounding: Vec<Pitch> = score
         .beats
         .iter()
-        .enumerate()
-        .filter(|(_, b)| b.drum < kit.drums.len())
-        .filter_map(|(i, b)| {
-            let asked = b.pitch?;
-            (asked != pitches[b.drum]).then_some(PedalChange {
-                beat: i,
-                drum: b.drum,
-                asked,
-                played: pitches[b.drum],
-            })
+        .map(|b| {
+            b.pitch
+                .unwrap_or_else(|| kit.drums.get(b.drum).map_or(Pitch(0), |d| d.tuning))
         })
-        .collect()
+        .collect();
+    for i in order {
+        let beat = &score.beats[i];
+        let Some((pitch, last_end)) = now.get_mut(beat.drum) else {
+            continue;
+        };
+        let before_s = map.seconds_at(beat.tick as f64);
+        if let (Some(asked), Some(after_s)) = (beat.pitch, *last_end)
+            && asked != *pitch
+        {
+            changes.push(PedalChange {
+                beat: i,
+                drum: beat.drum,
+                from: *pitch,
+                to: asked,
+                after_s,
+                before_s,
+            });
+        }
+        *pitch = beat.pitch.unwrap_or(*pitch);
+        sounding[i] = *pitch;
+        let end_s = map.seconds_at(beat.end_tick() as f64);
+        *last_end = Some(last_end.map_or(end_s, |e| e.max(end_s)));
+    }
+    (changes, sounding)
+}
+
+/// The retunings that carry out `score`'s pedal changes on `kit` as it plays the score
+/// ([`tuned`]), in time order.
+pub fn retunes(score: &Score, kit: &Kit) -> Vec<Retune> {
+    let mut retunes: Vec<Retune> = pedal_changes(score, kit)
+        .iter()
+        .map(PedalChange::retune)
+        .collect();
+    retunes.sort_by(|a, b| a.at_s.total_cmp(&b.at_s));
+    retunes
 }
 
 #[cfg(test)]
@@ -137,25 +223,54 @@ mod tests {
     }
 
     #[test]
-    fn a_pedal_change_keeps_the_first_pitch_and_names_the_other_beats() {
+    fn a_pedal_change_retunes_the_drum_between_its_strokes() {
         let kit = Kit::standard();
-        // Listed out of time order: the earliest beat naming a pitch (tick 480) decides; the
-        // beat at tick 0 names none and plays the drum as tuned.
-        let s = score(&[
+        // Listed out of time order: the earliest beat naming a pitch (tick 480) sets the
+        // start; the beat at tick 0 names none and plays the drum as it starts. At 100 bpm
+        // and 480 ticks per quarter a quarter is 0.6 s.
+        let mut s = score(&[
             (1920, 1, Some("C3")),
             (480, 1, Some("A2")),
             (0, 1, None),
             (960, 1, Some("A2")),
+            (2400, 1, None),
+            (2880, 1, Some("A2")),
         ]);
+        s.ticks_per_quarter = 480;
+        let quarter = 60.0 / s.tempo_map().bpm_at(0.0);
         let a2: Pitch = "A2".parse().unwrap();
+        let c3: Pitch = "C3".parse().unwrap();
         assert_eq!(drum_pitches(&s, &kit)[1], a2);
+        let tuned = tuned(&s, Cow::Borrowed(&kit));
+        let changes = pedal_changes(&s, &tuned);
+        let got: Vec<(usize, Pitch, Pitch)> =
+            changes.iter().map(|c| (c.beat, c.from, c.to)).collect();
+        // C3 at tick 1920, kept by the beat naming none, then back to A2.
+        assert_eq!(got, [(0, a2, c3), (5, c3, a2)]);
+        let first = &changes[0];
+        assert!((first.after_s - 2.0 * quarter).abs() < 1e-9, "{first:?}");
+        assert!((first.before_s - 4.0 * quarter).abs() < 1e-9, "{first:?}");
+        assert!(!first.is_quick());
+        let retunes = retunes(&s, &tuned);
+        assert_eq!(retunes.len(), 2);
+        assert!((retunes[0].at_s - (4.0 * quarter - RETUNE_LEAD_S)).abs() < 1e-9);
+        assert_eq!((retunes[0].drum, retunes[0].pitch), (1, c3));
+        assert!(first.to_string().contains("from A2 to C3"), "{first}");
+        // Seen from the untuned kit the drum starts at its kit tuning, not A2.
+        assert_eq!(pedal_changes(&s, &kit).len(), 3);
+    }
+
+    #[test]
+    fn a_quick_pedal_change_is_flagged_and_retuned_half_way() {
+        let kit = Kit::standard();
+        // Two sixteenths apart at 100 bpm: 0.15 s.
+        let mut s = score(&[(0, 2, Some("D3")), (120, 2, Some("E3"))]);
+        s.ticks_per_quarter = 480;
         let changes = pedal_changes(&s, &kit);
-        let asked: Vec<(usize, String)> = changes
-            .iter()
-            .map(|c| (c.beat, c.asked.to_string()))
-            .collect();
-        assert_eq!(asked, [(0, "C3".to_string())]);
-        assert!(changes.iter().all(|c| c.played == a2 && c.drum == 1));
-        assert!(changes[0].to_string().contains("pedal changes"));
+        assert_eq!(changes.len(), 1);
+        assert!(changes[0].is_quick());
+        assert!(changes[0].to_string().contains("quick"));
+        let r = changes[0].retune();
+        assert!((r.at_s - 0.5 * changes[0].before_s).abs() < 1e-9, "{r:?}");
     }
 }

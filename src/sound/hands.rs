@@ -26,23 +26,20 @@ pub fn hand_stems(
     // Per hand, per drum: the drum's synthesis of that hand's contacts.
     let mut monos: [Vec<Vec<f32>>; 2] = Default::default();
     let mut heads: SoundHeads = Vec::new();
-    for (j, drum) in kit.drums.iter().enumerate() {
-        let own: Vec<f64> = (touches.iter())
-            .filter(|t| t.drum == j)
-            .map(|t| t.at_s)
-            .collect();
+    for j in 0..kit.drums.len() {
+        let own = super::touches_of(touches, drums, j);
         if model == SoundModel::Modal {
-            let head = modal::sound_head(drum, drums, calibration);
+            let tunings = modal::sound_heads(kit, drums, j, calibration);
             let mut hands: [Vec<f32>; 2] = Default::default();
             modal::resynthesise(
-                head.as_deref(),
+                &tunings,
                 (drums, &own),
                 j,
                 (&mut Vec::new(), Some(&mut hands)),
                 frames,
                 &mut DrumSynth::default(),
             );
-            heads.push(head);
+            heads.push(tunings);
             for (m, h) in monos.iter_mut().zip(hands) {
                 m.push(h);
             }
@@ -52,7 +49,7 @@ pub fn hand_stems(
             let alone = drums.only_side(side);
             let mut mono = vec![0.0; frames];
             if model == SoundModel::Sample {
-                super::sample::render_drum(drum, &alone, j, &mut mono)?;
+                super::sample::render_drum(kit, &alone, j, &mut mono)?;
             } else {
                 super::signal::render_drum(&alone, j, &mut mono);
             }
@@ -67,7 +64,9 @@ pub fn hand_stems(
             (0..kit.drums.len())
                 .map(|j| {
                     let mut state = sympathy::SympathyState::default();
-                    sympathy::resynthesise(kit, &heads, j, (&refs, &fresh), frames, &mut state);
+                    let own = super::touches_of(touches, drums, j);
+                    let heard = (&heads, &own[..]);
+                    sympathy::resynthesise(kit, heard, j, (&refs, &fresh), frames, &mut state);
                     state.out
                 })
                 .collect()

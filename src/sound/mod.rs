@@ -24,10 +24,8 @@ pub use wav::{WavFormat, write_wav, write_wav_as};
 pub use crate::base::choices::SoundModel;
 use crate::drum::DrumSet;
 use crate::kit::Kit;
-use partials::SoundHead;
 use std::f64::consts::FRAC_PI_4;
 use std::path::PathBuf;
-use std::sync::Arc;
 
 /// Audio sample rate, Hz.
 pub const SAMPLE_RATE_HZ: u32 = 48_000;
@@ -157,6 +155,26 @@ pub struct SoundState {
     peaks: Vec<f32>,
 }
 
+/// When hands rest on drum `j`'s head, s, in time order: the `touches` on it, and before
+/// each of its pedal changes (`drums.retunes()`) the player damping it — for
+/// [`TOUCH_S`] up to the change, or from half-way between the drum's last stroke and the
+/// change when they are closer.
+fn touches_of(touches: &[Touch], drums: &DrumSet, j: usize) -> Vec<f64> {
+    let pedals = drums
+        .retunes()
+        .iter()
+        .filter(|r| r.drum == j)
+        .map(|r| (r.at_s - TOUCH_S).max(r.after_s + 0.5 * (r.at_s - r.after_s).max(0.0)));
+    let mut own: Vec<f64> = touches
+        .iter()
+        .filter(|t| t.drum == j)
+        .map(|t| t.at_s)
+        .chain(pedals)
+        .collect();
+    own.sort_by(f64::total_cmp);
+    own
+}
+
 /// Damp a replayed drum's output (sample and signal models, which hold no modal state):
 /// from each touch until the drum's next contact, the sound decays with the touch's
 /// T60 while the hand rests and stays at the level it reached after (the hand has
@@ -266,16 +284,25 @@ pub fn render_resuming(
     render_touched(kit, drums, &[], duration_s, model, previous)
 }
 
-/// Build (or find) the modal model's sounding head of every drum of `kit`, frequencies
-/// from `source`, under the shipped calibration: a render can do it on another core while
-/// it simulates, and its sound then finds them built. Nothing for the other models.
-pub fn prepare_heads(kit: &Kit, source: crate::drum::FrequencySource, model: SoundModel) {
+/// Build (or find) the modal model's sounding head of every drum of `kit`, and of each
+/// drum as its pedal changes `retunes` tune it, frequencies from `source`, under the
+/// shipped calibration: a render can do it on another core while it simulates, and its
+/// sound then finds them built. Nothing for the other models.
+pub fn prepare_heads(
+    kit: &Kit,
+    retunes: &[crate::kit::Retune],
+    source: crate::drum::FrequencySource,
+    model: SoundModel,
+) {
     if model != SoundModel::Modal {
         return;
     }
     let calibration = calibration::Calibration::shipped();
-    for drum in &kit.drums {
-        modal::sound_head_of(drum, source, calibration);
+    let retuned = retunes
+        .iter()
+        .filter_map(|r| Some(kit.drums.get(r.drum)?.retuned(r.pitch)));
+    for drum in kit.drums.iter().cloned().chain(retuned) {
+        modal::sound_head_of(&drum, source, calibration);
     }
 }
 
@@ -403,25 +430,16 @@ fn render_on(
     // Each drum on its own thread: they share nothing but what they read. The modal
     // model's threads also build (or find) their drum's sounding head, which the
     // sympathetic pass then reuses.
-    type Synthesised = (Result<usize, SoundError>, Option<Arc<SoundHead>>);
-    let slots: Vec<_> = kit
-        .drums
-        .iter()
-        .zip(state.drums.iter_mut())
-        .enumerate()
-        .collect();
-    let results: Vec<Synthesised> = each(slots, cores, |(j, (drum, (mono, synth, heard)))| {
-        let own: Vec<f64> = touches
-            .iter()
-            .filter(|t| t.drum == j)
-            .map(|t| t.at_s)
-            .collect();
-        let mut head = None;
+    type Synthesised = (Result<usize, SoundError>, modal::Tunings);
+    let slots: Vec<_> = state.drums.iter_mut().enumerate().collect();
+    let results: Vec<Synthesised> = each(slots, cores, |(j, (mono, synth, heard))| {
+        let own = touches_of(touches, drums, j);
+        let mut heads = Vec::new();
         let outcome = match model {
             SoundModel::Modal => {
-                head = modal::sound_head(drum, drums, calibration);
+                heads = modal::sound_heads(kit, drums, j, calibration);
                 Ok(modal::resynthesise(
-                    head.as_deref(),
+                    &heads,
                     (drums, &own),
                     j,
                     (mono, None),
@@ -431,7 +449,7 @@ fn render_on(
             }
             SoundModel::Sample => {
                 *mono = vec![0.0; frames];
-                sample::render_drum(drum, drums, j, mono).map(|touched| {
+                sample::render_drum(kit, drums, j, mono).map(|touched| {
                     damp_replayed(mono, &own, drums, j);
                     (touched, 0)
                 })
@@ -447,7 +465,7 @@ fn render_on(
             *heard = touched;
             from
         });
-        (from, head)
+        (from, heads)
     });
     let (froms, heads): (Vec<_>, modal::SoundHeads) = results.into_iter().unzip();
     let froms = froms.into_iter().collect::<Result<Vec<usize>, _>>()?;
@@ -459,7 +477,10 @@ fn render_on(
         let sympathy_froms: Vec<usize> = each(
             state.sympathy.iter_mut().enumerate().collect(),
             cores,
-            |(j, sym)| sympathy::resynthesise(kit, heads, j, (&monos, froms), frames, sym),
+            |(j, sym)| {
+                let own = touches_of(touches, drums, j);
+                sympathy::resynthesise(kit, (heads, &own), j, (&monos, froms), frames, sym)
+            },
         );
         start = sympathy_froms.iter().fold(start, |s, f| s.min(*f));
     } else {

@@ -20,8 +20,8 @@ use std::sync::{Arc, Mutex, OnceLock};
 /// Output per unit of Σ gain × modal velocity (gains: [`super::partials`]): an ff strike at the
 /// playing spot of the standard 26-inch drum peaks near −6 dBFS.
 pub const MODAL_CALIBRATION: f64 = 0.006;
-/// Samples per processing block.
-const BLOCK: usize = 128;
+/// Samples per processing block (a pedal change takes effect at a block's start).
+pub const BLOCK: usize = 128;
 /// States below this (m/s; with gains ≤ 0.2 per m/s, under −150 dBFS) are flushed to zero,
 /// and a chunk of voices that is all zero is skipped.
 pub const FLUSH_FLOOR: f32 = 1e-7;
@@ -57,8 +57,55 @@ pub fn sound_head_of(
     Some(head)
 }
 
-/// Each kit drum's sounding head (None where it could not be built).
-pub type SoundHeads = Vec<Option<Arc<SoundHead>>>;
+/// A drum's sounding heads over a performance: from each first frame on (48 kHz, a
+/// multiple of [`BLOCK`]), the head as its pedal tunes it then (None where it could not
+/// be built); the first from frame 0.
+pub type Tunings = Vec<(usize, Option<Arc<SoundHead>>)>;
+
+/// Each kit drum's sounding heads.
+pub type SoundHeads = Vec<Tunings>;
+
+/// The first frame of the block in which a pedal change at score time `at_s` (s) takes
+/// effect.
+pub fn change_frame(at_s: f64) -> usize {
+    ((at_s * f64::from(SAMPLE_RATE_HZ)).floor().max(0.0) as usize) / BLOCK * BLOCK
+}
+
+/// Drum `j` of `kit`'s sounding heads over the performance `drums` recorded: the kit's
+/// drum from the start, then the drum retuned at each of its pedal changes.
+pub fn sound_heads(
+    kit: &crate::kit::Kit,
+    drums: &DrumSet,
+    j: usize,
+    calibration: &Calibration,
+) -> Tunings {
+    let Some(drum) = kit.drums.get(j) else {
+        return Vec::new();
+    };
+    let source = drums.config().source;
+    std::iter::once((0, sound_head_of(drum, source, calibration)))
+        .chain(drums.retunes().iter().filter(|r| r.drum == j).map(|r| {
+            (
+                change_frame(r.at_s),
+                sound_head_of(&drum.retuned(r.pitch), source, calibration),
+            )
+        }))
+        .collect()
+}
+
+/// Which of `tunings` (first frames rising) holds at frame `n`.
+pub fn tuning_at<T>(tunings: &[(usize, T)], n: usize) -> usize {
+    tunings.iter().rposition(|(f, _)| *f <= n).unwrap_or(0)
+}
+
+/// The first frame from which two drums' voices over a performance (per tuning: its first
+/// frame and voices) differ; None when they are the same.
+pub fn first_voice_change(
+    now: &[(usize, Vec<Voice>)],
+    before: &[(usize, Vec<Voice>)],
+) -> Option<usize> {
+    first_change(now, before, |(f, _)| *f as f64).map(|f| f as usize)
+}
 
 /// A sounding head's voice with the model's calibration applied.
 pub fn calibrated_voice(v: &Voice) -> Voice {
@@ -113,7 +160,8 @@ pub struct DrumSynth {
     heard: Vec<(f64, DVec2, f64)>,
     /// The damping touches it heard, s.
     touches: Vec<f64>,
-    voices: Vec<Voice>,
+    /// The voices of each of its tunings, from its first frame.
+    voices: Vec<(usize, Vec<Voice>)>,
 }
 
 /// The time (s, by `time`) of the first entry where two time-ordered records differ: the
@@ -143,7 +191,7 @@ fn first_change<T: PartialEq>(now: &[T], before: &[T], time: impl Fn(&T) -> f64)
 /// tension is set by everything on it), so the bank is linear in each step and the two
 /// shares sum to the drum's sound to the float rounding.
 pub fn resynthesise(
-    head: Option<&SoundHead>,
+    heads: &[(usize, Option<Arc<SoundHead>>)],
     (drums, touches): (&DrumSet, &[f64]),
     j: usize,
     (out, mut hands): (&mut Vec<f32>, Option<&mut [Vec<f32>; 2]>),
@@ -165,7 +213,10 @@ pub fn resynthesise(
         .iter()
         .map(|e| (e.time_s, e.point, e.force_n))
         .collect();
-    let voices = head.map_or(Vec::new(), calibrated);
+    let voices: Vec<(usize, Vec<Voice>)> = heads
+        .iter()
+        .map(|(f, h)| (*f, h.as_deref().map_or(Vec::new(), calibrated)))
+        .collect();
     // The first frame a difference reaches: none before the end of the previous output
     // when the drum is silent now and was then, or heard the same entries with the same
     // voices.
@@ -175,15 +226,13 @@ pub fn resynthesise(
     let first_touch_difference =
         first_change(&touches, &synth.touches, |t| *t).map(|t| (t * fs).floor().max(0.0) as usize);
     let silent_both = heard.is_empty() && synth.heard.is_empty();
-    let from = if voices != synth.voices && !silent_both {
-        0
-    } else {
-        first_difference
-            .into_iter()
-            .chain(first_touch_difference)
-            .fold(usize::MAX, usize::min)
-            .min(out.len())
-    };
+    let voice_difference = first_voice_change(&voices, &synth.voices).filter(|_| !silent_both);
+    let from = first_difference
+        .into_iter()
+        .chain(first_touch_difference)
+        .chain(voice_difference)
+        .fold(usize::MAX, usize::min)
+        .min(out.len());
     let touched = !entries.is_empty();
     // A silent drum's output is zero: only what it held since `from` is cleared.
     let start = if touched {
@@ -203,40 +252,43 @@ pub fn resynthesise(
             *h = vec![0.0; frames];
         }
     }
-    let Some(head) = head.filter(|_| touched) else {
+    if !touched || heads.iter().all(|(_, h)| h.is_none()) {
         synth.saved.clear();
         return (false, start);
-    };
-    let mut bank = VoiceBank::new(&synth.voices, f64::from(SAMPLE_RATE_HZ));
-    let inv_mass: Vec<f64> = head
-        .modes
-        .modes()
-        .iter()
-        .map(|m| 1.0 / m.modal_mass_kg)
-        .collect();
+    }
     let damping = super::touch_factor(fs) as f32;
     let saved = &mut synth.saved;
+    let mut tuned = Tuned::new(
+        heads,
+        &synth.voices,
+        tuning_at(heads, start),
+        hands.is_some(),
+    );
     let mut silent = true;
     if let Some(s) = saved.pop() {
-        bank.restore(&s.bank);
+        tuned.bank.restore(&s.bank);
         silent = s.silent;
     }
-    let stride = bank.stride();
-    let mut shapes = vec![0.0; inv_mass.len()];
-    // The grid cell the shapes were last evaluated at: a contact moves little, so its
-    // entries share them (a function of the entry alone, so resuming changes nothing).
-    let mut shapes_cell: Option<DVec2> = None;
-    let mut row = vec![0.0f32; stride];
-    let mut input = vec![0.0f32; BLOCK * stride];
-    // Each hand's bank and input when the hands are rendered too.
-    let mut hand_banks: Vec<(VoiceBank, Vec<f32>)> = match hands {
-        Some(_) => (0..2)
-            .map(|_| (bank.clone(), vec![0.0f32; BLOCK * stride]))
-            .collect(),
-        None => Vec::new(),
-    };
     let mut first = 0;
     for n0 in (start..out.len()).step_by(BLOCK) {
+        let now = tuning_at(heads, n0);
+        if now != tuned.index {
+            // A pedal change: the head (damped before it) starts at rest at its new pitch.
+            tuned = Tuned::new(heads, &synth.voices, now, hands.is_some());
+            silent = true;
+        }
+        let Tuned {
+            bank,
+            hand_banks,
+            head,
+            inv_mass,
+            shapes,
+            shapes_cell,
+            row,
+            input,
+            ..
+        } = &mut tuned;
+        let stride = bank.stride();
         if n0.is_multiple_of(SAVE_EVERY_BLOCKS * BLOCK) {
             saved.push(Saved {
                 frame: n0,
@@ -255,26 +307,26 @@ pub fn resynthesise(
         {
             let (c, lo, hi) = span(e.time_s);
             let (lo, hi) = (lo.max(n0), hi.min(n1));
-            if lo >= hi {
+            let Some(head) = head.as_deref().filter(|_| lo < hi) else {
                 continue;
-            }
+            };
             let cell = (e.point / SHAPE_GRID_M).round();
-            if shapes_cell != Some(cell) {
-                head.shapes_at(cell * SHAPE_GRID_M, &mut shapes);
-                shapes_cell = Some(cell);
+            if *shapes_cell != Some(cell) {
+                head.shapes_at(cell * SHAPE_GRID_M, shapes);
+                *shapes_cell = Some(cell);
             }
-            for ((r, s), im) in row.iter_mut().zip(&shapes).zip(&inv_mass) {
+            for ((r, s), im) in row.iter_mut().zip(shapes.iter()).zip(inv_mass.iter()) {
                 *r = (e.force_n * s * im) as f32;
             }
             for n in lo..hi {
                 let w = (1.0 - (n as f64 - c).abs() / (dt * fs)).max(0.0) as f32;
                 let at = (n - n0) * stride..(n - n0 + 1) * stride;
                 let hand = hand_banks.get_mut(side_index(e.side));
-                for input in [Some(&mut input), hand.map(|h| &mut h.1)]
+                for input in [Some(&mut *input), hand.map(|h| &mut h.1)]
                     .into_iter()
                     .flatten()
                 {
-                    for (d, r) in input[at.clone()].iter_mut().zip(&row) {
+                    for (d, r) in input[at.clone()].iter_mut().zip(row.iter()) {
                         *d += w * r;
                     }
                 }
@@ -288,7 +340,7 @@ pub fn resynthesise(
                 .iter()
                 .any(|&at| at <= t && t < at + super::TOUCH_S);
             let glide = bank.glide();
-            for b in std::iter::once(&mut bank).chain(hand_banks.iter_mut().map(|h| &mut h.0)) {
+            for b in std::iter::once(&mut *bank).chain(hand_banks.iter_mut().map(|h| &mut h.0)) {
                 b.damp(if resting { damping } else { 1.0 });
                 b.retune(glide);
             }
@@ -314,4 +366,63 @@ pub fn resynthesise(
         }
     }
     (true, start)
+}
+
+/// A drum's synthesis at one of its tunings: the bank (and each hand's, with input),
+/// the head, and the scratch to drive it.
+struct Tuned {
+    index: usize,
+    bank: VoiceBank,
+    hand_banks: Vec<(VoiceBank, Vec<f32>)>,
+    head: Option<Arc<SoundHead>>,
+    inv_mass: Vec<f64>,
+    shapes: Vec<f64>,
+    /// The grid cell the shapes were last evaluated at: a contact moves little, so its
+    /// entries share them (a function of the entry alone, so resuming changes nothing).
+    shapes_cell: Option<DVec2>,
+    row: Vec<f32>,
+    input: Vec<f32>,
+}
+
+impl Tuned {
+    /// Tuning `index` of `heads` (voices `voices[index]`) at rest, with a bank per hand
+    /// when `hands`.
+    fn new(
+        heads: &[(usize, Option<Arc<SoundHead>>)],
+        voices: &[(usize, Vec<Voice>)],
+        index: usize,
+        hands: bool,
+    ) -> Tuned {
+        let head = heads.get(index).and_then(|(_, h)| h.clone());
+        let bank = VoiceBank::new(
+            voices.get(index).map_or(&[][..], |v| &v.1),
+            f64::from(SAMPLE_RATE_HZ),
+        );
+        let inv_mass: Vec<f64> = head.as_deref().map_or(Vec::new(), |h| {
+            h.modes
+                .modes()
+                .iter()
+                .map(|m| 1.0 / m.modal_mass_kg)
+                .collect()
+        });
+        let stride = bank.stride();
+        let hand_banks = if hands {
+            (0..2)
+                .map(|_| (bank.clone(), vec![0.0f32; BLOCK * stride]))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        Tuned {
+            index,
+            shapes: vec![0.0; inv_mass.len()],
+            shapes_cell: None,
+            row: vec![0.0f32; stride],
+            input: vec![0.0f32; BLOCK * stride],
+            bank,
+            hand_banks,
+            head,
+            inv_mass,
+        }
+    }
 }

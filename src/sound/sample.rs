@@ -51,7 +51,7 @@ use super::spectrum::{principal_hz, spectrum};
 use super::{REFERENCE_LEVEL, SAMPLE_RATE_HZ, SoundError, reference_speed_mps};
 use crate::drum::DrumSet;
 use crate::drum::strike::impact_speed_mps;
-use crate::kit::{Drum, Side};
+use crate::kit::{Kit, Side};
 use crate::score::Dynamic;
 use std::f64::consts::TAU;
 use std::io::Cursor;
@@ -240,9 +240,11 @@ fn interpolate(x: &[f32], pos: f64) -> f64 {
         * (p2 - p0 + t * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3 + t * (3.0 * (p1 - p2) + p3 - p0)))
 }
 
-/// Render drum `j`'s contacts into `out`; returns whether any contact was on it.
+/// Render drum `j` of `kit`'s contacts into `out`, each at the pitch the drum is tuned to
+/// when it starts (its pedal changes: `drums.retunes()`); returns whether any contact was
+/// on it.
 pub fn render_drum(
-    drum: &Drum,
+    kit: &Kit,
     drums: &DrumSet,
     j: usize,
     out: &mut [f32],
@@ -251,18 +253,22 @@ pub fn render_drum(
     if contacts.is_empty() {
         return Ok(false);
     }
-    let (left, right) = nearest_pair(drum.tuning.hz())?;
     let fs = f64::from(SAMPLE_RATE_HZ);
     for c in contacts {
+        let Some(drum) = crate::kit::drum_at(kit, drums.retunes(), j, c.start_s) else {
+            return Ok(false);
+        };
+        let tuning_hz = drum.tuning.hz();
+        let (left, right) = nearest_pair(tuning_hz)?;
         let rec = match c.side {
             Side::Left => left,
             Side::Right => right,
         };
         // Recording samples per output sample.
-        let step = drum.tuning.hz() / rec.principal_hz * f64::from(rec.rate_hz) / fs;
+        let step = tuning_hz / rec.principal_hz * f64::from(rec.rate_hz) / fs;
         let amp = REFERENCE_LEVEL * c.impact_speed_mps / reference_speed_mps();
         let start = ((c.start_s * fs).round().max(0.0) as usize).min(out.len());
-        let cutoff = cutoff_hz(c.impact_speed_mps) * drum.tuning.hz() / rec.principal_hz;
+        let cutoff = cutoff_hz(c.impact_speed_mps) * tuning_hz / rec.principal_hz;
         play(rec, step, cutoff, amp, &mut out[start..]);
     }
     Ok(true)

@@ -49,9 +49,9 @@ const NOISE_POLE: f64 = 0.67;
 
 /// Render drum `j`'s contacts into `out`; returns whether any contact was on it.
 pub fn render_drum(drums: &DrumSet, j: usize, out: &mut [f32]) -> bool {
-    let Some(head) = drums.head(j) else {
+    if drums.head(j).is_none() {
         return false;
-    };
+    }
     let contacts: Vec<(usize, &crate::drum::ContactEvent)> = drums
         .contacts()
         .iter()
@@ -62,23 +62,48 @@ pub fn render_drum(drums: &DrumSet, j: usize, out: &mut [f32]) -> bool {
         return false;
     }
     let fs = f64::from(SAMPLE_RATE_HZ);
-    let (index, voices) = voices_for(head, 1.0);
-    // Kicks are scaled by the total gain so kits with more or louder modes stay level.
-    let total_gain: f64 = voices.iter().map(|v| v.gain).sum::<f64>().max(1e-12);
-    let mut bank = VoiceBank::new(&voices, fs);
-    let mut shapes = vec![0.0; head.modes().len()];
-    let mut kick = vec![0.0f32; index.len()];
+    // The tuning the partials ring at (how many pedal changes came before) and them.
+    let mut partials: Option<(usize, Partials)> = None;
     let mut cursor = 0;
     for (ci, c) in &contacts {
         let start = ((c.start_s * fs).round().max(0.0) as usize).min(out.len());
+        let Some(head) = drums.head_at(j, c.start_s) else {
+            continue;
+        };
+        // At a pedal change (the head damped before it) the partials start again at rest
+        // at the new pitch.
+        let tuning = (drums.retunes().iter())
+            .filter(|r| r.drum == j && r.at_s <= c.start_s)
+            .count();
+        if partials.as_ref().is_none_or(|(t, _)| *t != tuning) {
+            if let Some((_, p)) = partials.as_mut() {
+                p.bank.ring(&mut out[cursor..start], FLUSH_FLOOR);
+                cursor = start;
+            }
+            partials = Some((tuning, Partials::of(head)));
+        }
+        let Some((
+            _,
+            Partials {
+                index,
+                total_gain,
+                bank,
+                shapes,
+                kick,
+            },
+        )) = partials.as_mut()
+        else {
+            continue;
+        };
+        let total_gain = *total_gain;
         bank.ring(&mut out[cursor..start], FLUSH_FLOOR);
         cursor = start;
         let amp = REFERENCE_LEVEL * c.impact_speed_mps / reference_speed_mps();
-        head.shapes_at(head.local(c.point), &mut shapes);
-        for (d, &k) in kick.iter_mut().zip(&index) {
+        head.shapes_at(head.local(c.point), shapes);
+        for (d, &k) in kick.iter_mut().zip(index.iter()) {
             *d = (amp / total_gain * SIGNAL_SCALE * shapes[k]) as f32;
         }
-        bank.kick(&kick);
+        bank.kick(kick);
         // The noise burst, added directly.
         let mut rng = Rng::new(0x5EED_0000 ^ ((j as u64) << 32) ^ *ci as u64);
         let mut lp = 0.0;
@@ -89,6 +114,33 @@ pub fn render_drum(drums: &DrumSet, j: usize, out: &mut [f32]) -> bool {
             *o += (NOISE_LEVEL * amp * env * lp) as f32;
         }
     }
-    bank.ring(&mut out[cursor..], FLUSH_FLOOR);
+    if let Some((_, p)) = partials.as_mut() {
+        p.bank.ring(&mut out[cursor..], FLUSH_FLOOR);
+    }
     true
+}
+
+/// A head's partials ringing, and the scratch to kick them.
+struct Partials {
+    /// Indices of the partials' modes in the head's modes.
+    index: Vec<usize>,
+    /// The kicks are scaled by the total gain so kits with more or louder modes stay level.
+    total_gain: f64,
+    bank: VoiceBank,
+    shapes: Vec<f64>,
+    kick: Vec<f32>,
+}
+
+impl Partials {
+    /// `head`'s partials at rest.
+    fn of(head: &HeadModes) -> Partials {
+        let (index, voices) = voices_for(head, 1.0);
+        Partials {
+            total_gain: voices.iter().map(|v| v.gain).sum::<f64>().max(1e-12),
+            bank: VoiceBank::new(&voices, f64::from(SAMPLE_RATE_HZ)),
+            shapes: vec![0.0; head.modes().len()],
+            kick: vec![0.0f32; index.len()],
+            index,
+        }
+    }
 }

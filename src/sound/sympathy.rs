@@ -15,10 +15,13 @@
 //! and modes with m ≥ 2 see no net force from a plane wave at this order. Each receiving
 //! head runs those modes (its m ≤ 1 voices, gains as in its own sound) driven by F/M_k,
 //! and what they radiate is added to its own sound. One way only: the ringing of a
-//! receiving head does not drive the source back (it is 30 dB and more below it).
+//! receiving head does not drive the source back (it is 20 dB and more below it). A hand
+//! resting on a receiving head damps its ringing as it damps its own sound, and at a pedal
+//! change the head starts again at rest at its new pitch.
 
 use super::SAMPLE_RATE_HZ;
-use super::modal::{FLUSH_FLOOR, SoundHeads};
+use super::modal::{BLOCK, FLUSH_FLOOR, SoundHeads, first_voice_change, tuning_at};
+use super::partials::SoundHead;
 use super::radiation::SOUND_SPEED_MPS;
 use super::voices::{BankState, Voice, VoiceBank};
 use crate::drum::bessel::bessel_j;
@@ -30,8 +33,6 @@ use std::f64::consts::PI;
 pub const FULL_SCALE_PA: f64 = 12.6;
 /// Distance at which the output is taken as the radiated pressure, m.
 pub const REFERENCE_DISTANCE_M: f64 = 1.0;
-/// Frames per processing block.
-const BLOCK: usize = 128;
 /// The receiving heads run at the audio rate over this (6 kHz: their modes are below
 /// [`MAX_HZ`]); their output is brought back by linear interpolation.
 const DECIMATION: usize = 8;
@@ -60,13 +61,14 @@ pub struct SympathyState {
     pub out: Vec<f32>,
     /// Saved: (frame, bank state, the last sub-step's output).
     saved: Vec<(usize, BankState, f32)>,
-    /// The voices it rang with (a change restarts it).
-    voices: Vec<Voice>,
+    /// The voices it rang with per tuning, from its first frame (a change restarts it
+    /// there).
+    voices: Vec<(usize, Vec<Voice>)>,
 }
 
 impl Receiver {
-    fn new(kit: &Kit, heads: &SoundHeads, j: usize) -> Option<Receiver> {
-        let head = heads.get(j)?.as_deref()?;
+    /// Drum `j`'s receiver when its head is `head`; `heads` say which drums sound.
+    fn new(kit: &Kit, heads: &SoundHeads, j: usize, head: &SoundHead) -> Option<Receiver> {
         let a = head.modes.radius_m();
         let picked: Vec<usize> = (0..head.voices.len())
             .filter(|&k| head.modes.modes()[k].m <= 1 && head.voices[k].freq_hz <= MAX_HZ)
@@ -100,7 +102,12 @@ impl Receiver {
             })
             .collect();
         let sources = (0..kit.drums.len())
-            .filter(|&i| i != j && heads.get(i).is_some_and(Option::is_some))
+            .filter(|&i| {
+                i != j
+                    && heads
+                        .get(i)
+                        .is_some_and(|t| t.iter().any(|(_, h)| h.is_some()))
+            })
             .map(|i| {
                 let from = kit.drums[i].centre();
                 let d = (centre - from).length().max(0.05);
@@ -126,20 +133,28 @@ impl Receiver {
 pub const MAX_HZ: f64 = 1000.0;
 
 /// Drum `j`'s sympathetic output, `frames` long, from the other drums' radiated sound
-/// (the time derivative of their synthesis `monos[i]`, as the mix radiates it), resuming `state` from the first frame a
-/// source's sound changed (`changed[i]`, per drum). Returns the first frame rewritten.
-/// Bit for bit a whole render.
+/// (the time derivative of their synthesis `monos[i]`, as the mix radiates it), its head
+/// as `heads[j]` tunes it over the performance and damped while a hand rests on it (from
+/// each of `touches`, s, for [`TOUCH_S`](super::TOUCH_S)), resuming `state` from the
+/// first frame a source's sound changed (`changed[i]`, per drum). Returns the first frame
+/// rewritten. Bit for bit a whole render.
 pub fn resynthesise(
     kit: &Kit,
-    heads: &SoundHeads,
+    (heads, touches): (&SoundHeads, &[f64]),
     j: usize,
     (monos, changed): (&[&[f32]], &[usize]),
     frames: usize,
     state: &mut SympathyState,
 ) -> usize {
-    let Some(mut rx) = Receiver::new(kit, heads, j) else {
+    let tunings = heads.get(j).map_or(&[][..], Vec::as_slice);
+    let receivers: Vec<Option<Receiver>> = tunings
+        .iter()
+        .map(|(_, h)| Receiver::new(kit, heads, j, h.as_deref()?))
+        .collect();
+    let Some(sources) = receivers.iter().flatten().next().map(|r| r.sources.clone()) else {
         // Nothing rings here: silent, and unchanged if it was silent already.
-        let unchanged = state.voices.is_empty() && state.out.iter().all(|v| *v == 0.0);
+        let unchanged =
+            state.voices.iter().all(|(_, v)| v.is_empty()) && state.out.iter().all(|v| *v == 0.0);
         let from = if unchanged { state.out.len() } else { 0 };
         *state = SympathyState {
             out: vec![0.0; frames],
@@ -147,35 +162,55 @@ pub fn resynthesise(
         };
         return from;
     };
+    let voices: Vec<(usize, Vec<Voice>)> = tunings
+        .iter()
+        .zip(&receivers)
+        .map(|((f, _), rx)| (*f, rx.as_ref().map_or(Vec::new(), |r| r.voices.clone())))
+        .collect();
     // From the first frame a source's sound changes here, or the head's own synthesis
     // changed (its voices may have: a new tuning or size).
-    let from = rx
-        .sources
+    let from = sources
         .iter()
         .map(|(i, delay, ..)| changed[*i].saturating_add(*delay))
         .chain([changed[j]])
+        .chain(first_voice_change(&voices, &state.voices))
         .min()
         .unwrap_or(usize::MAX)
         .min(state.out.len());
-    let from = if rx.voices == state.voices { from } else { 0 };
-    state.voices.clone_from(&rx.voices);
+    state.voices = voices;
     let resume = state.saved.iter().rposition(|(f, ..)| *f <= from);
     let start = resume.map_or(0, |k| state.saved[k].0).min(frames);
+    let mut index = tuning_at(tunings, start);
+    let mut receiver = receivers[index].clone();
     let mut last = 0.0f32;
     if let Some(k) = resume.filter(|_| start > 0) {
-        rx.bank.restore(&state.saved[k].1);
+        if let Some(rx) = receiver.as_mut() {
+            rx.bank.restore(&state.saved[k].1);
+        }
         last = state.saved[k].2;
     }
     state.saved.retain(|(f, ..)| *f < start);
     state.out.resize(frames, 0.0);
     state.out[start..].fill(0.0);
-    let stride = rx.bank.stride();
     let steps = BLOCK / DECIMATION;
-    let mut input = vec![0.0f32; steps * stride];
     let mut sub = [0.0f32; BLOCK / DECIMATION];
     let fs = f64::from(SAMPLE_RATE_HZ);
+    let damping = super::touch_factor(fs / DECIMATION as f64) as f32;
     let mut ringing = start > 0;
     for n0 in (start..frames).step_by(BLOCK) {
+        let now = tuning_at(tunings, n0);
+        if now != index {
+            // A pedal change: the head, damped before it, starts again at rest.
+            index = now;
+            receiver = receivers[index].clone();
+            ringing = false;
+        }
+        let Some(rx) = receiver.as_mut() else {
+            last = 0.0;
+            continue;
+        };
+        let stride = rx.bank.stride();
+        let mut input = vec![0.0f32; steps * stride];
         if n0.is_multiple_of(SAVE_EVERY_BLOCKS * BLOCK) {
             state.saved.push((n0, rx.bank.state(), last));
         }
@@ -218,6 +253,11 @@ pub fn resynthesise(
             driven = true;
         }
         sub.fill(0.0);
+        if driven || ringing {
+            let t = n0 as f64 / fs;
+            let resting = touches.iter().any(|&at| at <= t && t < at + super::TOUCH_S);
+            rx.bank.damp(if resting { damping } else { 1.0 });
+        }
         if driven {
             rx.bank
                 .render_driven(&input[..used * stride], &mut sub[..used]);
