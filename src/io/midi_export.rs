@@ -169,8 +169,9 @@ fn timpani_events<'a>(score: &Score, kit: &Kit, payloads: &'a [Vec<u8>]) -> Vec<
     let tpq = u64::from(score.ticks_per_quarter);
     // (tick, key, velocity, beat index, first stroke of the beat)
     let mut strokes: Vec<(u64, u8, u8, usize, bool)> = Vec::new();
-    for (i, beat) in score.beats.iter().enumerate() {
-        let key = beat.sounding_pitch(kit).0;
+    let sounding = crate::score::tuning::sounding_pitches(score, kit);
+    for (i, (beat, pitch)) in score.beats.iter().zip(&sounding).enumerate() {
+        let key = pitch.0;
         let vel = beat.dynamic.midi_velocity();
         strokes.extend(
             beat.stroke_ticks(score.ticks_per_quarter)

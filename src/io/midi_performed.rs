@@ -6,8 +6,8 @@
 //!
 //! Re-contacts and rebounds (touches that are no stroke's contact) get no note: they
 //! sound as part of the stroke's note (a buzz, a flam), and a note for each would double
-//! the stroke in a DAW. Key: the struck drum's tuning (the pitch it sounds; a beat's
-//! written pitch is not simulated). Channel 1, General MIDI program 48 "Timpani" (not
+//! the stroke in a DAW. Key: the pitch the struck drum is tuned to at the contact (the
+//! pitch it sounds, pedal changes included). Channel 1, General MIDI program 48 "Timpani" (not
 //! channel 10: General MIDI percussion has no timpani key). Velocity: the render's own
 //! force aim inverted, v = round(127 · (F − F₀) / ΔF) clamped to 1–127 (F peak force, N;
 //! F₀ and ΔF the aims at velocity 0 and the rise to 127), so a stroke that met its aim
@@ -42,11 +42,14 @@ impl ForceScale {
 pub fn export(score: &Score, kit: &Kit, hits: &[Hit], scale: &ForceScale) -> Vec<u8> {
     let tpq = score.ticks_per_quarter;
     let steps = tempo_steps(score);
+    let retunes = crate::score::tuning::retunes(score, kit);
     let mut notes: Vec<(u64, u8, u8)> = hits
         .iter()
         .filter(|h| h.primary)
         .filter_map(|h| {
-            let key = kit.drums.get(h.drum)?.tuning.0;
+            let key = crate::kit::drum_at(kit, &retunes, h.drum, h.time_s)?
+                .tuning
+                .0;
             let tick = tick_at(&steps, tpq, h.time_s).round() as u64;
             Some((tick, key, scale.velocity(h.peak_force_n)))
         })
@@ -151,5 +154,26 @@ mod tests {
             ons,
             vec![(480, key(0), 1), (960, key(1), 64), (2400, key(2), 127)]
         );
+        // The 26-inch drum's beats name D3 at 1 s and E3 at 2.25 s: a pedal change, and
+        // the hit after it is keyed E3.
+        score.beats = [(960, "D3"), (2400, "E3")]
+            .map(|(tick, p)| crate::score::Beat {
+                pitch: Some(p.parse().unwrap()),
+                ..crate::score::Beat::plain(tick, 2)
+            })
+            .to_vec();
+        let smf_bytes = export(&score, &kit, &hits, &scale);
+        let smf = Smf::parse(&smf_bytes).unwrap();
+        let keys: Vec<u8> = (smf.tracks[1].iter())
+            .filter_map(|e| match e.kind {
+                TrackEventKind::Midi {
+                    message: MidiMessage::NoteOn { key, .. },
+                    ..
+                } => Some(key.as_int()),
+                _ => None,
+            })
+            .collect();
+        let e3: crate::base::pitch::Pitch = "E3".parse().unwrap();
+        assert_eq!(keys, [key(0), key(1), e3.0]);
     }
 }

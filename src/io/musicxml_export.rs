@@ -108,6 +108,8 @@ struct Group<'a> {
     /// Where a damped roll's tremolo stops (its notes are split there).
     splits: Vec<u64>,
     beats: Vec<&'a Beat>,
+    /// The pitch each of `beats` sounds (its own, else its drum's then).
+    pitches: Vec<crate::base::pitch::Pitch>,
 }
 
 /// A direction or a bare `<sound>` at a tick.
@@ -145,7 +147,6 @@ struct Piece {
 
 struct Writer<'a> {
     score: &'a Score,
-    kit: &'a Kit,
     tpq: u64,
     /// Ticks per division.
     unit: u64,
@@ -159,7 +160,7 @@ struct Writer<'a> {
 impl<'a> Writer<'a> {
     fn new(score: &'a Score, kit: &'a Kit) -> Self {
         let tpq = u64::from(score.ticks_per_quarter.max(1));
-        let groups = groups(score, tpq);
+        let groups = groups(score, kit, tpq);
         let mut marks = tempo_marks(score);
         marks.extend(dynamic_marks(&groups));
         marks.sort_by_key(|d| d.tick);
@@ -180,7 +181,6 @@ impl<'a> Writer<'a> {
         let unit = times.fold(tpq, gcd);
         Writer {
             score,
-            kit,
             tpq,
             unit,
             groups,
@@ -329,7 +329,7 @@ impl<'a> Writer<'a> {
                 if n > 0 {
                     note.push_str("<chord/>");
                 }
-                note.push_str(&pitch_xml(beat.sounding_pitch(self.kit)));
+                note.push_str(&pitch_xml(group.pitches[n]));
                 let _ = write!(note, "<duration>{}</duration>", ticks / self.unit);
                 let (tie_stop, tie_start) = (!first, !last);
                 for (on, kind) in [(tie_stop, "stop"), (tie_start, "start")] {
@@ -506,17 +506,22 @@ fn dynamic_marks(groups: &[Group]) -> Vec<Mark> {
 /// The beats grouped by tick, each group ending at the next group's tick or the end of
 /// its bar (a roll: its length; a damped beat: its damping touch), whichever first; the
 /// last without a roll or damp lasts a quarter note at most.
-fn groups(score: &Score, tpq: u64) -> Vec<Group<'_>> {
+fn groups<'s>(score: &'s Score, kit: &Kit, tpq: u64) -> Vec<Group<'s>> {
     let meter = score.meter_map();
+    let sounding = crate::score::tuning::sounding_pitches(score, kit);
     let mut groups: Vec<Group> = Vec::new();
-    for b in &score.beats {
+    for (b, &pitch) in score.beats.iter().zip(&sounding) {
         match groups.last_mut() {
-            Some(g) if g.tick == b.tick => g.beats.push(b),
+            Some(g) if g.tick == b.tick => {
+                g.beats.push(b);
+                g.pitches.push(pitch);
+            }
             _ => groups.push(Group {
                 tick: b.tick,
                 end: 0,
                 splits: Vec::new(),
                 beats: vec![b],
+                pitches: vec![pitch],
             }),
         }
     }

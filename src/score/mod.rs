@@ -87,7 +87,8 @@ impl Beat {
         self.damp.map(|d| self.end_tick() + d)
     }
 
-    /// The pitch sounded: the beat's own or the drum's kit tuning.
+    /// The beat's own pitch, else `kit`'s tuning of its drum (what a beat naming none
+    /// sounds is the drum's pitch then: [`Score::sounding_pitches`]).
     pub fn sounding_pitch(&self, kit: &Kit) -> Pitch {
         self.pitch.unwrap_or(kit.drums[self.drum].tuning)
     }

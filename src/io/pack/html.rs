@@ -8,6 +8,7 @@
 //! load, e.g. when `index.html` was copied without its folders.
 
 use super::phrases::Phrase;
+use crate::base::pitch::Pitch;
 use crate::io::performance::{Contact, Performance};
 use crate::score::{BarBeat, Beat, Dynamic, Hand};
 use std::fmt::Write;
@@ -123,9 +124,10 @@ fn hand_name(beat: &Beat, index: usize, p: &Performance) -> String {
     }
 }
 
-fn drum_name(p: &Performance, beat: &Beat) -> String {
+/// The beat's drum and the pitch it sounds (`pitch`).
+fn drum_name(p: &Performance, beat: &Beat, pitch: Pitch) -> String {
     match p.kit.drums.get(beat.drum) {
-        Some(d) => format!("{} ({})", d.name, beat.sounding_pitch(p.kit)),
+        Some(d) => format!("{} ({pitch})", d.name),
         None => format!("drum {}", beat.drum),
     }
 }
@@ -138,7 +140,8 @@ fn score_table(out: &mut String, p: &Performance) {
          <th>hand</th><th>drum (pitch)</th><th>mode</th><th>dynamic</th><th>location</th>\
          <th>roll, damping</th></tr>\n",
     );
-    for (i, b) in p.score.beats.iter().enumerate() {
+    let sounding = crate::score::tuning::sounding_pitches(p.score, p.kit);
+    for (i, (b, &pitch)) in p.score.beats.iter().zip(&sounding).enumerate() {
         let pos = meter.position(b.tick);
         let mut extra = Vec::new();
         if let Some(r) = b.roll {
@@ -159,7 +162,7 @@ fn score_table(out: &mut String, p: &Performance) {
              <td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
             tempo.seconds_at(b.tick as f64),
             escape(&hand_name(b, i, p)),
-            escape(&drum_name(p, b)),
+            escape(&drum_name(p, b, pitch)),
             b.mode.name(),
             escape(&dynamic_name(b.dynamic)),
             escape(&b.location.name()),
