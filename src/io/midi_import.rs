@@ -809,13 +809,14 @@ pub(super) fn assign_drums(notes: &[Note], kit: &Kit) -> Vec<Beat> {
             mode: data.1,
             dynamic: Dynamic::from_midi_velocity(n.vel),
             drum,
-            pitch: (pitch != kit.drums[drum].tuning).then_some(pitch),
+            pitch: Some(pitch),
             location: data.3,
             roll: data.4,
             // A MIDI note's length says nothing reliable about damping: let it ring.
             damp: None,
         });
     }
+    crate::score::tuning::drop_needless_pitches(&mut beats, kit);
     beats
 }
 
@@ -957,7 +958,7 @@ mod tests {
     }
 
     /// Alternating D3 and A2 go to the drum tuned to D3 and to the drum nearest A2 (retuned
-    /// once, then kept), with the pitch kept only where it differs from the kit tuning.
+    /// once, then kept), with the pitch kept only on a drum retuned somewhere.
     #[test]
     fn drums_as_a_timpanist_would() {
         let kit = Kit::standard();
@@ -977,6 +978,27 @@ mod tests {
                 .iter()
                 .all(|b| b.hand == Hand::Auto && b.roll.is_none())
         );
+    }
+
+    /// A line with more pitches than drums retunes drums within the piece; every note,
+    /// the ones at a drum's kit tuning included, still sounds its own pitch (a beat naming
+    /// none would sound the drum's pitch then, so a retuned drum's beats all name theirs).
+    #[test]
+    fn a_line_with_more_pitches_than_drums_sounds_every_note() {
+        let kit = Kit::standard();
+        let line = [
+            "G2", "A2", "B2", "C3", "D3", "E3", "F3", "G3", "D3", "A2", "G2",
+        ];
+        let notes: Vec<Note> = (line.iter().enumerate())
+            .map(|(i, p)| note(i as u64 * 480, pitch(p)))
+            .collect();
+        let mut score = crate::score::Score::new("line");
+        score.beats = assign_drums(&notes, &kit);
+        let sounding: Vec<String> = (score.sounding_pitches(&kit).iter())
+            .map(ToString::to_string)
+            .collect();
+        assert_eq!(sounding, line);
+        assert!(!score.pedal_changes(&kit).is_empty());
     }
 
     /// Two notes at the same tick that the same drum could play go to different drums,

@@ -190,18 +190,18 @@ impl Score {
     /// The pedal changes this score asks of `kit` ([`tuning::pedal_changes`] of its
     /// [`kit`](Score::kit)), in time order.
     pub fn pedal_changes(&self, kit: &Kit) -> Vec<tuning::PedalChange> {
-        tuning::pedal_changes(self, &self.kit(kit))
+        tuning::pedal_changes(self, &self.settings.kit(kit))
     }
 
     /// The pitch each beat sounds on `kit` ([`tuning::sounding_pitches`] of its
     /// [`kit`](Score::kit)).
     pub fn sounding_pitches(&self, kit: &Kit) -> Vec<crate::base::pitch::Pitch> {
-        tuning::sounding_pitches(self, &self.kit(kit))
+        tuning::sounding_pitches(self, &self.settings.kit(kit))
     }
 
     /// The retunings that carry out this score's pedal changes on `kit`, in time order.
     pub fn retunes(&self, kit: &Kit) -> Vec<crate::kit::Retune> {
-        tuning::retunes(self, &self.kit(kit))
+        tuning::retunes(self, &self.settings.kit(kit))
     }
 
     /// An empty score in 4/4 at 100 bpm on the standard kit.

@@ -258,7 +258,8 @@ pub fn roll_of(run: &[Placed], tpq: u32) -> Roll {
 }
 
 /// The beats of the placed strokes: rolls where [`roll_runs`] finds them, a beat per drum
-/// of each other stroke; the drum's pitch written only where it differs from the kit's.
+/// of each other stroke; the pitch written on the beats of a drum retuned somewhere
+/// (`tuning::drop_needless_pitches`).
 pub fn beats(placed: &[Placed], kit: &Kit, tpq: u32) -> (Vec<Beat>, usize) {
     let runs = roll_runs(placed);
     let mut beats = Vec::new();
@@ -272,7 +273,7 @@ pub fn beats(placed: &[Placed], kit: &Kit, tpq: u32) -> (Vec<Beat>, usize) {
             mode: PlayingMode::Legato,
             dynamic: p.dynamic,
             drum,
-            pitch: (pitch != kit.drums[drum].tuning).then_some(pitch),
+            pitch: Some(pitch),
             location: ImpactLocation::PlayingSpot,
             roll: None,
             damp: None,
@@ -290,6 +291,7 @@ pub fn beats(placed: &[Placed], kit: &Kit, tpq: u32) -> (Vec<Beat>, usize) {
         beats.extend(p.drums.iter().map(|&d| beat(d)));
         i += 1;
     }
+    crate::score::tuning::drop_needless_pitches(&mut beats, kit);
     (beats, runs.len())
 }
 
