@@ -24,7 +24,7 @@ fn demo_paths() -> Vec<PathBuf> {
         .filter(|p| p.extension().is_some_and(|e| e == "ron"))
         .collect();
     paths.sort();
-    assert_eq!(paths.len(), 7);
+    assert_eq!(paths.len(), 8);
     paths
 }
 

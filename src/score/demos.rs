@@ -24,6 +24,10 @@ pub const DEMOS: &[(&str, &str)] = &[
     ),
     ("secco-study", include_str!("../../scores/secco-study.ron")),
     (
+        "pedal-changes",
+        include_str!("../../scores/pedal-changes.ron"),
+    ),
+    (
         "improvisation",
         include_str!("../../scores/improvisation.ron"),
     ),
