@@ -848,3 +848,63 @@ fn with_a_tail(
     };
     render(loaded, db, &params, &mut |_| true).unwrap()
 }
+
+/// Quick pedal changes (a D3 roll, E3 straight after it, F3 0.15 s later, on the 26-inch
+/// drum): each new note sounds at full strength and at its pitch — the damping before a
+/// change ends at the change, and the change comes before the beat's contact. (Before,
+/// a damping touch lasting 0.25 s past a quick change stopped the new notes 50 dB down.)
+#[test]
+fn quick_pedal_changes_keep_the_new_notes() {
+    use timpanist::base::choices::SoundModel;
+    use timpanist::score::Roll;
+    let db = db();
+    let mut score = Score::new("quick pedal changes");
+    score.ticks_per_quarter = 960;
+    let quarter_s = 60.0 / score.tempo_map().bpm_at(0.0);
+    let (e3_tick, f3_tick) = (1920, 1920 + 240);
+    let pitched = |tick, hand, pitch: &str| Beat {
+        hand,
+        pitch: Some(pitch.parse().unwrap()),
+        dynamic: Dynamic::F,
+        ..Beat::plain(tick, 2)
+    };
+    score.beats = vec![
+        Beat {
+            roll: Some(Roll {
+                length_ticks: 1920,
+                strokes_per_quarter: 4,
+            }),
+            ..pitched(0, Hand::Right, "D3")
+        },
+        pitched(e3_tick, Hand::Right, "E3"),
+        pitched(f3_tick, Hand::Left, "F3"),
+    ];
+    let loaded = on_the_standard_kit(score);
+    let changes = loaded.score.pedal_changes(&loaded.kit);
+    assert_eq!(changes.len(), 2);
+    assert!(changes.iter().all(|c| c.is_quick()), "{changes:?}");
+    let r = with_a_tail(&loaded, &db, SoundModel::Modal);
+    let stems = timpanist::sound::stems(
+        &r.kit,
+        (&r.drums, &r.touches),
+        r.audio.frames() as f64 / f64::from(r.audio.rate_hz),
+        SoundModel::Modal,
+    )
+    .unwrap();
+    let stem = stems[2].mono();
+    let rate = f64::from(r.audio.rate_hz);
+    let at = |s: f64| (s * rate) as usize;
+    let peak = |s: &[f32]| s.iter().fold(0.0f32, |m, x| m.max(x.abs()));
+    let first = peak(&stem[..at(0.3)]);
+    for tick in [e3_tick, f3_tick] {
+        let t = tick as f64 / 960.0 * quarter_s;
+        let new = peak(&stem[at(t)..at(t + 0.1)]);
+        assert!(new >= 0.3 * first, "at {t:.2} s: {new:e} against {first:e}");
+    }
+    let f3_s = f3_tick as f64 / 960.0 * quarter_s;
+    let heard = timpanist::sound::analysis::profile(&stem[at(f3_s - 0.005)..], r.audio.rate_hz)
+        .and_then(|p| p.principal_hz)
+        .unwrap();
+    let f3: timpanist::base::pitch::Pitch = "F3".parse().unwrap();
+    assert!((heard / f3.hz() - 1.0).abs() < 0.02, "heard {heard:.1} Hz");
+}

@@ -204,7 +204,7 @@ pub struct Retune {
     pub drum: usize,
     /// Score time from which the new pitch holds, s.
     pub at_s: f64,
-    /// Score time the drum's last stroke at the old pitch ends, s.
+    /// Score time of the drum's last stroke at the old pitch, s.
     pub after_s: f64,
     pub pitch: Pitch,
 }

@@ -14,6 +14,9 @@ use std::borrow::Cow;
 
 /// The new pitch holds this long before the first beat asking for it, s.
 pub const RETUNE_LEAD_S: f64 = 0.1;
+/// ... and at least this long, however close the strokes (a stroke's contact may come a
+/// few milliseconds early), s.
+pub const RETUNE_MARGIN_S: f64 = 0.01;
 /// A pedal change with less time than this after the drum's last stroke is flagged as
 /// quick: the head must be damped and the pedal moved in between, s.
 pub const QUICK_PEDAL_S: f64 = 0.5;
@@ -28,7 +31,7 @@ pub struct PedalChange {
     pub from: Pitch,
     /// What the beat asks.
     pub to: Pitch,
-    /// Score time the drum's previous stroke ends, s.
+    /// Score time of the drum's previous stroke (a roll's last), s.
     pub after_s: f64,
     /// Score time of the beat, s.
     pub before_s: f64,
@@ -50,7 +53,9 @@ impl PedalChange {
         let gap = self.gap_s().max(0.0);
         Retune {
             drum: self.drum,
-            at_s: (self.before_s - RETUNE_LEAD_S).max(self.after_s + 0.5 * gap),
+            at_s: (self.before_s - RETUNE_LEAD_S)
+                .max(self.after_s + 0.5 * gap)
+                .min(self.before_s - RETUNE_MARGIN_S),
             after_s: self.after_s,
             pitch: self.to,
         }
@@ -132,7 +137,7 @@ fn walk(score: &Score, kit: &Kit) -> (Vec<PedalChange>, Vec<Pitch>) {
     let map = score.tempo_map();
     let mut order: Vec<usize> = (0..score.beats.len()).collect();
     order.sort_by_key(|&i| score.beats[i].tick);
-    // Per drum: the pitch it plays and when its latest stroke ends (s).
+    // Per drum: the pitch it plays and when its latest stroke is (s).
     let mut now: Vec<(Pitch, Option<f64>)> = kit.drums.iter().map(|d| (d.tuning, None)).collect();
     let mut changes = Vec::new();
     let mut sounding: Vec<Pitch> = score
@@ -163,8 +168,9 @@ fn walk(score: &Score, kit: &Kit) -> (Vec<PedalChange>, Vec<Pitch>) {
         }
         *pitch = beat.pitch.unwrap_or(*pitch);
         sounding[i] = *pitch;
-        let end_s = map.seconds_at(beat.end_tick() as f64);
-        *last_end = Some(last_end.map_or(end_s, |e| e.max(end_s)));
+        let last_tick = (beat.stroke_ticks(score.ticks_per_quarter).last()).unwrap_or(beat.tick);
+        let last_s = map.seconds_at(last_tick as f64);
+        *last_end = Some(last_end.map_or(last_s, |e| e.max(last_s)));
     }
     (changes, sounding)
 }

@@ -155,34 +155,38 @@ pub struct SoundState {
     peaks: Vec<f32>,
 }
 
-/// When hands rest on drum `j`'s head, s, in time order: the `touches` on it, and before
-/// each of its pedal changes (`drums.retunes()`) the player damping it — for
-/// [`TOUCH_S`] up to the change, or from half-way between the drum's last stroke and the
-/// change when they are closer.
-fn touches_of(touches: &[Touch], drums: &DrumSet, j: usize) -> Vec<f64> {
-    let pedals = drums
-        .retunes()
-        .iter()
-        .filter(|r| r.drum == j)
-        .map(|r| (r.at_s - TOUCH_S).max(r.after_s + 0.5 * (r.at_s - r.after_s).max(0.0)));
-    let mut own: Vec<f64> = touches
+/// When hands rest on drum `j`'s head, from when to when (s), in time order: the
+/// `touches` on it, each for [`TOUCH_S`], and before each of its pedal changes
+/// (`drums.retunes()`) the player damping it up to the change — for [`TOUCH_S`], or from
+/// half-way between the drum's last stroke and the change when they are closer.
+fn touches_of(touches: &[Touch], drums: &DrumSet, j: usize) -> Vec<(f64, f64)> {
+    let pedals = drums.retunes().iter().filter(|r| r.drum == j).map(|r| {
+        let from = (r.at_s - TOUCH_S).max(r.after_s + 0.5 * (r.at_s - r.after_s).max(0.0));
+        (from.min(r.at_s), r.at_s)
+    });
+    let mut own: Vec<(f64, f64)> = touches
         .iter()
         .filter(|t| t.drum == j)
-        .map(|t| t.at_s)
+        .map(|t| (t.at_s, t.at_s + TOUCH_S))
         .chain(pedals)
         .collect();
-    own.sort_by(f64::total_cmp);
+    own.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
     own
+}
+
+/// Whether a hand rests on the head at time `t` (s) under `touches` (from, until; s).
+fn resting(touches: &[(f64, f64)], t: f64) -> bool {
+    touches.iter().any(|&(from, until)| from <= t && t < until)
 }
 
 /// Damp a replayed drum's output (sample and signal models, which hold no modal state):
 /// from each touch until the drum's next contact, the sound decays with the touch's
 /// T60 while the hand rests and stays at the level it reached after (the hand has
 /// stopped it).
-fn damp_replayed(mono: &mut [f32], touches: &[f64], drums: &DrumSet, j: usize) {
+fn damp_replayed(mono: &mut [f32], touches: &[(f64, f64)], drums: &DrumSet, j: usize) {
     let fs = f64::from(SAMPLE_RATE_HZ);
     let factor = touch_factor(fs);
-    for &at in touches {
+    for &(at, until) in touches {
         let next = drums
             .contacts()
             .iter()
@@ -191,7 +195,7 @@ fn damp_replayed(mono: &mut [f32], touches: &[f64], drums: &DrumSet, j: usize) {
             .fold(f64::INFINITY, f64::min);
         let from = ((at * fs).round().max(0.0) as usize).min(mono.len());
         let to = ((next * fs).round().min(mono.len() as f64)) as usize;
-        let rest = (TOUCH_S * fs) as usize;
+        let rest = ((until - at) * fs).max(0.0) as usize;
         let mut gain = 1.0;
         for (k, s) in mono[from..to.max(from)].iter_mut().enumerate() {
             if k < rest {

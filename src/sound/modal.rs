@@ -158,8 +158,8 @@ pub struct DrumSynth {
     /// The drum's excitation it heard, in time order: time (s), contact point (m), force
     /// (N).
     heard: Vec<(f64, DVec2, f64)>,
-    /// The damping touches it heard, s.
-    touches: Vec<f64>,
+    /// The damping touches it heard: from when to when a hand rested on the head, s.
+    touches: Vec<(f64, f64)>,
     /// The voices of each of its tunings, from its first frame.
     voices: Vec<(usize, Vec<Voice>)>,
 }
@@ -192,7 +192,7 @@ fn first_change<T: PartialEq>(now: &[T], before: &[T], time: impl Fn(&T) -> f64)
 /// shares sum to the drum's sound to the float rounding.
 pub fn resynthesise(
     heads: &[(usize, Option<Arc<SoundHead>>)],
-    (drums, touches): (&DrumSet, &[f64]),
+    (drums, touches): (&DrumSet, &[(f64, f64)]),
     j: usize,
     (out, mut hands): (&mut Vec<f32>, Option<&mut [Vec<f32>; 2]>),
     frames: usize,
@@ -222,9 +222,9 @@ pub fn resynthesise(
     // voices.
     let first_difference = first_change(&heard, &synth.heard, |e| e.0).map(|t| span(t).1);
     let mut touches = touches.to_vec();
-    touches.sort_by(f64::total_cmp);
+    touches.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
     let first_touch_difference =
-        first_change(&touches, &synth.touches, |t| *t).map(|t| (t * fs).floor().max(0.0) as usize);
+        first_change(&touches, &synth.touches, |t| t.0).map(|t| (t * fs).floor().max(0.0) as usize);
     let silent_both = heard.is_empty() && synth.heard.is_empty();
     let voice_difference = first_voice_change(&voices, &synth.voices).filter(|_| !silent_both);
     let from = first_difference
@@ -335,10 +335,7 @@ pub fn resynthesise(
         }
         if driven || !silent {
             let t = n0 as f64 / fs;
-            let resting = synth
-                .touches
-                .iter()
-                .any(|&at| at <= t && t < at + super::TOUCH_S);
+            let resting = super::resting(&synth.touches, t);
             let glide = bank.glide();
             for b in std::iter::once(&mut *bank).chain(hand_banks.iter_mut().map(|h| &mut h.0)) {
                 b.damp(if resting { damping } else { 1.0 });

@@ -135,12 +135,12 @@ pub const MAX_HZ: f64 = 1000.0;
 /// Drum `j`'s sympathetic output, `frames` long, from the other drums' radiated sound
 /// (the time derivative of their synthesis `monos[i]`, as the mix radiates it), its head
 /// as `heads[j]` tunes it over the performance and damped while a hand rests on it (from
-/// each of `touches`, s, for [`TOUCH_S`](super::TOUCH_S)), resuming `state` from the
+/// each of `touches`, from when to when, s), resuming `state` from the
 /// first frame a source's sound changed (`changed[i]`, per drum). Returns the first frame
 /// rewritten. Bit for bit a whole render.
 pub fn resynthesise(
     kit: &Kit,
-    (heads, touches): (&SoundHeads, &[f64]),
+    (heads, touches): (&SoundHeads, &[(f64, f64)]),
     j: usize,
     (monos, changed): (&[&[f32]], &[usize]),
     frames: usize,
@@ -255,7 +255,7 @@ pub fn resynthesise(
         sub.fill(0.0);
         if driven || ringing {
             let t = n0 as f64 / fs;
-            let resting = touches.iter().any(|&at| at <= t && t < at + super::TOUCH_S);
+            let resting = super::resting(touches, t);
             rx.bank.damp(if resting { damping } else { 1.0 });
         }
         if driven {
