@@ -49,11 +49,10 @@ pub fn hand_stems(
             let alone = drums.only_side(side);
             let mut mono = vec![0.0; frames];
             if model == SoundModel::Sample {
-                super::sample::render_drum(kit, &alone, j, &mut mono)?;
+                super::sample::render_drum(kit, (&alone, &own), j, &mut mono)?;
             } else {
-                super::signal::render_drum(&alone, j, &mut mono);
+                super::signal::render_drum((&alone, &own), j, &mut mono);
             }
-            super::damp_replayed(&mut mono, &own, drums, j);
             monos[modal::side_index(side)].push(mono);
         }
     }

@@ -179,30 +179,32 @@ fn resting(touches: &[(f64, f64)], t: f64) -> bool {
     touches.iter().any(|&(from, until)| from <= t && t < until)
 }
 
-/// Damp a replayed drum's output (sample and signal models, which hold no modal state):
-/// from each touch until the drum's next contact, the sound decays with the touch's
-/// T60 while the hand rests and stays at the level it reached after (the hand has
-/// stopped it).
-fn damp_replayed(mono: &mut [f32], touches: &[(f64, f64)], drums: &DrumSet, j: usize) {
+/// Damp one replayed note (sample model), `note` starting at frame `start`: while a hand
+/// rests on the head (`touches`: from, until; s) it decays with the touch's T60, and it
+/// stays at the level it reached after (the hand has stopped it). Touches before the
+/// note leave it alone.
+fn damp_note(note: &mut [f32], start: usize, touches: &[(f64, f64)]) {
     let fs = f64::from(SAMPLE_RATE_HZ);
     let factor = touch_factor(fs);
-    for &(at, until) in touches {
-        let next = drums
-            .contacts()
-            .iter()
-            .filter(|c| c.drum == j && c.start_s > at)
-            .map(|c| c.start_s)
-            .fold(f64::INFINITY, f64::min);
-        let from = ((at * fs).round().max(0.0) as usize).min(mono.len());
-        let to = ((next * fs).round().min(mono.len() as f64)) as usize;
-        let rest = ((until - at) * fs).max(0.0) as usize;
-        let mut gain = 1.0;
-        for (k, s) in mono[from..to.max(from)].iter_mut().enumerate() {
-            if k < rest {
-                gain *= factor;
-            }
+    let frame = |t: f64| ((t * fs).round().max(0.0) as usize).saturating_sub(start);
+    let mut gain = 1.0;
+    let mut done = 0;
+    for &(from, until) in touches {
+        let (a, b) = (frame(from).max(done), frame(until).min(note.len()));
+        if a >= b {
+            continue;
+        }
+        for s in &mut note[done..a] {
             *s = (f64::from(*s) * gain) as f32;
         }
+        for s in &mut note[a..b] {
+            gain *= factor;
+            *s = (f64::from(*s) * gain) as f32;
+        }
+        done = b;
+    }
+    for s in &mut note[done..] {
+        *s = (f64::from(*s) * gain) as f32;
     }
 }
 
@@ -453,16 +455,11 @@ fn render_on(
             }
             SoundModel::Sample => {
                 *mono = vec![0.0; frames];
-                sample::render_drum(kit, drums, j, mono).map(|touched| {
-                    damp_replayed(mono, &own, drums, j);
-                    (touched, 0)
-                })
+                sample::render_drum(kit, (drums, &own), j, mono).map(|touched| (touched, 0))
             }
             SoundModel::Signal => {
                 *mono = vec![0.0; frames];
-                let touched = signal::render_drum(drums, j, mono);
-                damp_replayed(mono, &own, drums, j);
-                Ok((touched, 0))
+                Ok((signal::render_drum((drums, &own), j, mono), 0))
             }
         };
         let from = outcome.map(|(touched, from)| {
@@ -541,4 +538,29 @@ fn render_on(
         gain,
     };
     Ok((audio, state))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A replayed note is untouched before a hand rests on the head, decays with the
+    /// touch's T60 while it rests, and stays stopped after (a later stroke does not bring
+    /// it back); a touch before the note leaves it alone.
+    #[test]
+    fn a_touch_stops_a_replayed_note_for_good() {
+        let fs = f64::from(SAMPLE_RATE_HZ);
+        let start = (1.0 * fs) as usize;
+        let mut note = vec![1.0f32; (2.0 * fs) as usize];
+        damp_note(&mut note, start, &[(0.2, 0.45), (1.5, 1.75)]);
+        let at = |t: f64| note[((t - 1.0) * fs) as usize];
+        assert_eq!(at(1.49), 1.0);
+        // 0.05 s of a 0.05 s T60: 60 dB down.
+        assert!(
+            (f64::from(at(1.55)) / 1e-3 - 1.0).abs() < 0.01,
+            "{}",
+            at(1.55)
+        );
+        assert!(at(1.8) < 1e-12 && at(2.9) == at(1.8));
+    }
 }

@@ -241,11 +241,11 @@ fn interpolate(x: &[f32], pos: f64) -> f64 {
 }
 
 /// Render drum `j` of `kit`'s contacts into `out`, each at the pitch the drum is tuned to
-/// when it starts (its pedal changes: `drums.retunes()`); returns whether any contact was
-/// on it.
+/// when it starts (its pedal changes: `drums.retunes()`) and stopped by the hands resting
+/// on the head after it (`touches`: from, until; s); returns whether any contact was on it.
 pub fn render_drum(
     kit: &Kit,
-    drums: &DrumSet,
+    (drums, touches): (&DrumSet, &[(f64, f64)]),
     j: usize,
     out: &mut [f32],
 ) -> Result<bool, SoundError> {
@@ -269,7 +269,13 @@ pub fn render_drum(
         let amp = REFERENCE_LEVEL * c.impact_speed_mps / reference_speed_mps();
         let start = ((c.start_s * fs).round().max(0.0) as usize).min(out.len());
         let cutoff = cutoff_hz(c.impact_speed_mps) * tuning_hz / rec.principal_hz;
-        play(rec, step, cutoff, amp, &mut out[start..]);
+        let len = ((rec.samples.len() as f64 - 1.0) / step).floor().max(0.0) as usize;
+        let mut note = vec![0.0f32; len.min(out.len() - start)];
+        play(rec, step, cutoff, amp, &mut note);
+        super::damp_note(&mut note, start, touches);
+        for (o, n) in out[start..].iter_mut().zip(&note) {
+            *o += n;
+        }
     }
     Ok(true)
 }

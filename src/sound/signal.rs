@@ -47,8 +47,9 @@ const NOISE_TAU_S: f64 = 0.002;
 const NOISE_LEN_S: f64 = 0.012;
 const NOISE_POLE: f64 = 0.67;
 
-/// Render drum `j`'s contacts into `out`; returns whether any contact was on it.
-pub fn render_drum(drums: &DrumSet, j: usize, out: &mut [f32]) -> bool {
+/// Render drum `j`'s contacts into `out`, the partials damped while a hand rests on the
+/// head (`touches`: from, until; s); returns whether any contact was on it.
+pub fn render_drum((drums, touches): (&DrumSet, &[(f64, f64)]), j: usize, out: &mut [f32]) -> bool {
     if drums.head(j).is_none() {
         return false;
     }
@@ -62,6 +63,23 @@ pub fn render_drum(drums: &DrumSet, j: usize, out: &mut [f32]) -> bool {
         return false;
     }
     let fs = f64::from(SAMPLE_RATE_HZ);
+    let damping = super::touch_factor(fs) as f32;
+    // Ring `p` over out[from..to], damped where a hand rests (its edges split the span).
+    let ring = |p: &mut Partials, out: &mut [f32], from: usize, to: usize| {
+        let edges = (touches.iter())
+            .flat_map(|&(a, b)| [a, b])
+            .map(|t| (t * fs).round().max(0.0) as usize)
+            .filter(|&e| e > from && e < to);
+        let mut edges: Vec<usize> = edges.chain([to]).collect();
+        edges.sort_unstable();
+        let mut at = from;
+        for edge in edges {
+            let resting = super::resting(touches, at as f64 / fs);
+            p.bank.damp(if resting { damping } else { 1.0 });
+            p.bank.ring(&mut out[at..edge], FLUSH_FLOOR);
+            at = edge;
+        }
+    };
     // The tuning the partials ring at (how many pedal changes came before) and them.
     let mut partials: Option<(usize, Partials)> = None;
     let mut cursor = 0;
@@ -77,33 +95,22 @@ pub fn render_drum(drums: &DrumSet, j: usize, out: &mut [f32]) -> bool {
             .count();
         if partials.as_ref().is_none_or(|(t, _)| *t != tuning) {
             if let Some((_, p)) = partials.as_mut() {
-                p.bank.ring(&mut out[cursor..start], FLUSH_FLOOR);
+                ring(p, out, cursor, start);
                 cursor = start;
             }
             partials = Some((tuning, Partials::of(head)));
         }
-        let Some((
-            _,
-            Partials {
-                index,
-                total_gain,
-                bank,
-                shapes,
-                kick,
-            },
-        )) = partials.as_mut()
-        else {
+        let Some((_, p)) = partials.as_mut() else {
             continue;
         };
-        let total_gain = *total_gain;
-        bank.ring(&mut out[cursor..start], FLUSH_FLOOR);
+        ring(p, out, cursor, start);
         cursor = start;
         let amp = REFERENCE_LEVEL * c.impact_speed_mps / reference_speed_mps();
-        head.shapes_at(head.local(c.point), shapes);
-        for (d, &k) in kick.iter_mut().zip(index.iter()) {
-            *d = (amp / total_gain * SIGNAL_SCALE * shapes[k]) as f32;
+        head.shapes_at(head.local(c.point), &mut p.shapes);
+        for (d, &k) in p.kick.iter_mut().zip(&p.index) {
+            *d = (amp / p.total_gain * SIGNAL_SCALE * p.shapes[k]) as f32;
         }
-        bank.kick(kick);
+        p.bank.kick(&p.kick);
         // The noise burst, added directly.
         let mut rng = Rng::new(0x5EED_0000 ^ ((j as u64) << 32) ^ *ci as u64);
         let mut lp = 0.0;
@@ -115,7 +122,7 @@ pub fn render_drum(drums: &DrumSet, j: usize, out: &mut [f32]) -> bool {
         }
     }
     if let Some((_, p)) = partials.as_mut() {
-        p.bank.ring(&mut out[cursor..], FLUSH_FLOOR);
+        ring(p, out, cursor, out.len());
     }
     true
 }
