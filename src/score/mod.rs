@@ -53,7 +53,8 @@ pub struct Beat {
     pub dynamic: Dynamic,
     /// Index of the drum in the kit (0 is the first drum of the kit file).
     pub drum: usize,
-    /// The pitch the drum is tuned to for this beat; `None` keeps the kit tuning.
+    /// The pitch the drum is tuned to for this beat (another than it plays just before is
+    /// a pedal change: [`tuning`]); `None` plays the drum as it is tuned then.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pitch: Option<Pitch>,
     pub location: ImpactLocation,
