@@ -57,7 +57,8 @@ fn pitch_row(
     let beats = sel.beats.iter().filter_map(|&i| doc.score.beats.get(i));
     let kit = doc.score.kit(&doc.kit);
     let d = &kit.drums[drum];
-    let sounding = doc.score.sounding_pitches(&doc.kit);
+    let (changes, sounding) =
+        crate::score::tuning::walk(&doc.score, &doc.score.settings.kit(&doc.kit));
     let tuned = sel.beats.first().and_then(|&i| sounding.get(i)).copied();
     let mut pitches = vec![(None, format!("as tuned ({})", tuned.unwrap_or(d.tuning)))];
     let mut p = Some(d.lowest);
@@ -69,7 +70,6 @@ fn pitch_row(
     if let Some(pitch) = pick(ui, "Pitch", current, &pitches) {
         set_beats(doc, sel, out, |b| b.pitch = pitch);
     }
-    let changes = doc.score.pedal_changes(&doc.kit);
     if let Some(change) = changes.iter().find(|c| sel.beats.contains(&c.beat)) {
         ui.label("");
         let text = format!(

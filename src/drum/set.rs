@@ -667,11 +667,13 @@ impl DrumSet {
         self.heads.get(drum).map(|h| &h.modes)
     }
 
-    /// The modes of drum `drum` at the tuning it holds at score time `time_s`, s.
-    pub fn head_at(&self, drum: usize, time_s: f64) -> Option<&HeadModes> {
+    /// The tuning drum `drum` holds at score time `time_s` (s) — how many of its pedal
+    /// changes came before — and its modes then.
+    pub fn head_at(&self, drum: usize, time_s: f64) -> Option<(usize, &HeadModes)> {
         let head = self.heads.get(drum)?;
         let k = head.tunings.iter().rposition(|t| t.from_s <= time_s);
-        Some(&head.tunings[k.unwrap_or(0)].modes)
+        let k = k.unwrap_or(0);
+        Some((k, &head.tunings[k].modes))
     }
 
     /// The pedal changes the heads carry out, in time order.
@@ -841,7 +843,7 @@ mod tests {
             .unwrap();
         let hz = drums.heads[2].steps[k11].omega0 / std::f64::consts::TAU;
         assert!((hz / a2.hz() - 1.0).abs() < 0.01, "{hz} Hz");
-        let f11 = |t: f64| drums.head_at(2, t).unwrap().modes()[k11].freq_hz;
+        let f11 = |t: f64| drums.head_at(2, t).unwrap().1.modes()[k11].freq_hz;
         assert!((f11(0.29) / drum.tuning.hz() - 1.0).abs() < 0.01);
         assert!((f11(0.31) / a2.hz() - 1.0).abs() < 0.01);
         // Back before the change: the old tuning, and the same future again.

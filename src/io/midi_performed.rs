@@ -47,9 +47,7 @@ pub fn export(score: &Score, kit: &Kit, hits: &[Hit], scale: &ForceScale) -> Vec
         .iter()
         .filter(|h| h.primary)
         .filter_map(|h| {
-            let key = crate::kit::drum_at(kit, &retunes, h.drum, h.time_s)?
-                .tuning
-                .0;
+            let key = crate::kit::pitch_at(kit, &retunes, h.drum, h.time_s)?.0;
             let tick = tick_at(&steps, tpq, h.time_s).round() as u64;
             Some((tick, key, scale.velocity(h.peak_force_n)))
         })

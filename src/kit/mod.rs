@@ -209,17 +209,13 @@ pub struct Retune {
     pub pitch: Pitch,
 }
 
-/// The drum `drum` of `kit` as it is tuned at score time `time_s` (s) under the pedal
-/// changes `retunes` (in time order): the kit's drum, retuned by the latest change of
-/// that drum at or before `time_s`. None for an unknown drum.
-pub fn drum_at(kit: &Kit, retunes: &[Retune], drum: usize, time_s: f64) -> Option<Drum> {
-    let base = kit.drums.get(drum)?;
-    Some(
-        match retunes.iter().rfind(|r| r.drum == drum && r.at_s <= time_s) {
-            Some(r) => base.retuned(r.pitch),
-            None => base.clone(),
-        },
-    )
+/// The pitch drum `drum` of `kit` is tuned to at score time `time_s` (s) under the pedal
+/// changes `retunes` (in time order): that of its latest change at or before `time_s`,
+/// else the kit's. None for an unknown drum.
+pub fn pitch_at(kit: &Kit, retunes: &[Retune], drum: usize, time_s: f64) -> Option<Pitch> {
+    let tuning = kit.drums.get(drum)?.tuning;
+    let latest = retunes.iter().rfind(|r| r.drum == drum && r.at_s <= time_s);
+    Some(latest.map_or(tuning, |r| r.pitch))
 }
 
 impl Kit {

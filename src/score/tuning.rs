@@ -130,9 +130,10 @@ pub fn sounding_pitches(score: &Score, kit: &Kit) -> Vec<Pitch> {
     walk(score, kit).1
 }
 
-/// The beats of `score` in time order, each drum's pitch followed through them: the pedal
-/// changes and the pitch each beat sounds.
-fn walk(score: &Score, kit: &Kit) -> (Vec<PedalChange>, Vec<Pitch>) {
+/// The beats of `score` in time order on `kit` (tuned as [`pedal_changes`] does), each
+/// drum's pitch followed through them: the pedal changes and the pitch each beat sounds
+/// ([`pedal_changes`] and [`sounding_pitches`] in one pass).
+pub fn walk(score: &Score, kit: &Kit) -> (Vec<PedalChange>, Vec<Pitch>) {
     let kit = tuned(score, Cow::Borrowed(kit));
     let map = score.tempo_map();
     let mut order: Vec<usize> = (0..score.beats.len()).collect();

@@ -26,14 +26,16 @@ pub fn hand_stems(
     // Per hand, per drum: the drum's synthesis of that hand's contacts.
     let mut monos: [Vec<Vec<f32>>; 2] = Default::default();
     let mut heads: SoundHeads = Vec::new();
-    for j in 0..kit.drums.len() {
-        let own = super::touches_of(touches, drums, j);
+    let resting: Vec<Vec<(f64, f64)>> = (0..kit.drums.len())
+        .map(|j| super::touches_of(touches, drums, j))
+        .collect();
+    for (j, own) in resting.iter().enumerate() {
         if model == SoundModel::Modal {
             let tunings = modal::sound_heads(kit, drums, j, calibration);
             let mut hands: [Vec<f32>; 2] = Default::default();
             modal::resynthesise(
                 &tunings,
-                (drums, &own),
+                (drums, own),
                 j,
                 (&mut Vec::new(), Some(&mut hands)),
                 frames,
@@ -49,9 +51,9 @@ pub fn hand_stems(
             let alone = drums.only_side(side);
             let mut mono = vec![0.0; frames];
             if model == SoundModel::Sample {
-                super::sample::render_drum(kit, (&alone, &own), j, &mut mono)?;
+                super::sample::render_drum(kit, (&alone, own), j, &mut mono)?;
             } else {
-                super::signal::render_drum((&alone, &own), j, &mut mono);
+                super::signal::render_drum((&alone, own), j, &mut mono);
             }
             monos[modal::side_index(side)].push(mono);
         }
@@ -60,10 +62,9 @@ pub fn hand_stems(
         let sympathies: Vec<Vec<f32>> = if model == SoundModel::Modal {
             let refs: Vec<&[f32]> = monos.iter().map(Vec::as_slice).collect();
             let fresh = vec![0; refs.len()];
-            (0..kit.drums.len())
-                .map(|j| {
+            (resting.iter().enumerate())
+                .map(|(j, own)| {
                     let mut state = sympathy::SympathyState::default();
-                    let own = super::touches_of(touches, drums, j);
                     let heard = (&heads, &own[..]);
                     sympathy::resynthesise(kit, heard, j, (&refs, &fresh), frames, &mut state);
                     state.out

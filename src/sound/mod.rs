@@ -437,16 +437,18 @@ fn render_on(
     // model's threads also build (or find) their drum's sounding head, which the
     // sympathetic pass then reuses.
     type Synthesised = (Result<usize, SoundError>, modal::Tunings);
-    let slots: Vec<_> = state.drums.iter_mut().enumerate().collect();
-    let results: Vec<Synthesised> = each(slots, cores, |(j, (mono, synth, heard))| {
-        let own = touches_of(touches, drums, j);
+    let resting: Vec<Vec<(f64, f64)>> = (0..kit.drums.len())
+        .map(|j| touches_of(touches, drums, j))
+        .collect();
+    let slots: Vec<_> = state.drums.iter_mut().zip(&resting).enumerate().collect();
+    let results: Vec<Synthesised> = each(slots, cores, |(j, ((mono, synth, heard), own))| {
         let mut heads = Vec::new();
         let outcome = match model {
             SoundModel::Modal => {
                 heads = modal::sound_heads(kit, drums, j, calibration);
                 Ok(modal::resynthesise(
                     &heads,
-                    (drums, &own),
+                    (drums, own),
                     j,
                     (mono, None),
                     frames,
@@ -455,11 +457,11 @@ fn render_on(
             }
             SoundModel::Sample => {
                 *mono = vec![0.0; frames];
-                sample::render_drum(kit, (drums, &own), j, mono).map(|touched| (touched, 0))
+                sample::render_drum(kit, (drums, own), j, mono).map(|touched| (touched, 0))
             }
             SoundModel::Signal => {
                 *mono = vec![0.0; frames];
-                Ok((signal::render_drum((drums, &own), j, mono), 0))
+                Ok((signal::render_drum((drums, own), j, mono), 0))
             }
         };
         let from = outcome.map(|(touched, from)| {
@@ -476,11 +478,15 @@ fn render_on(
         state.sympathy.resize(kit.drums.len(), Default::default());
         let (heads, froms) = (&heads, &froms);
         let sympathy_froms: Vec<usize> = each(
-            state.sympathy.iter_mut().enumerate().collect(),
+            state
+                .sympathy
+                .iter_mut()
+                .zip(&resting)
+                .enumerate()
+                .collect(),
             cores,
-            |(j, sym)| {
-                let own = touches_of(touches, drums, j);
-                sympathy::resynthesise(kit, (heads, &own), j, (&monos, froms), frames, sym)
+            |(j, (sym, own))| {
+                sympathy::resynthesise(kit, (heads, own), j, (&monos, froms), frames, sym)
             },
         );
         start = sympathy_froms.iter().fold(start, |s, f| s.min(*f));

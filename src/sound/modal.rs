@@ -26,17 +26,9 @@ pub const BLOCK: usize = 128;
 /// and a chunk of voices that is all zero is skipped.
 pub const FLUSH_FLOOR: f32 = 1e-7;
 
-/// The sounding modes of `drum` under `calibration`, built once per process per drum
-/// definition, frequency source and calibration (a full-band head takes a while to build).
-pub fn sound_head(
-    drum: &Drum,
-    drums: &DrumSet,
-    calibration: &Calibration,
-) -> Option<Arc<SoundHead>> {
-    sound_head_of(drum, drums.config().source, calibration)
-}
-
-/// [`sound_head`] with the frequencies from `source`.
+/// The sounding modes of `drum` under `calibration`, frequencies from `source`, built once
+/// per process per drum definition, frequency source and calibration (a full-band head
+/// takes a while to build).
 pub fn sound_head_of(
     drum: &Drum,
     source: FrequencySource,

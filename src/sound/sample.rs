@@ -255,10 +255,10 @@ pub fn render_drum(
     }
     let fs = f64::from(SAMPLE_RATE_HZ);
     for c in contacts {
-        let Some(drum) = crate::kit::drum_at(kit, drums.retunes(), j, c.start_s) else {
+        let Some(pitch) = crate::kit::pitch_at(kit, drums.retunes(), j, c.start_s) else {
             return Ok(false);
         };
-        let tuning_hz = drum.tuning.hz();
+        let tuning_hz = pitch.hz();
         let (left, right) = nearest_pair(tuning_hz)?;
         let rec = match c.side {
             Side::Left => left,

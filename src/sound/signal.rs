@@ -80,19 +80,16 @@ pub fn render_drum((drums, touches): (&DrumSet, &[(f64, f64)]), j: usize, out: &
             at = edge;
         }
     };
-    // The tuning the partials ring at (how many pedal changes came before) and them.
+    // The tuning the partials ring at (`DrumSet::head_at`) and them.
     let mut partials: Option<(usize, Partials)> = None;
     let mut cursor = 0;
     for (ci, c) in &contacts {
         let start = ((c.start_s * fs).round().max(0.0) as usize).min(out.len());
-        let Some(head) = drums.head_at(j, c.start_s) else {
+        let Some((tuning, head)) = drums.head_at(j, c.start_s) else {
             continue;
         };
         // At a pedal change (the head damped before it) the partials start again at rest
         // at the new pitch.
-        let tuning = (drums.retunes().iter())
-            .filter(|r| r.drum == j && r.at_s <= c.start_s)
-            .count();
         if partials.as_ref().is_none_or(|(t, _)| *t != tuning) {
             if let Some((_, p)) = partials.as_mut() {
                 ring(p, out, cursor, start);
