@@ -64,7 +64,7 @@ fn demo_scores_strike_every_beat_on_time() {
             long += usize::from(e.duration_ms > 8.0 + 1e-6);
             all.push((e.contact_s - e.scheduled_s.unwrap()).abs());
             assert!(
-                (5.0..300.0).contains(&e.peak_force_n) && (2.0..9.0).contains(&e.duration_ms),
+                (5.0..300.0).contains(&e.peak_force_n) && (2.0..=8.0).contains(&e.duration_ms),
                 "{}: {e:?}",
                 path.display()
             );
@@ -83,13 +83,9 @@ fn demo_scores_strike_every_beat_on_time() {
             path.display()
         );
     }
-    // The compensation aims a pressed stroke shallower and tries further (before it did,
-    // 7 of the 302 lasted 8.0–8.8 ms).
-    assert!(
-        long * 100 <= all.len(),
-        "{long} of {} contacts over 8 ms",
-        all.len()
-    );
+    // The arm no longer presses a stick on a head (before: 3 of 319 lasted 8.0–8.9 ms
+    // with the 36 g mallet, 7 of 302 up to 8.8 ms with the 45 g one).
+    assert_eq!(long, 0, "{long} of {} contacts over 8 ms", all.len());
     assert_timing("without joint limits", all, recontacts);
     // Strokes start from the most alike settled stroke and correct their depth by the
     // measured force-depth law, and stop when an attempt would repeat one: 516 attempts
@@ -222,6 +218,61 @@ fn ladder_on_the_outer_drums() {
         .map(|e| (e.contact_s - e.scheduled_s.unwrap()).abs())
         .fold(0.0, f64::max);
     assert!(worst < 0.003, "worst {worst} s");
+}
+
+/// The ladder at the bottom of the big drums' ranges (the left hand on the 32-inch drum in
+/// D2, the right on the 29-inch in F2: the slackest heads, where a free stroke of the 45 g
+/// mallet lasted 8–9 ms and the arm pressed others to 9.5 ms): every contact lasts
+/// 2–8 ms, no stick falls back on a head, every stroke is within 3 ms and 20 % of its
+/// (mode, dynamic) median, and the medians over the modes rise from pp to ff.
+#[test]
+fn ladder_at_the_bottom_of_the_big_drums() {
+    let mut loaded = LoadedScore::load(&root().join("scores/dynamics-ladder.ron")).unwrap();
+    for beat in &mut loaded.score.beats {
+        (beat.drum, beat.pitch) = if beat.drum == 2 {
+            (1, Some("F2".parse().unwrap()))
+        } else {
+            (0, Some("D2".parse().unwrap()))
+        };
+    }
+    let r = render(&loaded, &db(), &RenderParams::default(), &mut |_| true).unwrap();
+    assert_eq!(r.timing.missed, 0, "{:?}", r.timing);
+    let scored: Vec<_> = r.events.iter().filter(|e| e.beat.is_some()).collect();
+    assert!(scored.iter().all(|e| e.recontacts == 0), "re-contacts");
+    for e in &scored {
+        assert!((2.0..=8.0).contains(&e.duration_ms), "{e:?}");
+        assert!(
+            (e.contact_s - e.scheduled_s.unwrap()).abs() < 0.003,
+            "{e:?}"
+        );
+    }
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        0.5 * (v[(v.len() - 1) / 2] + v[v.len() / 2])
+    };
+    let mut previous = 0.0;
+    for (_, _, name) in Dynamic::MARKS {
+        let of_dynamic = |mode: Option<&str>| -> Vec<f64> {
+            scored
+                .iter()
+                .filter(|e| e.dynamic == Some(name) && (mode.is_none() || e.mode == mode))
+                .map(|e| e.peak_force_n)
+                .collect()
+        };
+        let m = median(of_dynamic(None));
+        assert!(m > previous, "{name}: {m:.1} N after {previous:.1} N");
+        previous = m;
+        for mode in PlayingMode::ALL {
+            let forces = of_dynamic(Some(mode.name()));
+            let group = median(forces.clone());
+            for f in forces {
+                assert!(
+                    (f / group - 1.0).abs() <= 0.2,
+                    "{mode:?} {name}: {f:.1} N of {group:.1}"
+                );
+            }
+        }
+    }
 }
 
 /// The dynamics ladder (every mode × pp…ff, both hands, two drums): per mode the median
@@ -622,11 +673,12 @@ fn recontact_sized(contacts: &[ContactEvent]) -> Vec<&ContactEvent> {
 /// Replayed at the reference settings, a rendering comes back bit for bit.
 ///
 /// Issue 22 asks tip paths within 1 mm, contact times within 0.3 ms and peak forces within
-/// 5 % before a larger step may be the default. Measured here: contacts within 0.20 ms,
-/// peak forces within 3.9 % (6.0 % while the coarser step took its goals at its end), tip
-/// paths 0.33 mm apart RMS but 3.7 mm at worst, in the rattle of the loosened grip 20–90
-/// ms after a contact: close, not within, so 10 kHz stays the default and this test holds
-/// the figures measured, with a margin.
+/// 5 % before a larger step may be the default. Measured here: contacts within 0.10 ms,
+/// peak forces within 9.2 % (3.9 % before the arm let a stick on a head rebound; 6.0 %
+/// while the coarser step took its goals at its end), tip paths 0.36 mm apart RMS but
+/// 4.8 mm at worst, in the rattle of the loosened grip 20–90 ms after a contact: close,
+/// not within, so 10 kHz stays the default and this test holds the figures measured, with
+/// a margin.
 #[test]
 fn a_body_at_5_khz_with_the_contact_at_10_khz_stays_near_the_reference() {
     let db = db();
@@ -700,8 +752,11 @@ fn a_body_at_5_khz_with_the_contact_at_10_khz_stays_near_the_reference() {
         "contact times {:.2} ms apart",
         worst_contact_s * 1e3
     );
+    // Within 5 % until the arm let a stick on a head rebound (the nested IK's goal then
+    // follows the tip, which the coarser body step places a little differently): one ff
+    // stroke of the minute study is now 9.2 % off (100 N against 91 N), two more 4–5 %.
     assert!(
-        worst_force <= 0.05,
+        worst_force <= 0.1,
         "peak forces {:.1} % apart",
         worst_force * 100.0
     );

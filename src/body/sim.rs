@@ -283,28 +283,32 @@ pub trait Environment {
 /// points of the environment's tip mass under the contact's force (semi-implicit Euler, as
 /// the contact's implicit solve assumes). What the rest of the body would add to a tip's
 /// motion within one body step (0.2 ms at 5 kHz) is left out. With `n` = 1 it is the
-/// environment's force at `tips`.
+/// environment's force at `tips`. Also says which tips were pressed on in the last
+/// contact step (the contact as it stands at the end of the body step).
 fn sub_stepped_forces(
     environment: &mut dyn Environment,
     time_s: f64,
     tips: [(DVec3, DVec3); 2],
     n: usize,
     dt_s: f64,
-) -> [DVec3; 2] {
+) -> ([DVec3; 2], [bool; 2]) {
+    let touching = |forces: &[DVec3; 2]| [forces[0].z > 0.0, forces[1].z > 0.0];
     if n <= 1 {
-        return environment.tip_forces(time_s, tips);
+        let forces = environment.tip_forces(time_s, tips);
+        return (forces, touching(&forces));
     }
     let mass = environment.tip_mass_kg();
-    let (mut at, mut sum) = (tips, [DVec3::ZERO; 2]);
+    let (mut at, mut sum, mut last) = (tips, [DVec3::ZERO; 2], [false; 2]);
     for i in 0..n {
         let forces = environment.tip_forces(time_s + i as f64 * dt_s, at);
+        last = touching(&forces);
         for ((p, v), (force, total)) in at.iter_mut().zip(forces.iter().zip(&mut sum)) {
             *total += *force;
             *v += *force / mass * dt_s;
             *p += *v * dt_s;
         }
     }
-    sum.map(|f| f / n as f64)
+    (sum.map(|f| f / n as f64), last)
 }
 
 /// Empty space: no contact, never cancelled.
@@ -441,6 +445,7 @@ pub fn simulate_in(
 pub struct Checkpoint {
     samples: usize,
     state: State,
+    touching: [bool; 2],
 }
 
 impl Checkpoint {
@@ -472,6 +477,8 @@ pub struct Simulator {
     contact_substeps: usize,
     initial: Pose,
     state: State,
+    /// Whether each tip (left, right) felt a contact force in the latest step.
+    touching: [bool; 2],
     /// Task-rate joint targets computed so far.
     targets: Vec<Pose>,
     motion: Motion,
@@ -527,6 +534,7 @@ impl Simulator {
             contact_substeps,
             initial: *initial,
             state,
+            touching: [false; 2],
             targets: Vec::new(),
             motion: Motion {
                 rate_hz: reference.rate_hz,
@@ -556,6 +564,7 @@ impl Simulator {
         Checkpoint {
             samples: self.samples(),
             state: self.state.clone(),
+            touching: self.touching,
         }
     }
 
@@ -563,6 +572,7 @@ impl Simulator {
     pub fn rewind(&mut self, checkpoint: &Checkpoint) {
         let m = checkpoint.samples;
         self.state = checkpoint.state.clone();
+        self.touching = checkpoint.touching;
         self.targets.truncate(m + 1);
         for tips in &mut self.motion.tips {
             tips.truncate(m);
@@ -718,10 +728,19 @@ impl Simulator {
                         goal[j.index()] = reference_pose[j.index()];
                     }
                 }
+                // A tip on a head is let rebound: its goal does not chase the strike-through
+                // target below where the tip is (the arm does not press it into the head).
+                let floor: [Option<f64>; 2] = std::array::from_fn(|h| {
+                    let side = [Side::Left, Side::Right][h];
+                    self.touching[h].then(|| self.model.skeleton.tip(&self.state.q, side).z)
+                });
                 for _ in 0..self.params.nested_iterations {
                     let frames = self.model.skeleton.forward(&goal);
                     for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
-                        let target = reference.tips[h][k - 1].lerp(reference.tips[h][k], u);
+                        let mut target = reference.tips[h][k - 1].lerp(reference.tips[h][k], u);
+                        if let Some(z) = floor[h] {
+                            target.z = target.z.max(z);
+                        }
                         match reference.hands.as_ref().and_then(|t| t.at(h, k, u)) {
                             Some(hand) => place_hand(
                                 &self.model.skeleton,
@@ -794,12 +813,19 @@ impl Simulator {
                 }
             }
             let contact_dt = self.dt;
+            let mut touching = [false; 2];
             self.dynamics.step_with_tip_forces(
                 &mut self.state,
                 &tau,
-                |tips| sub_stepped_forces(environment, time_s, tips, contact, contact_dt),
+                |tips| {
+                    let forces;
+                    (forces, touching) =
+                        sub_stepped_forces(environment, time_s, tips, contact, contact_dt);
+                    forces
+                },
                 dt,
             );
+            self.touching = touching;
             let max_speed = self.params.max_angular_speed;
             let speed = self.state.w.iter().map(|w| w.length()).fold(0.0, f64::max);
             if !self.state.is_finite() || speed > max_speed {
@@ -970,10 +996,12 @@ mod tests {
     fn sub_stepped_contact_moves_the_tip_as_a_point_mass() {
         let tip = (DVec3::new(0.0, 0.0, -0.01), DVec3::new(0.0, 0.0, -2.0));
         let mut floor = Floor { seen: Vec::new() };
-        let once = sub_stepped_forces(&mut floor, 1.0, [tip; 2], 1, 1e-4);
+        let (once, touching) = sub_stepped_forces(&mut floor, 1.0, [tip; 2], 1, 1e-4);
         assert_eq!(once[1], DVec3::Z);
+        assert_eq!(touching, [true; 2]);
         let mut floor = Floor { seen: Vec::new() };
-        let mean = sub_stepped_forces(&mut floor, 1.0, [tip; 2], 2, 1e-4);
+        let (mean, touching) = sub_stepped_forces(&mut floor, 1.0, [tip; 2], 2, 1e-4);
+        assert_eq!(touching, [true; 2]);
         let (t, p, v) = floor.seen[1];
         assert_eq!(floor.seen.len(), 2);
         assert!((t - 1.0001).abs() < 1e-12);

@@ -501,8 +501,11 @@ impl Performance {
             let acceptable = clean && !late && attempt >= aims.settle_attempts;
             // A cluster that sounds but has a force far off or a pressed contact gets up
             // to half as many attempts again.
-            let ran_out = attempt >= aims.max_attempts
-                && (missed > 0 || far + long == 0 || attempt >= aims.max_attempts * 3 / 2);
+            // A long cluster (a roll) settles from the front, a stroke or two per attempt:
+            // it gets an attempt for every two strokes if that is more.
+            let max_attempts = aims.max_attempts.max(cluster.len().div_ceil(2));
+            let ran_out = attempt >= max_attempts
+                && (missed > 0 || far + long == 0 || attempt >= max_attempts * 3 / 2);
             if on_time || acceptable || ran_out {
                 break;
             }
@@ -512,7 +515,24 @@ impl Performance {
                 .map(|m| m.map(|c| contacts[c].clone()))
                 .collect();
             placed.push(self.placement(cluster.clone()));
-            for ((i, contact), tried) in cluster.clone().zip(found).zip(&tried) {
+            // The strokes before the first one that needs a correction keep their
+            // placement: they play the same again (the simulation is causal and
+            // deterministic), so a long cluster (a roll) settles from the front instead of
+            // every stroke shifting a little and stirring up all those after it.
+            let needs = |i: usize, c: &Option<crate::drum::ContactEvent>| {
+                c.as_ref().is_none_or(|c| {
+                    let ratio = c.peak_force_n / aims.force_n[i];
+                    (ratio - 1.0).abs() > aims.force_tolerance
+                        || (c.start_s - strokes[i].time_s).abs() > aims.tolerance_s
+                        || pressed(c, aims)
+                })
+            };
+            let first = cluster
+                .clone()
+                .zip(&found)
+                .position(|(i, c)| needs(i, c))
+                .unwrap_or(0);
+            for ((i, contact), tried) in cluster.clone().zip(found).zip(&tried).skip(first) {
                 self.correct(i, contact.as_ref(), strokes[i].time_s, aims, tried);
             }
             let next = self.placement(cluster.clone());

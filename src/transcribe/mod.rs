@@ -144,7 +144,7 @@ pub fn transcribe(
         return Err(TranscribeError::Silent { file: source });
     }
     let band = pitch_band(kit);
-    let strokes: Vec<notate::Stroke> = times
+    let mut strokes: Vec<notate::Stroke> = times
         .iter()
         .enumerate()
         .map(|(i, &t)| {
@@ -156,6 +156,14 @@ pub fn transcribe(
             }
         })
         .collect();
+    for run in fast_runs(&times) {
+        let span = (times[run.start], times[run.end - 1]);
+        if let Some(run_hz) = notes::hear_run(samples, rate_hz, span, band) {
+            for stroke in &mut strokes[run] {
+                stroke.principal_hz = notes::onto_run(stroke.principal_hz, run_hz);
+            }
+        }
+    }
 
     let mut score = Score::new(options.title.as_deref().unwrap_or("Transcription"));
     score.kit = options.kit_ref.clone();
@@ -245,6 +253,22 @@ fn lead_in_ticks(first_s: f64, period_s: f64, tpq: u32) -> u64 {
 
 /// How much louder than timpanist's strokes the recording is, dB: its median stroke
 /// against an mf stroke at the median pitch.
+/// The runs of at least [`notes::RUN_STROKES`] onsets (`times`, s, sorted) each within
+/// [`notes::RUN_GAP_S`] of the next: index ranges.
+fn fast_runs(times: &[f64]) -> Vec<std::ops::Range<usize>> {
+    let mut runs = Vec::new();
+    let mut start = 0;
+    for i in 1..=times.len() {
+        if i == times.len() || times[i] - times[i - 1] > notes::RUN_GAP_S {
+            if i - start >= notes::RUN_STROKES {
+                runs.push(start..i);
+            }
+            start = i;
+        }
+    }
+    runs
+}
+
 fn relative_shift(strokes: &[notate::Stroke], kit: &Kit) -> f64 {
     let mut levels: Vec<f64> = strokes.iter().map(|s| s.level_db).collect();
     levels.sort_by(f64::total_cmp);
@@ -282,5 +306,20 @@ impl MarkLevels {
                     .unwrap_or(f64::NEG_INFINITY)
             })
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fast_runs;
+
+    /// Four or more onsets each within 0.15 s of the next make a run; fewer, or a wider
+    /// gap, do not.
+    #[test]
+    fn fast_runs_are_rolls_of_four_or_more() {
+        let times = [0.0, 0.5, 0.6, 0.7, 0.8, 0.9, 1.5, 1.6, 1.7, 2.5];
+        assert_eq!(fast_runs(&times), vec![1..6]);
+        assert!(fast_runs(&[0.0, 0.1, 0.2]).is_empty());
+        assert_eq!(fast_runs(&[0.0, 0.1, 0.2, 0.3]), vec![0..4]);
     }
 }
