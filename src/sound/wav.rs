@@ -54,7 +54,9 @@ pub fn write_wav_as(path: &Path, audio: &Audio, format: WavFormat) -> Result<(),
     };
     // Made in memory, then written as any other file (`write_atomic`: a temporary file
     // beside the target, synced and renamed, with the usual permissions).
-    let mut bytes = Cursor::new(Vec::new());
+    let mut bytes = Cursor::new(Vec::with_capacity(
+        64 + audio.samples.len() * usize::from(format.bits() / 8),
+    ));
     {
         let mut writer = hound::WavWriter::new(&mut bytes, spec).map_err(wav)?;
         let full_scale = f64::from((1u32 << (format.bits() - 1)) - 1);
