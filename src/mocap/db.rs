@@ -474,6 +474,19 @@ pub fn decode_take(path: &Path, bytes: &[u8]) -> Result<TakeData, FileError> {
         .take((n as u64 + 1) * 8 * (6 + 4 * JOINT_COUNT as u64) + 64)
         .read_to_end(&mut body)
         .map_err(|e| bad("sample data", format!("corrupt compressed data: {e}")))?;
+    // Every frame takes at least a byte in each channel (a tip's flags and three axes,
+    // four per joint): a frame count the data cannot hold is refused before anything is
+    // allocated for it.
+    let needed = n.checked_mul(2 * 4 + 4 * joints);
+    if needed.is_none_or(|needed| body.len() < needed) {
+        return Err(bad(
+            "sample data",
+            format!(
+                "{n} frames cannot fit in {} bytes of samples (truncated?)",
+                body.len()
+            ),
+        ));
+    }
     let mut reader = Channels {
         body: &body,
         pos: 0,
@@ -495,20 +508,26 @@ pub fn decode_take(path: &Path, bytes: &[u8]) -> Result<TakeData, FileError> {
     let joints = if joints == 0 {
         None
     } else {
-        let channels: Vec<Vec<f64>> = (0..4 * JOINT_COUNT)
-            .map(|_| reader.channel(n, QUATERNION_STEP))
-            .collect::<Option<_>>()
-            .ok_or_else(|| bad("sample data", "truncated joint channel".into()))?;
-        Some(
-            (0..n)
-                .map(|f| {
-                    std::array::from_fn(|j| {
-                        let c = |k: usize| channels[4 * j + k][f];
-                        DQuat::from_xyzw(c(1), c(2), c(3), c(0)).normalize()
-                    })
+        // Each channel straight into its component of the poses (w, x, y, z per joint).
+        let mut poses = vec![[DQuat::IDENTITY; JOINT_COUNT]; n];
+        for c in 0..4 * JOINT_COUNT {
+            let (j, k) = (c / 4, c % 4);
+            reader
+                .channel_into(n, QUATERNION_STEP, |f, v| {
+                    let q = &mut poses[f][j];
+                    match k {
+                        0 => q.w = v,
+                        1 => q.x = v,
+                        2 => q.y = v,
+                        _ => q.z = v,
+                    }
                 })
-                .collect(),
-        )
+                .ok_or_else(|| bad("sample data", "truncated joint channel".into()))?;
+        }
+        for q in poses.iter_mut().flatten() {
+            *q = q.normalize();
+        }
+        Some(poses)
     };
     if reader.pos != body.len() {
         return Err(bad(
@@ -579,14 +598,20 @@ impl Channels<'_> {
     }
 
     fn channel(&mut self, n: usize, step: f64) -> Option<Vec<f64>> {
+        let mut out = vec![0.0; n];
+        self.channel_into(n, step, |f, v| out[f] = v)?;
+        Some(out)
+    }
+
+    /// Decode `n` values of a channel, handing each (frame, value) to `put`.
+    fn channel_into(&mut self, n: usize, step: f64, mut put: impl FnMut(usize, f64)) -> Option<()> {
         let (mut value, mut delta) = (0i64, 0i64);
-        (0..n)
-            .map(|_| {
-                delta = delta.checked_add(self.varint()?)?;
-                value = value.checked_add(delta)?;
-                Some(value as f64 * step)
-            })
-            .collect()
+        for f in 0..n {
+            delta = delta.checked_add(self.varint()?)?;
+            value = value.checked_add(delta)?;
+            put(f, value as f64 * step);
+        }
+        Some(())
     }
 }
 
@@ -708,6 +733,9 @@ mod tests {
         }
         let mut huge = bytes.clone();
         huge[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
-        assert!(decode_take(Path::new("t.tmot"), &huge).is_err());
+        let err = decode_take(Path::new("t.tmot"), &huge)
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("cannot fit"), "{err}");
     }
 }
