@@ -416,7 +416,6 @@ pub fn encode_take(data: &TakeData) -> Vec<u8> {
     z.finish().expect("writing to memory cannot fail")
 }
 
-/// Read a `.tmot` file; `path` names it in errors. Corrupt or truncated data is an error.
 /// Decode each (path, bytes, frames the index expects) on the machine's cores (decoding
 /// the shipped database is most of the program's start), failing on the first bad file in
 /// index order.
@@ -446,6 +445,7 @@ fn decode_all(files: &[(PathBuf, Vec<u8>, usize)]) -> Result<Vec<TakeData>, File
     decoded.into_iter().flatten().collect()
 }
 
+/// Read a `.tmot` file; `path` names it in errors. Corrupt or truncated data is an error.
 pub fn decode_take(path: &Path, bytes: &[u8]) -> Result<TakeData, FileError> {
     let bad = |place: &str, msg: String| FileError::invalid(path, place.to_string(), msg);
     if bytes.len() < 24 || &bytes[..8] != MAGIC {
