@@ -634,7 +634,7 @@ impl Run<'_> {
                         job = newer;
                     }
                     let (drums, touches, end_s) = job;
-                    sound = crate::sound::render_touched_on(
+                    sound = crate::sound::resynthesise_on(
                         kit,
                         (&drums, &touches),
                         end_s,
@@ -642,7 +642,7 @@ impl Run<'_> {
                         Some(sound),
                         crate::sound::Cores::One,
                     )
-                    .map_or_else(|_| SoundState::default(), |(_, state)| state);
+                    .unwrap_or_default();
                 }
                 sound
             });
@@ -701,6 +701,7 @@ impl Run<'_> {
         let mut stage = Stage {
             start_s: comp.start_s,
             drum_time: Duration::ZERO,
+            drum_steps: 0,
             report: &mut report,
             settled,
         };

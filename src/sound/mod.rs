@@ -400,12 +400,49 @@ pub fn render_touched_on(
 /// [`render_calibrated`] on `cores`.
 fn render_on(
     kit: &Kit,
+    sounding: (&DrumSet, &[Touch]),
+    duration_s: f64,
+    model: (SoundModel, &calibration::Calibration),
+    previous: Option<SoundState>,
+    cores: Cores,
+) -> Result<(Audio, SoundState), SoundError> {
+    let state = synthesise_on(kit, sounding, duration_s, model, previous, cores)?;
+    Ok((state.audio(), state))
+}
+
+/// [`render_touched_on`] without its audio: only the state a later rendering resumes
+/// (for sound made ahead while the body is still simulated, which nobody plays; it
+/// saves copying the whole mix).
+pub fn resynthesise_on(
+    kit: &Kit,
+    sounding: (&DrumSet, &[Touch]),
+    duration_s: f64,
+    model: SoundModel,
+    previous: Option<SoundState>,
+    cores: Cores,
+) -> Result<SoundState, SoundError> {
+    let calibration = calibration::Calibration::shipped();
+    synthesise_on(
+        kit,
+        sounding,
+        duration_s,
+        (model, calibration),
+        previous,
+        cores,
+    )
+}
+
+/// The sound of `drums` struck and `touches` damped up to `duration_s`, resuming
+/// `previous` where its record first differs: each drum's voice, the sympathetic
+/// ringing, the stereo mix and its block peaks.
+fn synthesise_on(
+    kit: &Kit,
     (drums, touches): (&DrumSet, &[Touch]),
     duration_s: f64,
     (model, calibration): (SoundModel, &calibration::Calibration),
     previous: Option<SoundState>,
     cores: Cores,
-) -> Result<(Audio, SoundState), SoundError> {
+) -> Result<SoundState, SoundError> {
     if !(duration_s.is_finite() && (0.0..=86_400.0).contains(&duration_s)) {
         return Err(SoundError::Duration(duration_s));
     }
@@ -526,24 +563,33 @@ fn render_on(
         }
         state.peaks.push(peak);
     }
-    let peak = state.peaks.iter().copied().fold(0.0f32, f32::max);
-    let gain = if f64::from(peak) > PEAK_LIMIT {
-        PEAK_LIMIT / f64::from(peak)
-    } else {
-        1.0
-    };
-    let samples = if gain < 1.0 {
-        mix.iter().map(|s| (f64::from(*s) * gain) as f32).collect()
-    } else {
-        mix.clone()
-    };
-    let audio = Audio {
-        rate_hz: SAMPLE_RATE_HZ,
-        channels: 2,
-        samples,
-        gain,
-    };
-    Ok((audio, state))
+    Ok(state)
+}
+
+impl SoundState {
+    /// The mix as audio, scaled down as a whole if it would pass [`PEAK_LIMIT`].
+    fn audio(&self) -> Audio {
+        let peak = self.peaks.iter().copied().fold(0.0f32, f32::max);
+        let gain = if f64::from(peak) > PEAK_LIMIT {
+            PEAK_LIMIT / f64::from(peak)
+        } else {
+            1.0
+        };
+        let samples = if gain < 1.0 {
+            self.mix
+                .iter()
+                .map(|s| (f64::from(*s) * gain) as f32)
+                .collect()
+        } else {
+            self.mix.clone()
+        };
+        Audio {
+            rate_hz: SAMPLE_RATE_HZ,
+            channels: 2,
+            samples,
+            gain,
+        }
+    }
 }
 
 #[cfg(test)]
