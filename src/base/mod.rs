@@ -3,14 +3,15 @@
 //! strict RON reading with atomic writing, the limits inputs are held to, the median, the
 //! words of a gesture score (side, hand, playing mode, grip, dynamic, impact location), a
 //! performed hit (`hit`: what `render` makes and `io` writes) and the choices its settings
-//! make (control pipeline, IK method, mode frequencies, sound model). Imports no other
-//! module of the crate.
+//! make (control pipeline, IK method, mode frequencies, sound model), and work spread
+//! over threads in order (`parallel`). Imports no other module of the crate.
 
 pub mod choices;
 pub mod dirs;
 pub mod gesture;
 pub mod hit;
 pub mod limits;
+pub mod parallel;
 pub mod pitch;
 pub mod problem;
 pub mod rng;

@@ -293,16 +293,9 @@ impl DrumSet {
         let law = HertzContact::of(mallet)?;
         // Each head on its own thread: building a head's modes (Bessel zeros and radial
         // tables) is most of a fresh render's set-up, and the heads share nothing.
-        let heads = std::thread::scope(|scope| {
-            let jobs: Vec<_> = kit
-                .drums
-                .iter()
-                .map(|drum| scope.spawn(move || Head::new(drum, config, dt_s)))
-                .collect();
-            jobs.into_iter()
-                .map(|job| job.join().expect("building a head panicked"))
-                .collect::<Result<Vec<_>, DrumError>>()
-        })?;
+        let heads = crate::base::parallel::each(&kit.drums, |drum| Head::new(drum, config, dt_s))
+            .into_iter()
+            .collect::<Result<Vec<_>, DrumError>>()?;
         let heads_len = heads.len();
         let most = heads
             .iter()

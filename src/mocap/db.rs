@@ -431,18 +431,9 @@ fn decode_all(files: &[(PathBuf, Vec<u8>, usize)]) -> Result<Vec<TakeData>, File
         }
         Ok(data)
     };
-    let workers = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let chunk = files.len().div_ceil(workers).max(1);
-    let decoded: Vec<Vec<Result<TakeData, FileError>>> = std::thread::scope(|scope| {
-        let jobs: Vec<_> = files
-            .chunks(chunk)
-            .map(|part| scope.spawn(move || part.iter().map(decode).collect()))
-            .collect();
-        jobs.into_iter()
-            .map(|j| j.join().expect("a take decoder panicked"))
-            .collect()
-    });
-    decoded.into_iter().flatten().collect()
+    crate::base::parallel::chunked(files, decode)
+        .into_iter()
+        .collect()
 }
 
 /// Read a `.tmot` file; `path` names it in errors. Corrupt or truncated data is an error.

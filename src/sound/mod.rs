@@ -361,21 +361,10 @@ pub enum Cores {
 /// `f` of each item, on a thread each with [`Cores::All`], else one after another; in
 /// order either way.
 fn each<T: Send, R: Send>(items: Vec<T>, cores: Cores, f: impl Fn(T) -> R + Sync) -> Vec<R> {
-    if cores == Cores::One {
-        return items.into_iter().map(f).collect();
+    match cores {
+        Cores::One => items.into_iter().map(f).collect(),
+        Cores::All => crate::base::parallel::each(items, f),
     }
-    std::thread::scope(|scope| {
-        let jobs: Vec<_> = items
-            .into_iter()
-            .map(|item| {
-                let f = &f;
-                scope.spawn(move || f(item))
-            })
-            .collect();
-        jobs.into_iter()
-            .map(|job| job.join().expect("a drum's synthesis panicked"))
-            .collect()
-    })
 }
 
 /// [`render_touched`] on `cores`.
