@@ -135,11 +135,13 @@ pub fn job() -> impl FnMut(Request, &Job<Reply>) + Send + 'static {
         let began = Instant::now();
         // Where the first step resumed from.
         let mut origin: Option<Option<f64>> = None;
+        let mut step_s = RESUME_STEP_S;
         loop {
             let stop_after_s = if origin.is_none() {
                 FIRST_STEP_S
             } else {
-                RESUME_STEP_S
+                step_s *= 2.0;
+                step_s / 2.0
             };
             let result = render_composition(
                 &mut resume,

@@ -296,8 +296,10 @@ pub const SOUND_AHEAD_S: f64 = 5.0;
 /// After an edit the editor first renders this far past the edited stroke, s, ready to
 /// play at once...
 pub const FIRST_STEP_S: f64 = 0.4;
-/// ...then the rest in steps of this, s (each several times faster than real time, so
-/// playback started at once never runs out).
+/// ...then the rest in steps, the first this long, s, and each next one twice the last
+/// (each several times faster than real time, so playback started at once never runs
+/// out; fewer steps hand over fewer whole copies of the audio and motion, and a longer
+/// one makes its sound beside its simulation, every [`SOUND_AHEAD_S`]).
 pub const RESUME_STEP_S: f64 = 4.0;
 
 /// What renderings leave behind to resume from after an edit: the settled performance,
