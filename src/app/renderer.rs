@@ -140,8 +140,8 @@ pub fn job() -> impl FnMut(Request, &Job<Reply>) + Send + 'static {
             let stop_after_s = if origin.is_none() {
                 FIRST_STEP_S
             } else {
-                step_s *= 2.0;
-                step_s / 2.0
+                let next = 2.0 * step_s;
+                std::mem::replace(&mut step_s, next)
             };
             let result = render_composition(
                 &mut resume,

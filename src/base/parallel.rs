@@ -3,7 +3,7 @@
 //! consecutive items per core ([`chunked`]: many small ones, such as a database's takes).
 //! A job's panic is raised again in the caller, as if the work had run there.
 
-use std::thread::{Scope, ScopedJoinHandle};
+use std::thread::ScopedJoinHandle;
 
 /// `f` of each item, each on a thread of its own; in order.
 pub fn each<T: Send, R: Send>(
@@ -25,7 +25,7 @@ pub fn each<T: Send, R: Send>(
 pub fn chunked<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let run = items.len().div_ceil(cores).max(1);
-    std::thread::scope(|scope: &Scope<'_, '_>| {
+    std::thread::scope(|scope| {
         let f = &f;
         let jobs: Vec<_> = items
             .chunks(run)

@@ -123,8 +123,6 @@ pub struct Stage<'a> {
     /// [`DRUM_TIMING_EVERY`]th step (reading the clock twice a step cost ~1 % of a
     /// render).
     pub drum_time: Duration,
-    /// Drum steps taken so far.
-    pub drum_steps: u32,
     /// Told the fraction of the score simulated; `false` cancels.
     pub report: &'a mut dyn FnMut(f64) -> bool,
     /// Shown the performance each time a cluster is settled: everything it has simulated
@@ -132,8 +130,10 @@ pub struct Stage<'a> {
     pub settled: &'a mut dyn FnMut(&Performance),
 }
 
-/// The drums' wall time is read on one step in this many.
-const DRUM_TIMING_EVERY: u32 = 16;
+/// The drums' wall time is read on one step in this many (by the drums' own step count:
+/// prime, so the sample is not in step with the membrane frames, whose catch-up makes
+/// every [`crate::drum::set::MEMBRANE_FRAME_STEPS`]th step dearer).
+const DRUM_TIMING_EVERY: u64 = 17;
 
 struct Meeting<'a, 'b> {
     drums: &'a mut DrumSet,
@@ -143,13 +143,12 @@ struct Meeting<'a, 'b> {
 impl Environment for Meeting<'_, '_> {
     fn tip_forces(&mut self, time_s: f64, tips: [(DVec3, DVec3); 2]) -> [DVec3; 2] {
         let stage = &mut *self.stage;
-        stage.drum_steps = stage.drum_steps.wrapping_add(1);
-        if !stage.drum_steps.is_multiple_of(DRUM_TIMING_EVERY) {
+        if !self.drums.steps_taken().is_multiple_of(DRUM_TIMING_EVERY) {
             return self.drums.step(stage.start_s + time_s, tips);
         }
         let began = Instant::now();
         let forces = self.drums.step(stage.start_s + time_s, tips);
-        stage.drum_time += began.elapsed() * DRUM_TIMING_EVERY;
+        stage.drum_time += began.elapsed() * DRUM_TIMING_EVERY as u32;
         forces
     }
 

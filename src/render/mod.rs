@@ -703,7 +703,6 @@ impl Run<'_> {
         let mut stage = Stage {
             start_s: comp.start_s,
             drum_time: Duration::ZERO,
-            drum_steps: 0,
             report: &mut report,
             settled,
         };
