@@ -676,9 +676,11 @@ fn recontact_sized(contacts: &[ContactEvent]) -> Vec<&ContactEvent> {
 /// 5 % before a larger step may be the default. Measured here: contacts within 0.10 ms,
 /// peak forces within 9.2 % (3.9 % before the arm let a stick on a head rebound; 6.0 %
 /// while the coarser step took its goals at its end), tip paths 0.36 mm apart RMS but
-/// 4.8 mm at worst, in the rattle of the loosened grip 20–90 ms after a contact: close,
-/// not within, so 10 kHz stays the default and this test holds the figures measured, with
-/// a margin.
+/// 4.8 mm at worst, in the rattle of the loosened grip 20–90 ms after a contact; with the
+/// compensation's warm start from what earlier contacts suggest (other placements, so
+/// other renders to replay): contacts within 0.30 ms, forces 5.9 %, tips 0.39 mm RMS and
+/// 5.7 mm at worst. Close, not within, so 10 kHz stays the default and this test holds
+/// the figures measured, with a margin.
 #[test]
 fn a_body_at_5_khz_with_the_contact_at_10_khz_stays_near_the_reference() {
     let db = db();
@@ -743,7 +745,7 @@ fn a_body_at_5_khz_with_the_contact_at_10_khz_stays_near_the_reference() {
         worst_rms_m * 1e3
     );
     assert!(
-        worst_tip_m <= 5e-3,
+        worst_tip_m <= 6.5e-3,
         "tip paths {:.2} mm apart",
         worst_tip_m * 1e3
     );

@@ -9,8 +9,9 @@
 //! the stick falling back on a head —, then contacts out of time, forces far off their
 //! aim, contacts pressed too long, forces a little off, then the worst timing) and the
 //! performance moves on. Each
-//! cluster starts from its predecessors' settled shifts and depths (same hand, mode,
-//! dynamic and drum, else the nearest kind), so repeated material settles at once.
+//! cluster starts from what its predecessors' contacts say they should have had (same
+//! hand, mode, dynamic and spot, else the nearest kind; across dynamics by the line of
+//! depth against force aim), so repeated material settles at once.
 //!
 //! Every cluster's start and end is a [`Commit`]: the performance can rewind there and
 //! resume with a changed score — bit for bit what a whole rendering of it would give, as long as
@@ -51,6 +52,31 @@ const TRANSITION_S: f64 = 0.06;
 /// the deepest aim and too weak one step shallower).
 const REPEAT_SHIFT_S: f64 = 1e-4;
 const REPEAT_DEPTH_M: f64 = 1e-4;
+/// Impacts on one drum closer than this, m, strike the same spot of its head (which
+/// gives as much at one spot as at the other).
+const SAME_SPOT_M: f64 = 0.03;
+/// A stroke starts from the mean of what this many of the latest strokes most like it
+/// suggest.
+const WARM_FROM: usize = 2;
+/// Strokes alike in all but the dynamic (of one hand and mode) set a depth by the line
+/// through the latest this many of them (force aim, depth).
+const DEPTH_LINE_FROM: usize = 8;
+/// Their force aims must span at least this, N, for a line.
+const DEPTH_LINE_SPAN_N: f64 = 5.0;
+
+/// The depth (m) at force aim `aim` (N) on the least-squares line through `points`
+/// (force aim, depth), when their aims span [`DEPTH_LINE_SPAN_N`] and deeper aims
+/// strike harder on it; `None` otherwise (strokes of one dynamic only).
+fn depth_line(points: &[(f64, f64)], aim: f64) -> Option<f64> {
+    let (lo, hi) = points
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p.0), hi.max(p.0))
+        });
+    let line = crate::base::stats::least_squares_line(points);
+    (hi - lo >= DEPTH_LINE_SPAN_N && line.slope > 0.0).then(|| line.at(aim))
+}
+
 /// Within a lead-in, a state is saved every this many seconds (so an edit there resumes
 /// close to it).
 pub const LEAD_COMMIT_EVERY_S: f64 = 0.05;
@@ -172,6 +198,9 @@ pub struct Performance {
     pub drums: DrumSet,
     /// Per stroke, how much earlier its target is played, s.
     pub shift_s: Vec<f64>,
+    /// Per settled stroke, the shift and depth (s, m) its kept attempt's contact says
+    /// it should have had: what a stroke like it starts from.
+    pub suggested: Vec<(f64, f64)>,
     /// Strokes settled.
     pub settled: usize,
     /// Each settled cluster's start.
@@ -197,6 +226,7 @@ impl Performance {
             sim,
             drums,
             shift_s: vec![0.0; strokes],
+            suggested: vec![(0.0, 0.0); strokes],
             settled: 0,
             commits: Vec::new(),
             attempts: 0,
@@ -226,6 +256,7 @@ impl Performance {
             targets.set_depth(i, self.targets.depth(i));
         }
         self.shift_s.resize(strokes, 0.0);
+        self.suggested.resize(strokes, (0.0, 0.0));
         self.targets = targets;
         self.reference = self.targets.blank();
         self.targets
@@ -343,32 +374,98 @@ impl Performance {
         Ok(())
     }
 
-    /// Start each stroke of `cluster` from the settled shift and depth of the latest
-    /// earlier stroke most like it: of its hand, mode, dynamic and drum; else of its hand,
-    /// mode and dynamic; else of its hand and mode, else of its hand — these two with the
-    /// depth in proportion to the two strokes' force aims (a stroke of another dynamic
-    /// also comes with its own approach, so its depth changes less than
-    /// [`depth_for_force`] says: over the seven demos 521 attempts against 539 by that
-    /// law); else no shift and the first depth.
+    /// Start each stroke of `cluster` from what the earlier strokes most like it
+    /// suggest ([`Self::suggest`]): the latest strokes of its hand, mode and dynamic at
+    /// the same spot of the same head; else of its hand and mode at that spot; else of
+    /// its hand, mode and dynamic on that drum; else of its hand, mode and dynamic; else
+    /// of its hand and mode; else of its hand. The shift is the mean of the latest
+    /// [`WARM_FROM`]'s; the depth comes from the line through up to
+    /// [`DEPTH_LINE_FROM`] of them (force aim, depth: a ladder of dynamics) when their
+    /// aims differ, else from the latest [`WARM_FROM`]'s in proportion to the force aims
+    /// (geometric mean). No stroke like it: no shift and the first depth.
     fn warm_start(&mut self, cluster: Range<usize>, strokes: &[PlannedStroke], aims: &Aims) {
         for i in cluster {
-            let s = &strokes[i];
-            let settled = &strokes[..self.settled];
-            let played = |o: &PlannedStroke| o.hand == s.hand && o.mode == s.mode;
-            let alike: [&dyn Fn(&PlannedStroke) -> bool; 4] = [
-                &|o| played(o) && o.dynamic == s.dynamic && o.drum == s.drum,
-                &|o| played(o) && o.dynamic == s.dynamic,
-                &played,
-                &|o| o.hand == s.hand,
-            ];
-            let from = alike.iter().find_map(|a| settled.iter().rposition(a));
-            let (shift, depth) = from.map_or((0.0, aims.first_depth_m), |j| {
-                let scale = aims.force_n[i].max(1e-3) / aims.force_n[j].max(1e-3);
-                let depth = self.targets.depth(j) * scale;
-                (self.shift_s[j], depth.clamp(MIN_DEPTH_M, MAX_DEPTH_M))
-            });
+            let like = self.most_alike(&strokes[..self.settled], &strokes[i]);
+            let (shift, depth) = if like.is_empty() {
+                (0.0, aims.first_depth_m)
+            } else {
+                let latest = &like[..like.len().min(WARM_FROM)];
+                let n = latest.len() as f64;
+                let shift = latest.iter().map(|&j| self.suggested[j].0).sum::<f64>() / n;
+                let points: Vec<(f64, f64)> = like
+                    .iter()
+                    .map(|&j| (aims.force_n[j], self.suggested[j].1))
+                    .collect();
+                let depth = depth_line(&points, aims.force_n[i]).unwrap_or_else(|| {
+                    let log_depth: f64 = latest
+                        .iter()
+                        .map(|&j| {
+                            let scale = aims.force_n[i].max(1e-3) / aims.force_n[j].max(1e-3);
+                            (self.suggested[j].1 * scale).ln()
+                        })
+                        .sum();
+                    (log_depth / n).exp()
+                });
+                (shift, depth.clamp(MIN_DEPTH_M, MAX_DEPTH_M))
+            };
             self.shift_s[i] = shift;
             self.targets.set_depth(i, depth);
+        }
+    }
+
+    /// The latest (up to [`DEPTH_LINE_FROM`], latest first) of the `settled` strokes in
+    /// the first of [`Self::warm_start`]'s kinds that has any like `stroke`.
+    fn most_alike(&self, settled: &[PlannedStroke], stroke: &PlannedStroke) -> Vec<usize> {
+        let s = stroke;
+        let played = |o: &PlannedStroke| o.hand == s.hand && o.mode == s.mode;
+        let spot =
+            |o: &PlannedStroke| o.drum == s.drum && o.target.distance(s.target) < SAME_SPOT_M;
+        let alike: [&dyn Fn(&PlannedStroke) -> bool; 6] = [
+            &|o| played(o) && o.dynamic == s.dynamic && spot(o),
+            &|o| played(o) && spot(o),
+            &|o| played(o) && o.dynamic == s.dynamic && o.drum == s.drum,
+            &|o| played(o) && o.dynamic == s.dynamic,
+            &played,
+            &|o| o.hand == s.hand,
+        ];
+        alike
+            .iter()
+            .map(|a| {
+                (0..settled.len())
+                    .rev()
+                    .filter(|&j| a(&settled[j]))
+                    .take(DEPTH_LINE_FROM)
+                    .collect::<Vec<_>>()
+            })
+            .find(|like| !like.is_empty())
+            .unwrap_or_default()
+    }
+
+    /// What each stroke of the settled `cluster` should have had by its contact in the
+    /// kept attempt: the shift corrected by how late it was, the depth by how far its
+    /// force was off (by [`depth_for_force`], at most a quarter either way), the shift
+    /// allowing for the deeper aim reaching the head earlier (as [`Self::correct`]).
+    fn suggest(
+        &mut self,
+        cluster: Range<usize>,
+        strokes: &[PlannedStroke],
+        aims: &Aims,
+        commit: &Commit,
+    ) {
+        let contacts = self.drums.contacts();
+        let matches =
+            strikes::match_range(strokes, cluster.clone(), contacts, commit.drums.contacts());
+        for (i, m) in cluster.zip(matches) {
+            let (shift, depth) = (self.shift_s[i], self.targets.depth(i));
+            self.suggested[i] = m.map_or((shift, depth), |c| {
+                let c = &contacts[c];
+                let ratio = aims.force_n[i] / c.peak_force_n.max(1e-3);
+                let better = (depth * depth_for_force(ratio).clamp(0.8, 1.25))
+                    .clamp(MIN_DEPTH_M, MAX_DEPTH_M);
+                let late = c.start_s - strokes[i].time_s;
+                let shift = shift + late - (better - depth) / c.impact_speed_mps.max(0.5);
+                (shift.clamp(-MAX_SHIFT_S, MAX_SHIFT_S), better)
+            });
         }
     }
 
@@ -566,6 +663,7 @@ impl Performance {
             self.place(cluster.clone(), &commit, until);
             self.advance(until, stage)?;
         }
+        self.suggest(cluster.clone(), strokes, aims, &commit);
         self.settled = cluster.end;
         self.commits.push(Commit {
             strokes: cluster.end,
@@ -637,9 +735,11 @@ fn same_placement(a: &[(f64, f64)], b: &[(f64, f64)]) -> bool {
 }
 
 /// How a stroke's peak force grows with its aimed depth below the head, about: F ∝ dᵉ
-/// (measured over the one-minute study's corrections: e ≈ 0.3–0.6; the approach the
-/// composed motion brings gives most of the force, the strike-through the rest).
-const FORCE_DEPTH_EXPONENT: f64 = 0.4;
+/// (over the one-minute study's 226 attempts the impact speed went as d^0.48–0.60 for
+/// one hand, mode and drum — d^0.60 for one stroke —, and the peak force in proportion
+/// to it, 10.4 N per m/s, 4.4 N RMS off that line; the approach the composed motion
+/// brings gives most of the force, the strike-through the rest).
+const FORCE_DEPTH_EXPONENT: f64 = 0.5;
 
 /// The depth ratio that changes a stroke's peak force by `force_ratio` (by
 /// [`FORCE_DEPTH_EXPONENT`]).
@@ -674,6 +774,26 @@ pub fn clusters(strokes: &[PlannedStroke]) -> Vec<Range<usize>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A ladder of dynamics: depths on a line of force aim give that line back; aims of
+    /// one dynamic, or a line where deeper strikes softer, give none.
+    #[test]
+    fn depth_line_through_a_ladder_of_dynamics() {
+        let ladder = [(46.0, 0.012), (59.0, 0.020), (72.0, 0.029), (86.0, 0.037)];
+        let fitted = depth_line(&ladder, 99.0).expect("a ladder has a line");
+        // Least squares through the four, about their mean (65.75 N, 24.5 mm).
+        let (mx, my) = (65.75, 0.0245);
+        let (sxy, sxx) = ladder.iter().fold((0.0, 0.0), |(xy, xx), (x, y)| {
+            (xy + (x - mx) * (y - my), xx + (x - mx) * (x - mx))
+        });
+        assert!((fitted - (my + sxy / sxx * (99.0 - mx))).abs() < 1e-12);
+        assert!(fitted > 0.043 && fitted < 0.047, "{fitted}");
+        let exact = [(40.0, 0.010), (80.0, 0.030)];
+        assert!((depth_line(&exact, 60.0).unwrap() - 0.020).abs() < 1e-12);
+        assert_eq!(depth_line(&[(72.0, 0.02), (74.0, 0.03)], 99.0), None);
+        assert_eq!(depth_line(&[(40.0, 0.03), (80.0, 0.02)], 99.0), None);
+        assert_eq!(depth_line(&[(72.0, 0.02)], 99.0), None);
+    }
 
     #[test]
     fn placements_within_a_tenth_of_a_millisecond_and_millimetre_are_one() {

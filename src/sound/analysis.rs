@@ -243,14 +243,7 @@ fn t60_of(points: &[(f64, f64)]) -> Option<f64> {
     if points.len() < 3 {
         return None;
     }
-    let n = points.len() as f64;
-    let (mt, ml) = points
-        .iter()
-        .fold((0.0, 0.0), |(a, b), p| (a + p.0 / n, b + p.1 / n));
-    let (sxy, sxx) = points.iter().fold((0.0, 0.0), |(a, b), p| {
-        (a + (p.0 - mt) * (p.1 - ml), b + (p.0 - mt) * (p.0 - mt))
-    });
-    let slope = sxy / sxx;
+    let slope = crate::base::stats::least_squares_line(points).slope;
     (slope < 0.0).then(|| -60.0 / slope)
 }
 
