@@ -712,11 +712,11 @@ impl Simulator {
             let u = ((s - 1) * contact + 1) as f64 / self.substeps as f64;
             let time_s = (k - 1) as f64 / reference.rate_hz + (s - 1) as f64 * dt;
             // Normalised lerp: within one 4 ms task interval it matches slerp to ~1e-7 rad.
-            let mut goal: Pose = std::array::from_fn(|j| from[j].lerp(to[j], u));
+            // (Not needed while the nested IK's goal is held.)
             let held_goal = solved.filter(|_| !(s - 1).is_multiple_of(every));
-            if let Some(held_goal) = held_goal {
-                goal = held_goal;
-            } else if self.pipeline == Pipeline::Himc {
+            let mut goal: Pose =
+                held_goal.unwrap_or_else(|| std::array::from_fn(|j| from[j].lerp(to[j], u)));
+            if held_goal.is_none() && self.pipeline == Pipeline::Himc {
                 // IK nested in PD (seed 000 Alg. 2): every `nested_every` steps, solve the
                 // tips' targets from the simulated pose, Δq = J⁺(X_t − X(q)), with the
                 // redundancy pulled toward the task-rate IK posture; PD then tracks that.
