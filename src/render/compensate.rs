@@ -385,7 +385,7 @@ impl Performance {
     /// (geometric mean). No stroke like it: no shift and the first depth.
     fn warm_start(&mut self, cluster: Range<usize>, strokes: &[PlannedStroke], aims: &Aims) {
         for i in cluster {
-            let like = self.most_alike(&strokes[..self.settled], &strokes[i]);
+            let like = most_alike(&strokes[..self.settled], &strokes[i]);
             let (shift, depth) = if like.is_empty() {
                 (0.0, aims.first_depth_m)
             } else {
@@ -411,34 +411,6 @@ impl Performance {
             self.shift_s[i] = shift;
             self.targets.set_depth(i, depth);
         }
-    }
-
-    /// The latest (up to [`DEPTH_LINE_FROM`], latest first) of the `settled` strokes in
-    /// the first of [`Self::warm_start`]'s kinds that has any like `stroke`.
-    fn most_alike(&self, settled: &[PlannedStroke], stroke: &PlannedStroke) -> Vec<usize> {
-        let s = stroke;
-        let played = |o: &PlannedStroke| o.hand == s.hand && o.mode == s.mode;
-        let spot =
-            |o: &PlannedStroke| o.drum == s.drum && o.target.distance(s.target) < SAME_SPOT_M;
-        let alike: [&dyn Fn(&PlannedStroke) -> bool; 6] = [
-            &|o| played(o) && o.dynamic == s.dynamic && spot(o),
-            &|o| played(o) && spot(o),
-            &|o| played(o) && o.dynamic == s.dynamic && o.drum == s.drum,
-            &|o| played(o) && o.dynamic == s.dynamic,
-            &played,
-            &|o| o.hand == s.hand,
-        ];
-        alike
-            .iter()
-            .map(|a| {
-                (0..settled.len())
-                    .rev()
-                    .filter(|&j| a(&settled[j]))
-                    .take(DEPTH_LINE_FROM)
-                    .collect::<Vec<_>>()
-            })
-            .find(|like| !like.is_empty())
-            .unwrap_or_default()
     }
 
     /// What each stroke of the settled `cluster` should have had by its contact in the
@@ -724,6 +696,33 @@ impl Performance {
         }
         self.shift_s[i] = shift.clamp(-MAX_SHIFT_S, MAX_SHIFT_S);
     }
+}
+
+/// The latest (up to [`DEPTH_LINE_FROM`], latest first) of the `settled` strokes in
+/// the first of [`Performance::warm_start`]'s kinds that has any like `stroke`.
+fn most_alike(settled: &[PlannedStroke], stroke: &PlannedStroke) -> Vec<usize> {
+    let s = stroke;
+    let played = |o: &PlannedStroke| o.hand == s.hand && o.mode == s.mode;
+    let spot = |o: &PlannedStroke| o.drum == s.drum && o.target.distance(s.target) < SAME_SPOT_M;
+    let alike: [&dyn Fn(&PlannedStroke) -> bool; 6] = [
+        &|o| played(o) && o.dynamic == s.dynamic && spot(o),
+        &|o| played(o) && spot(o),
+        &|o| played(o) && o.dynamic == s.dynamic && o.drum == s.drum,
+        &|o| played(o) && o.dynamic == s.dynamic,
+        &played,
+        &|o| o.hand == s.hand,
+    ];
+    alike
+        .iter()
+        .map(|a| {
+            (0..settled.len())
+                .rev()
+                .filter(|&j| a(&settled[j]))
+                .take(DEPTH_LINE_FROM)
+                .collect::<Vec<_>>()
+        })
+        .find(|like| !like.is_empty())
+        .unwrap_or_default()
 }
 
 /// Whether two placements of a cluster are the same to [`REPEAT_SHIFT_S`] and
