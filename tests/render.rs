@@ -673,14 +673,15 @@ fn recontact_sized(contacts: &[ContactEvent]) -> Vec<&ContactEvent> {
 /// Replayed at the reference settings, a rendering comes back bit for bit.
 ///
 /// Issue 22 asks tip paths within 1 mm, contact times within 0.3 ms and peak forces within
-/// 5 % before a larger step may be the default. Measured here: contacts within 0.10 ms,
-/// peak forces within 9.2 % (3.9 % before the arm let a stick on a head rebound; 6.0 %
-/// while the coarser step took its goals at its end), tip paths 0.36 mm apart RMS but
-/// 4.8 mm at worst, in the rattle of the loosened grip 20–90 ms after a contact; with the
-/// compensation's warm start from what earlier contacts suggest (other placements, so
-/// other renders to replay): contacts within 0.30 ms, forces 5.9 %, tips 0.39 mm RMS and
-/// 5.7 mm at worst. Close, not within, so 10 kHz stays the default and this test holds
-/// the figures measured, with a margin.
+/// 5 % before a larger step may be the default. Measured here with the tip between the
+/// body's steps moving as the body answers the contact's force (its operational-space
+/// response) and the body stepping at 10 kHz while a stick is on a head: contacts within
+/// 0.10 ms, peak forces within 4.9 % (median 0.6 %; 5.9 % while every body step was
+/// coarse and the tip moved as a point of the mallet's mass between them), tip paths
+/// 0.23 mm apart RMS but 3.7 mm at worst (5.7 mm before), while a stick rises from a
+/// stroke whose impact speed differs by a few per cent (the coarser step's explicit PD
+/// on the stiff wrist and grip). Close, not within, so this test holds the figures
+/// measured, with a margin.
 #[test]
 fn a_body_at_5_khz_with_the_contact_at_10_khz_stays_near_the_reference() {
     let db = db();
@@ -740,25 +741,24 @@ fn a_body_at_5_khz_with_the_contact_at_10_khz_stays_near_the_reference() {
     );
     assert!(compared > 250, "{compared}");
     assert!(
-        worst_rms_m <= 0.5e-3,
+        worst_rms_m <= 0.35e-3,
         "tip paths {:.2} mm RMS",
         worst_rms_m * 1e3
     );
     assert!(
-        worst_tip_m <= 6.5e-3,
+        worst_tip_m <= 4.5e-3,
         "tip paths {:.2} mm apart",
         worst_tip_m * 1e3
     );
     assert!(
-        worst_contact_s <= 0.3e-3,
+        worst_contact_s <= 0.2e-3,
         "contact times {:.2} ms apart",
         worst_contact_s * 1e3
     );
-    // Within 5 % until the arm let a stick on a head rebound (the nested IK's goal then
-    // follows the tip, which the coarser body step places a little differently): one ff
-    // stroke of the minute study is now 9.2 % off (100 N against 91 N), two more 4–5 %.
+    // One ff stroke of the minute study 4.9 % off (91.6 N against 87.3 N: its approach
+    // 1.9 % faster), the others within 3 %.
     assert!(
-        worst_force <= 0.1,
+        worst_force <= 0.06,
         "peak forces {:.1} % apart",
         worst_force * 100.0
     );

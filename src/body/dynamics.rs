@@ -253,6 +253,18 @@ struct Scratch {
     d_inv: [DMat3; N],
     /// u = τ − Sᵀ·pA, N·m.
     u: [DVec3; N],
+    /// Spatial acceleration of the latest articulated pass, segment frame (the pelvis
+    /// accelerating upward in place of gravity).
+    acc: [SpatialVec; N],
+}
+
+/// How a stick tip answers a force on it at the start of a step: its acceleration with no
+/// force there (m/s², performer frame, gravity included) and the change of it per newton,
+/// J·M⁻¹·Jᵀ (the inverse of the tip's operational-space inertia, 1/kg).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TipResponse {
+    pub free: DVec3,
+    pub mobility: DMat3,
 }
 
 /// Forward dynamics of a [`BodyModel`].
@@ -289,6 +301,7 @@ impl Dynamics {
                 pa: [SpatialVec::ZERO; N],
                 d_inv: [DMat3::IDENTITY; N],
                 u: [DVec3::ZERO; N],
+                acc: [SpatialVec::ZERO; N],
             },
         }
     }
@@ -378,7 +391,7 @@ impl Dynamics {
             }
         }
         // Accelerations, root to tips; the pelvis accelerates upward to model gravity.
-        let mut acc = [SpatialVec::ZERO; N];
+        let acc = &mut s.acc;
         let mut qdd = [DVec3::ZERO; N];
         for i in 0..N {
             let a_p =
@@ -391,6 +404,43 @@ impl Dynamics {
             acc[i] = a + SpatialVec::new(qdd[i], DVec3::ZERO);
         }
         qdd
+    }
+
+    /// The acceleration of a stick tip (m/s², performer frame) after an articulated pass:
+    /// the classical acceleration of the tip point, a_O + α×r + ω×(v_O + ω×r), with the
+    /// pass's upward pelvis acceleration taken back out (gravity included).
+    fn tip_acceleration(&self, side: Side) -> DVec3 {
+        let s = &self.scratch;
+        let i = Joint::arm(side)[3].index();
+        let r = DVec3::new(0.0, 0.0, -self.model.skeleton.stick_length_m);
+        let (a, v) = (s.acc[i], s.v[i]);
+        let local = a.lin + a.ang.cross(r) + v.ang.cross(v.lin + v.ang.cross(r));
+        s.rot[i] * local + self.gravity
+    }
+
+    /// How the tip of `side` answers a force on it under joint torques `tau` (N·m), in the
+    /// state of the latest kinematics pass: four articulated passes (none, and a newton
+    /// along each axis).
+    fn tip_response(&mut self, tau: &[DVec3; N], side: Side) -> TipResponse {
+        let (tip, _) = self.tips_from_kinematics()[side_index(side)];
+        let segment = Joint::arm(side)[3].index();
+        self.articulated(tau, &[]);
+        let free = self.tip_acceleration(side);
+        let column = |dynamics: &mut Dynamics, axis: DVec3| {
+            let push = ExternalForce {
+                segment,
+                point_world: tip,
+                force_world: axis,
+            };
+            dynamics.articulated(tau, &[push]);
+            dynamics.tip_acceleration(side) - free
+        };
+        let mobility = DMat3::from_cols(
+            column(self, DVec3::X),
+            column(self, DVec3::Y),
+            column(self, DVec3::Z),
+        );
+        TipResponse { free, mobility }
     }
 
     /// One step of length dt (s): semi-implicit (symplectic) Euler — w += dt·ẇ, then
@@ -407,19 +457,23 @@ impl Dynamics {
     }
 
     /// One step like [`Self::step`] with forces on the stick tips: `contact` gets both tips'
-    /// position (m) and velocity (m/s) at the start of the step, performer frame, and
-    /// returns the force on each (N, performer frame), applied at the tip during the step.
-    /// One kinematics pass serves both.
+    /// position (m) and velocity (m/s) at the start of the step, performer frame, and a way
+    /// to ask how a tip ([left, right] index) answers a force ([`TipResponse`], asked only
+    /// when needed: it costs four articulated passes), and returns the force on each (N,
+    /// performer frame), applied at the tip during the step. One kinematics pass serves
+    /// all.
     pub fn step_with_tip_forces(
         &mut self,
         state: &mut State,
         tau: &[DVec3; N],
-        contact: impl FnOnce([(DVec3, DVec3); 2]) -> [DVec3; 2],
+        contact: impl FnOnce([(DVec3, DVec3); 2], &mut dyn FnMut(usize) -> TipResponse) -> [DVec3; 2],
         dt: f64,
     ) -> [(DVec3, DVec3); 2] {
         self.kinematics(state);
         let tips = self.tips_from_kinematics();
-        let forces = contact(tips);
+        let forces = contact(tips, &mut |h| {
+            self.tip_response(tau, [Side::Left, Side::Right][h])
+        });
         let external: [ExternalForce; 2] = std::array::from_fn(|h| ExternalForce {
             segment: Joint::arm([Side::Left, Side::Right][h])[3].index(),
             point_world: tips[h].0,
@@ -559,6 +613,14 @@ impl Dynamics {
             }
         }
         m
+    }
+}
+
+/// A side's index in [left, right] pairs.
+fn side_index(side: Side) -> usize {
+    match side {
+        Side::Left => 0,
+        Side::Right => 1,
     }
 }
 

@@ -178,10 +178,6 @@ impl Environment for Meeting<'_, '_> {
         forces
     }
 
-    fn tip_mass_kg(&self) -> f64 {
-        self.drums.tip_mass_kg()
-    }
-
     fn progress(&mut self, done: usize, total: usize) -> bool {
         !done.is_multiple_of(64) || (self.stage.report)(done as f64 / total.max(1) as f64)
     }

@@ -26,10 +26,6 @@ impl Environment for Heads<'_> {
     fn tip_forces(&mut self, time_s: f64, tips: [(DVec3, DVec3); 2]) -> [DVec3; 2] {
         self.drums.step(self.start_s + time_s, tips)
     }
-
-    fn tip_mass_kg(&self) -> f64 {
-        self.drums.tip_mass_kg()
-    }
 }
 
 /// Follow `rendering`'s targets (`Rendering::reference`) with the simulation settings
