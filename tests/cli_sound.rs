@@ -95,3 +95,35 @@ fn fit_refuses_a_bad_recording() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("junk.wav"));
     assert!(!cal.exists());
 }
+
+/// Noise is not a struck note: `sound analyse` and `sound fit` name the file and say why,
+/// exit non-zero, and the fit writes nothing.
+#[test]
+fn noise_is_refused_as_a_note() {
+    let dir = tempfile::tempdir().unwrap();
+    let noise = dir.path().join("room-tone.wav");
+    let mut rng = timpanist::base::rng::Rng::new(9);
+    let samples = (0..88_200)
+        .map(|_| rng.uniform(-0.05, 0.05) as f32)
+        .collect();
+    let audio = timpanist::sound::Audio {
+        samples,
+        channels: 1,
+        rate_hz: 44_100,
+        gain: 1.0,
+    };
+    timpanist::sound::wav::write_wav(&noise, &audio).unwrap();
+    let noise_s = noise.to_str().unwrap();
+    let out = timpanist(&["sound", "analyse", noise_s]);
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        said.contains("room-tone.wav") && said.contains("no struck note"),
+        "{said}"
+    );
+    let cal = dir.path().join("cal.ron");
+    let out = timpanist(&["sound", "fit", noise_s, "-o", cal.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no struck note"));
+    assert!(!cal.exists());
+}

@@ -52,6 +52,9 @@ pub fn fit(files: &[PathBuf], output: &Path) -> anyhow::Result<()> {
             .iter()
             .map(|path| {
                 let (samples, rate_hz) = analysis::read_mono(path)?;
+                if let Some(why) = analysis::not_a_note(&samples, rate_hz) {
+                    anyhow::bail!("{}: {why}", path.display());
+                }
                 Ok(Note {
                     name: path.display().to_string(),
                     samples,
@@ -137,8 +140,18 @@ pub fn analyse(files: &[PathBuf], at: &[f64], plot: Option<&Path>) -> anyhow::Re
 
 /// Print one note's measurements.
 fn analyse_note(name: &str, samples: &[f32], rate: u32) -> anyhow::Result<()> {
+    if let Some(why) = analysis::not_a_note(samples, rate) {
+        anyhow::bail!("{name}: {why}");
+    }
     let p = analysis::profile(samples, rate).ok_or_else(|| anyhow::anyhow!("{name}: silent"))?;
     println!("{name}");
+    let after_s = samples.len() as f64 / f64::from(rate) - p.onset_s;
+    if after_s < analysis::SHORT_NOTE_S {
+        println!(
+            "  note: only {after_s:.2} s after the onset; the bands and centroid are over that, \
+             not a second"
+        );
+    }
     // The peak of the analysed span (the onset's first second).
     let from = (p.onset_s * f64::from(rate)) as usize;
     let span = &samples[from..(from + rate as usize).min(samples.len())];
@@ -158,15 +171,22 @@ fn analyse_note(name: &str, samples: &[f32], rate: u32) -> anyhow::Result<()> {
     let decays: Vec<String> = OCTAVE_CENTRES_HZ
         .iter()
         .map(|&c| {
-            analysis::band_t60(samples, rate, c, (0.02, 1.0), 0.08)
-                .map_or(format!("{c:.0} Hz -"), |t| format!("{c:.0} Hz {t:.2} s"))
+            analysis::band_t60(
+                samples,
+                rate,
+                c,
+                ((0.02, 1.0), 0.08),
+                analysis::MIN_DECAY_DB,
+            )
+            .map_or(format!("{c:.0} Hz -"), |t| format!("{c:.0} Hz {t:.2} s"))
         })
         .collect();
     println!("  octave-band T60 over 0-1 s: {}", decays.join(", "));
     match p.principal_hz {
         Some(f) => {
             let t0 = p.onset_s;
-            let t60 = analysis::partial_t60(samples, rate, f, (t0 + 0.05, t0 + 1.5), 0.1);
+            let span = ((t0 + 0.05, t0 + 1.5), 0.1);
+            let t60 = analysis::partial_t60(samples, rate, f, span, analysis::MIN_DECAY_DB);
             let glide = analysis::glide_percent(samples, rate, f);
             print!("  (1,1) {f:.2} Hz");
             if let Some(t60) = t60 {

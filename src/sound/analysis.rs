@@ -18,6 +18,20 @@ const ONSET_SHARE: f32 = 0.05;
 /// The onset is moved this long earlier so the attack's first rise is inside the span, s.
 const ONSET_LEAD_S: f64 = 0.002;
 
+/// A decay is measured only where the level falls at least this much over the span, dB.
+pub const MIN_DECAY_DB: f64 = 3.0;
+/// A struck note's loudest 10 ms stand at least this far above the median 10 ms of its
+/// file (or `--at` span), dB: pink noise stands 2–3 dB above, a timpani note 20–60.
+pub const MIN_STRIKE_CONTRAST_DB: f64 = 10.0;
+/// Shorter than this after the onset, a note is not measured at all, s.
+pub const MIN_NOTE_S: f64 = 0.2;
+/// Shorter than this after the onset, a note is measured over what there is, with a
+/// warning, s.
+pub const SHORT_NOTE_S: f64 = 0.5;
+/// A stereo (or wider) file whose channels summed keep less than this share of their mean
+/// energy is read from its loudest channel instead: spaced microphones out of phase cancel.
+const MIN_MIX_SHARE: f64 = 0.5;
+
 /// Kettledrum ratios (1,1)…(5,1) used to recognise the (1,1) (guide §5, Fletcher & Rossing).
 pub const KETTLEDRUM_RATIOS: [f64; 5] = [1.0, 1.5, 1.98, 2.44, 2.94];
 
@@ -43,6 +57,44 @@ pub fn onset(samples: &[f32], rate_hz: u32) -> Option<usize> {
     }
     let first = samples.iter().position(|s| s.abs() >= ONSET_SHARE * peak)?;
     Some(first.saturating_sub((ONSET_LEAD_S * f64::from(rate_hz)) as usize))
+}
+
+/// Why `samples` (at `rate_hz`) cannot be measured as a struck note, if they cannot:
+/// silent, less than [`MIN_NOTE_S`] after its onset, or no strike standing
+/// [`MIN_STRIKE_CONTRAST_DB`] above the file's median level in 10 ms windows (noise, a
+/// sustained tone).
+pub fn not_a_note(samples: &[f32], rate_hz: u32) -> Option<String> {
+    let Some(start) = onset(samples, rate_hz) else {
+        return Some("silent".into());
+    };
+    let after_s = (samples.len() - start) as f64 / f64::from(rate_hz);
+    if after_s < MIN_NOTE_S {
+        return Some(format!(
+            "only {after_s:.3} s of sound after the onset: too short to measure (at least \
+             {MIN_NOTE_S} s)"
+        ));
+    }
+    let window = ((0.01 * f64::from(rate_hz)) as usize).max(1);
+    let mut levels: Vec<f64> = samples
+        .chunks(window)
+        .filter(|w| w.len() == window)
+        .map(|w| w.iter().map(|&x| f64::from(x) * f64::from(x)).sum::<f64>() / window as f64)
+        .collect();
+    if levels.len() < 3 {
+        return Some(format!(
+            "too short to measure ({:.3} s)",
+            samples.len() as f64 / f64::from(rate_hz)
+        ));
+    }
+    levels.sort_by(f64::total_cmp);
+    let (median, loudest) = (levels[levels.len() / 2], levels[levels.len() - 1]);
+    let contrast_db = 10.0 * (loudest / median.max(1e-30)).log10();
+    (contrast_db < MIN_STRIKE_CONTRAST_DB).then(|| {
+        format!(
+            "no struck note: its loudest 10 ms stand only {contrast_db:.1} dB above its median \
+             level (at least {MIN_STRIKE_CONTRAST_DB} dB: is it noise or a sustained sound?)"
+        )
+    })
 }
 
 /// Power spectrum of `samples` under one Hann window spanning them, zero-padded to a power
@@ -177,30 +229,31 @@ pub fn glide_percent(samples: &[f32], rate_hz: u32, near_hz: f64) -> Option<f64>
 /// Level (dB, arbitrary reference) of the partial near `near_hz` in successive Hann
 /// windows of `window_s` seconds from `from_s` to `to_s` after the signal's start, and
 /// the least-squares T60 (s) of that decay: 60 dB over the fitted slope. None when the
-/// span is too short or the partial does not decay.
+/// span is too short or the partial falls less than `min_fall_db` ([`t60_of`]).
 pub fn partial_t60(
     samples: &[f32],
     rate_hz: u32,
     near_hz: f64,
-    span_s: (f64, f64),
-    window_s: f64,
+    (span_s, window_s): ((f64, f64), f64),
+    min_fall_db: f64,
 ) -> Option<f64> {
     let points = levels(samples, rate_hz, (0, span_s), window_s, |w| {
         let (_, amp) = peak_in(&spectrum(w, rate_hz), near_hz * 0.97, near_hz * 1.03)?;
         Some(20.0 * amp.max(1e-12).log10())
     });
-    t60_of(&points)
+    t60_of(&points, min_fall_db)
 }
 
 /// Energy of an octave band (centre `centre_hz`) in successive windows: the band's T60 (s)
 /// from a least-squares line through its level from `from_s` to `to_s` after the onset, in
-/// windows of `window_s` seconds. None when the band does not decay.
+/// windows of `window_s` seconds. None when the band falls less than `min_fall_db`
+/// ([`t60_of`]).
 pub fn band_t60(
     samples: &[f32],
     rate_hz: u32,
     centre_hz: f64,
-    span_s: (f64, f64),
-    window_s: f64,
+    (span_s, window_s): ((f64, f64), f64),
+    min_fall_db: f64,
 ) -> Option<f64> {
     let start = onset(samples, rate_hz)?;
     let points = levels(samples, rate_hz, (start, span_s), window_s, |w| {
@@ -208,7 +261,7 @@ pub fn band_t60(
         let energy = octave_energy(bin, &power, centre_hz);
         (energy > 0.0).then(|| 10.0 * energy.log10())
     });
-    t60_of(&points)
+    t60_of(&points, min_fall_db)
 }
 
 /// A level (dB, by `level`) of successive windows of `window_s` seconds, half overlapping,
@@ -238,13 +291,16 @@ fn levels(
 }
 
 /// T60 (s) of levels (time s, dB) from their least-squares slope; None for fewer than three
-/// points or a level that does not fall.
-fn t60_of(points: &[(f64, f64)]) -> Option<f64> {
+/// points or a line that falls by less than `min_fall_db` over them (with
+/// [`MIN_DECAY_DB`]: noise or a sustained sound, whose T60 of minutes read off a flat line
+/// means nothing; 0 keeps every falling line).
+fn t60_of(points: &[(f64, f64)], min_fall_db: f64) -> Option<f64> {
     if points.len() < 3 {
         return None;
     }
     let slope = crate::base::stats::least_squares_line(points).slope;
-    (slope < 0.0).then(|| -60.0 / slope)
+    let span_s = points[points.len() - 1].0 - points[0].0;
+    (slope < 0.0 && slope * span_s <= -min_fall_db).then(|| -60.0 / slope)
 }
 
 /// The magnitude spectrum of a note over `window_s` from its onset (Hann, zero-padded),
@@ -288,7 +344,8 @@ pub struct ReadError {
     pub message: String,
 }
 
-/// A WAV file's channels averaged to mono (PCM 8–32 bit or float), with its rate.
+/// A WAV file's channels averaged to mono (PCM 8–32 bit or float; see [`downmix`]), with
+/// its rate.
 pub fn read_mono(path: &Path) -> Result<(Vec<f32>, u32), ReadError> {
     let bytes = crate::base::limits::read_at_most(
         path,
@@ -308,32 +365,67 @@ pub fn read_mono_bytes(path: &Path, bytes: &[u8]) -> Result<(Vec<f32>, u32), Rea
         path: path.to_path_buf(),
         message,
     };
-    let mut reader =
-        hound::WavReader::new(std::io::Cursor::new(bytes)).map_err(|e| bad(e.to_string()))?;
+    if bytes.starts_with(b"RF64") || bytes.starts_with(b"BW64") {
+        return Err(bad(
+            "an RF64/BW64 WAV (the format for files over 4 GB) is not read: save the note \
+             as a plain WAV"
+                .into(),
+        ));
+    }
+    let unreadable = |e: hound::Error| {
+        let message = e.to_string();
+        bad(if message.contains("enough bytes") {
+            format!("{message} (the file is empty or cut short)")
+        } else {
+            message
+        })
+    };
+    let mut reader = hound::WavReader::new(std::io::Cursor::new(bytes)).map_err(unreadable)?;
     let spec = reader.spec();
     let ch = usize::from(spec.channels.max(1));
     let raw: Vec<f32> = match spec.sample_format {
         hound::SampleFormat::Float => reader
             .samples::<f32>()
             .collect::<Result<_, _>>()
-            .map_err(|e| bad(e.to_string()))?,
+            .map_err(unreadable)?,
         hound::SampleFormat::Int => {
             let scale = 1.0 / (1u64 << (spec.bits_per_sample.clamp(8, 32) - 1)) as f32;
             reader
                 .samples::<i32>()
                 .map(|s| s.map(|v| v as f32 * scale))
                 .collect::<Result<_, _>>()
-                .map_err(|e| bad(e.to_string()))?
+                .map_err(unreadable)?
         }
     };
     if raw.is_empty() {
         return Err(bad("the file holds no samples".into()));
     }
-    let mono = raw
+    Ok((downmix(&raw, ch), spec.sample_rate))
+}
+
+/// Interleaved frames of `ch` channels to mono: their mean, or the loudest channel when the
+/// mean keeps less than [`MIN_MIX_SHARE`] of the channels' mean energy (a spaced pair
+/// whose microphones hear the head out of phase would cancel its low partials).
+fn downmix(raw: &[f32], ch: usize) -> Vec<f32> {
+    let mean: Vec<f32> = raw
         .chunks_exact(ch)
         .map(|f| f.iter().sum::<f32>() / ch as f32)
         .collect();
-    Ok((mono, spec.sample_rate))
+    if ch < 2 {
+        return mean;
+    }
+    let energy = |xs: &mut dyn Iterator<Item = f32>| xs.map(|x| f64::from(x).powi(2)).sum::<f64>();
+    let per_channel: Vec<f64> = (0..ch)
+        .map(|c| energy(&mut raw.iter().skip(c).step_by(ch).copied()))
+        .collect();
+    let channels_mean = per_channel.iter().sum::<f64>() / ch as f64;
+    if energy(&mut mean.iter().copied()) >= MIN_MIX_SHARE * channels_mean {
+        return mean;
+    }
+    let loudest = (0..ch)
+        .max_by(|&a, &b| per_channel[a].total_cmp(&per_channel[b]))
+        .unwrap_or(0);
+    raw.iter().skip(loudest).step_by(ch).copied().collect()
 }
 
 #[cfg(test)]
@@ -363,12 +455,56 @@ mod tests {
         );
         assert!((p.centroid_hz / f0 - 1.0).abs() < 0.1, "{}", p.centroid_hz);
         let onset = p.onset_s;
-        let est = partial_t60(&s, rate, f0, (onset + 0.05, onset + 0.9), 0.1).unwrap();
+        let est = partial_t60(
+            &s,
+            rate,
+            f0,
+            ((onset + 0.05, onset + 0.9), 0.1),
+            MIN_DECAY_DB,
+        )
+        .unwrap();
         assert!((est / t60 - 1.0).abs() < 0.05, "{est}");
-        let band = band_t60(&s, rate, 250.0, (0.05, 0.9), 0.1).unwrap();
+        let band = band_t60(&s, rate, 250.0, ((0.05, 0.9), 0.1), MIN_DECAY_DB).unwrap();
         assert!((band / t60 - 1.0).abs() < 0.05, "{band}");
         let f = partial_at(&s, rate, 0.2, 0.05, 245.0).unwrap();
         assert!((f / f0 - 1.0).abs() < 2e-3, "{f}");
         assert!(super::onset(&[0.0; 10], rate).is_none());
+        assert_eq!(not_a_note(&s, rate), None);
+    }
+
+    /// Noise, a flat tone, silence and a scrap of a note are refused with the reason; a
+    /// level that does not fall has no T60.
+    #[test]
+    fn refuses_what_is_not_a_struck_note() {
+        let rate = 48_000;
+        let mut rng = crate::base::rng::Rng::new(3);
+        let noise: Vec<f32> = (0..96_000).map(|_| rng.uniform(-0.1, 0.1) as f32).collect();
+        let why = not_a_note(&noise, rate).unwrap();
+        assert!(why.contains("no struck note"), "{why}");
+        let tone: Vec<f32> = (0..96_000)
+            .map(|i| (TAU * 200.0 * i as f64 / 48_000.0).sin() as f32)
+            .collect();
+        assert!(not_a_note(&tone, rate).unwrap().contains("no struck note"));
+        assert_eq!(not_a_note(&[0.0; 96_000], rate).unwrap(), "silent");
+        let scrap: Vec<f32> = tone[..2400].to_vec();
+        assert!(not_a_note(&scrap, rate).unwrap().contains("too short"));
+        let span = ((0.05, 0.9), 0.1);
+        assert_eq!(band_t60(&tone, rate, 250.0, span, MIN_DECAY_DB), None);
+        assert_eq!(partial_t60(&tone, rate, 200.0, span, MIN_DECAY_DB), None);
+    }
+
+    /// Two channels hearing the head out of phase are read from the louder, not cancelled;
+    /// two in phase are averaged.
+    #[test]
+    fn a_stereo_pair_out_of_phase_is_not_cancelled() {
+        let note: Vec<f32> = (0..4800)
+            .map(|i| (TAU * 100.0 * i as f64 / 48_000.0).sin() as f32)
+            .collect();
+        let interleave =
+            |l: f32, r: f32| -> Vec<f32> { note.iter().flat_map(|&x| [l * x, r * x]).collect() };
+        assert_eq!(downmix(&interleave(1.0, -0.9), 2), note);
+        let mean: Vec<f32> = note.iter().map(|&x| (x + 0.5 * x) / 2.0).collect();
+        assert_eq!(downmix(&interleave(1.0, 0.5), 2), mean);
+        assert_eq!(downmix(&note, 1), note);
     }
 }
