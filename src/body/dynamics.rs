@@ -412,17 +412,16 @@ impl Dynamics {
     fn tip_acceleration(&self, side: Side) -> DVec3 {
         let s = &self.scratch;
         let i = Joint::arm(side)[3].index();
-        let r = DVec3::new(0.0, 0.0, -self.model.skeleton.stick_length_m);
+        let r = self.tip_local();
         let (a, v) = (s.acc[i], s.v[i]);
         let local = a.lin + a.ang.cross(r) + v.ang.cross(v.lin + v.ang.cross(r));
         s.rot[i] * local + self.gravity
     }
 
-    /// How the tip of `side` answers a force on it under joint torques `tau` (N·m), in the
-    /// state of the latest kinematics pass: four articulated passes (none, and a newton
-    /// along each axis).
-    fn tip_response(&mut self, tau: &[DVec3; N], side: Side) -> TipResponse {
-        let (tip, _) = self.tips_from_kinematics()[side_index(side)];
+    /// How the tip of `side`, at `tip` (m, performer frame), answers a force on it under
+    /// joint torques `tau` (N·m), in the state of the latest kinematics pass: four
+    /// articulated passes (none, and a newton along each axis).
+    fn tip_response(&mut self, tau: &[DVec3; N], side: Side, tip: DVec3) -> TipResponse {
         let segment = Joint::arm(side)[3].index();
         self.articulated(tau, &[]);
         let free = self.tip_acceleration(side);
@@ -472,7 +471,7 @@ impl Dynamics {
         self.kinematics(state);
         let tips = self.tips_from_kinematics();
         let forces = contact(tips, &mut |h| {
-            self.tip_response(tau, [Side::Left, Side::Right][h])
+            self.tip_response(tau, [Side::Left, Side::Right][h], tips[h].0)
         });
         let external: [ExternalForce; 2] = std::array::from_fn(|h| ExternalForce {
             segment: Joint::arm([Side::Left, Side::Right][h])[3].index(),
@@ -527,9 +526,14 @@ impl Dynamics {
         self.tips_from_kinematics()
     }
 
+    /// The stick tip in its grip segment's frame, m.
+    fn tip_local(&self) -> DVec3 {
+        DVec3::new(0.0, 0.0, -self.model.skeleton.stick_length_m)
+    }
+
     fn tips_from_kinematics(&self) -> [(DVec3, DVec3); 2] {
         let s = &self.scratch;
-        let local = DVec3::new(0.0, 0.0, -self.model.skeleton.stick_length_m);
+        let local = self.tip_local();
         [Side::Left, Side::Right].map(|side| {
             let i = Joint::arm(side)[3].index();
             let v = s.v[i];
@@ -543,7 +547,7 @@ impl Dynamics {
     /// Stick tip of a side: position (m) and velocity (m/s), performer frame.
     pub fn tip(&mut self, state: &State, side: Side) -> (DVec3, DVec3) {
         let grip = Joint::arm(side)[3].index();
-        let local = DVec3::new(0.0, 0.0, -self.model.skeleton.stick_length_m);
+        let local = self.tip_local();
         self.point_velocity(state, grip, local)
     }
 
@@ -613,14 +617,6 @@ impl Dynamics {
             }
         }
         m
-    }
-}
-
-/// A side's index in [left, right] pairs.
-fn side_index(side: Side) -> usize {
-    match side {
-        Side::Left => 0,
-        Side::Right => 1,
     }
 }
 
