@@ -369,17 +369,22 @@ fn space_plays_on_the_silent_clock() {
     h.get_by_label("Keyboard and mouse");
 }
 
-/// The inspector's physics and sound settings: picking the ID pipeline and the sample
-/// model, and typing a drum's diameter, are undoable edits of the score's settings; undo
-/// and redo restore them; they are saved with the score and read back.
+/// The inspector's physics and sound settings: picking a concert hall, the ID pipeline
+/// and the sample model, and typing a drum's diameter, are undoable edits of the score's
+/// settings; undo and redo restore them; they are saved with the score and read back.
 #[test]
 fn inspector_edits_settings_undoably_and_saves_them() {
     use timpanist::body::sim::Pipeline;
-    use timpanist::sound::SoundModel;
+    use timpanist::sound::{Room, SoundModel};
     let dir = tempfile::tempdir().unwrap();
     let mut h = harness(Some(demo()), dir.path());
     h.get_by_label("Physics and sound").click();
     settle(&mut h);
+    h.get_by_label("Room").click();
+    settle(&mut h);
+    h.get_by_label("concert hall (T60 2.2 s)").click();
+    settle(&mut h);
+    assert_eq!(h.state().loaded().unwrap().score.settings.room, Room::Hall);
     h.get_by_label("Control").click();
     settle(&mut h);
     h.get_by_label("ID (PD + inverse dynamics)").click();
@@ -390,7 +395,7 @@ fn inspector_edits_settings_undoably_and_saves_them() {
     settle(&mut h);
     let s = &h.state().loaded().unwrap().score.settings;
     assert_eq!((s.control, s.sound), (Pipeline::Id, SoundModel::Sample));
-    assert_eq!(h.state().undo_steps(), 2);
+    assert_eq!(h.state().undo_steps(), 3);
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
     settle(&mut h);
     let s = &h.state().loaded().unwrap().score.settings;
@@ -409,13 +414,16 @@ fn inspector_edits_settings_undoably_and_saves_them() {
     h.state_mut().wait_for_files();
     let text = std::fs::read_to_string(&path).unwrap();
     assert!(
-        text.contains("settings") && text.contains("Sample"),
+        text.contains("settings") && text.contains("Sample") && text.contains("room: Hall"),
         "{text}"
     );
     let mut again = harness(Some(path), dir.path());
     settle(&mut again);
     let s = &again.state().loaded().unwrap().score.settings;
-    assert_eq!((s.control, s.sound), (Pipeline::Id, SoundModel::Sample));
+    assert_eq!(
+        (s.control, s.sound, s.room),
+        (Pipeline::Id, SoundModel::Sample, Room::Hall)
+    );
 }
 
 /// With nothing selected, a beat added in a hand's lane goes on the first drum that hand

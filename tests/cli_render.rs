@@ -148,6 +148,37 @@ fn cli_render_steps_the_body_at_the_rate_asked() {
     assert!(String::from_utf8_lossy(&refused.stderr).contains("--body-hz"));
 }
 
+/// `--room hall` hears the performance in a concert hall: the same length, the drums
+/// ringing on longer after the last stroke (the reverberation) than dry.
+#[test]
+fn cli_render_hears_the_drums_in_a_hall() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |room: &str| {
+        let wav = dir.path().join(format!("{room}.wav"));
+        let out = Command::new(env!("CARGO_BIN_EXE_timpanist"))
+            .current_dir(root())
+            .args(["render", "scores/improvisation.ron", "--wav"])
+            .arg(&wav)
+            .args(["--room", room])
+            .output()
+            .unwrap();
+        succeeded(&out);
+        let mut reader = hound::WavReader::open(&wav).unwrap();
+        let samples: Vec<f64> = reader
+            .samples::<i16>()
+            .map(|s| f64::from(s.unwrap()))
+            .collect();
+        samples
+    };
+    let (dry, hall) = (run("dry"), run("hall"));
+    assert_eq!(dry.len(), hall.len());
+    let last = dry.len() - 48_000; // the last half second (stereo)
+    let energy = |s: &[f64]| s.iter().map(|v| v * v).sum::<f64>();
+    let more_db = 10.0 * (energy(&hall[last..]) / energy(&dry[last..])).log10();
+    eprintln!("the hall's last half second: {more_db:.1} dB over dry");
+    assert!(more_db > 1.0, "{more_db:.1} dB");
+}
+
 /// A malformed score, or one with a stroke out of reach, fails with its name and the
 /// place or beat, a non-zero exit, and no WAV.
 #[test]

@@ -127,3 +127,54 @@ fn noise_is_refused_as_a_note() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("no struck note"));
     assert!(!cal.exists());
 }
+
+/// `sound stroke --room hall` hears the stroke in a concert hall: the (1,1) stays at the
+/// tuning, and the 63 Hz octave band, which a dry D3 stroke leaves empty (its attack is
+/// where the first second's Hann window is zero), holds what the room carries of the
+/// attack into that second — inside the recordings' spread (−49…−32 dB, ±3 dB); a room
+/// it does not know is refused with the ones it does.
+#[test]
+fn a_stroke_heard_in_a_hall_fills_the_63_hz_band() {
+    let dir = tempfile::tempdir().unwrap();
+    let band_63 = |room: &str| -> (f64, f64) {
+        let wav = dir.path().join(format!("{room}.wav"));
+        let wav_s = wav.to_str().unwrap();
+        let args = [
+            "sound",
+            "stroke",
+            "--pitch",
+            "D3",
+            "--dynamic",
+            "mf",
+            "--seconds",
+            "3",
+        ];
+        let out = timpanist(&[&args[..], &["--room", room, "--wav", wav_s]].concat());
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let out = timpanist(&["sound", "analyse", wav_s]);
+        let text = String::from_utf8_lossy(&out.stdout).to_string();
+        let after = |key: &str| -> f64 {
+            let rest = text.split(key).nth(1).unwrap_or_else(|| panic!("{text}"));
+            let number = rest.split([',', ' ']).find(|s| !s.is_empty()).unwrap();
+            number.parse().unwrap_or_else(|_| panic!("{text}"))
+        };
+        (after("63 Hz "), after("(1,1) "))
+    };
+    let (dry, dry_hz) = band_63("dry");
+    let (hall, hall_hz) = band_63("hall");
+    eprintln!("63 Hz band: dry {dry:.1} dB, in the hall {hall:.1} dB");
+    assert!(dry < -80.0, "dry {dry}");
+    assert!((-52.0..=-29.0).contains(&hall), "hall {hall}");
+    assert!(
+        (hall_hz / dry_hz - 1.0).abs() < 0.002,
+        "{dry_hz} {hall_hz} Hz"
+    );
+    let out = timpanist(&["sound", "stroke", "--room", "cave", "--wav", "x.wav"]);
+    assert!(!out.status.success());
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(said.contains("studio") && said.contains("hall"), "{said}");
+}

@@ -13,7 +13,7 @@ use crate::score::settings::{
     DIAMETER_RANGE_M, DrumChange, GAIN_SCALE_RANGE, MODE_COUNT_RANGE, Settings,
     TENSION_RANGE_N_PER_M,
 };
-use crate::sound::SoundModel;
+use crate::sound::{Room, SoundModel};
 use eframe::egui;
 
 /// A combo box over `options` bound to `value`; whether it changed.
@@ -109,6 +109,16 @@ pub fn show(ui: &mut egui::Ui, doc: &LoadedScore, out: &mut Vec<Command>) {
                 &[
                     (FrequencySource::Measured, "measured kettledrum ratios"),
                     (FrequencySource::Membrane, "ideal membrane (tension)"),
+                ],
+            );
+            started |= choose(
+                ui,
+                "Room",
+                &mut after.room,
+                &[
+                    (Room::Dry, "dry (the heads alone)"),
+                    (Room::Studio, "studio (T60 0.7 s)"),
+                    (Room::Hall, "concert hall (T60 2.2 s)"),
                 ],
             );
         });

@@ -91,6 +91,12 @@ arg_enum!(SoundArg => crate::sound::SoundModel {
     Signal => crate::sound::SoundModel::Signal,
 });
 
+arg_enum!(RoomArg => crate::sound::Room {
+    Dry => crate::sound::Room::Dry,
+    Studio => crate::sound::Room::Studio,
+    Hall => crate::sound::Room::Hall,
+});
+
 /// `render --video-fps`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum VideoFpsArg {

@@ -19,7 +19,8 @@ mod transcribe;
 
 use crate::io::open::OpenAction;
 use args::{
-    DynamicArg, GripArg, LocationArg, ModeArg, SideArg, UpArg, parse_format, parse_tips, parse_vec3,
+    DynamicArg, GripArg, LocationArg, ModeArg, RoomArg, SideArg, UpArg, parse_format, parse_tips,
+    parse_vec3,
 };
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -283,6 +284,9 @@ pub enum SoundCommand {
         /// Length, s.
         #[arg(long, default_value_t = 2.0)]
         seconds: f64,
+        /// The room it is heard in (one microphone of the pair).
+        #[arg(long, value_enum, default_value_t = RoomArg::Dry)]
+        room: RoomArg,
         /// The WAV to write (48 kHz mono).
         #[arg(long)]
         wav: PathBuf,
@@ -671,8 +675,10 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             pitch,
             dynamic,
             seconds,
+            room,
             wav,
-        })) => sound::stroke(&pitch, dynamic.into(), seconds, &wav).map(|()| ExitCode::SUCCESS),
+        })) => sound::stroke((&pitch, dynamic.into()), seconds, room.into(), &wav)
+            .map(|()| ExitCode::SUCCESS),
         Some(Command::Sound(SoundCommand::Fit { files, output })) => {
             sound::fit(&files, &output).map(|()| ExitCode::SUCCESS)
         }

@@ -6,7 +6,8 @@
 //! unit of other labels than asked are told as notes (`super::compose`).
 
 use super::args::{
-    BvhRateArg, BvhUnitsArg, ControlArg, SoundArg, VideoCameraArg, VideoFpsArg, WavFormatArg,
+    BvhRateArg, BvhUnitsArg, ControlArg, RoomArg, SoundArg, VideoCameraArg, VideoFpsArg,
+    WavFormatArg,
 };
 use crate::base::ron_file;
 use crate::body::sim::{Pipeline, SimParams};
@@ -16,7 +17,7 @@ use crate::mocap::shipped::DbSource;
 use crate::motion::plan::{self, PlanParams};
 use crate::render::{Progress, RenderParams, Rendering, render, strikes};
 use crate::score::LoadedScore;
-use crate::sound::SoundModel;
+use crate::sound::{Room, SoundModel};
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -135,6 +136,11 @@ pub struct RenderArgs {
     /// The sound model [default: the score's settings, modal].
     #[arg(long, value_enum)]
     pub sound: Option<SoundArg>,
+    /// The room the drums are heard in: dry (the heads' own sound), a studio or a concert
+    /// hall (its reverberation added to the mix and to every stem) [default: the score's
+    /// settings, dry].
+    #[arg(long, value_enum)]
+    pub room: Option<RoomArg>,
     /// The motion database folder [default: the first of ./mocap,
     /// ~/.local/share/timpanist/mocap, <prefix>/share/timpanist/mocap holding an
     /// index.ron, else the database built into the program].
@@ -163,6 +169,7 @@ impl RenderArgs {
         Choices {
             control: self.control.map(Into::into),
             sound: self.sound.map(Into::into),
+            room: self.room.map(Into::into),
             seed: self.seed,
             stats,
             joint_limits: self.joint_limits,
@@ -177,6 +184,8 @@ pub struct Choices {
     pub control: Option<Pipeline>,
     /// The sound model (default: the score's settings).
     pub sound: Option<SoundModel>,
+    /// The room (default: the score's settings).
+    pub room: Option<Room>,
     /// Seed of the choice among near-equal motion units.
     pub seed: u64,
     /// Print where the time went and the force by dynamic.
@@ -215,6 +224,7 @@ pub fn rendered(
     let Choices {
         control,
         sound,
+        room,
         seed,
         stats,
         joint_limits,
@@ -233,6 +243,7 @@ pub fn rendered(
     let params = RenderParams {
         control: control.unwrap_or(settings.control),
         sound: sound.unwrap_or(settings.sound),
+        room: room.unwrap_or(settings.room),
         plan: PlanParams {
             seed,
             ..PlanParams::default()
@@ -308,7 +319,7 @@ pub fn run(
         .map(|_| figures::performance_figure(&performance));
     let duration_s = rendering.audio.frames() as f64 / f64::from(rendering.audio.rate_hz);
     let recorded = (&rendering.drums, &rendering.touches[..]);
-    let (kit, model) = (&rendering.kit, rendering.params.sound);
+    let (kit, model) = (&rendering.kit, rendering.params.voicing());
     let stems = outputs
         .stems
         .map(|_| crate::sound::stems(kit, recorded, duration_s, model))

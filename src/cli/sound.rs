@@ -6,11 +6,11 @@ use crate::sound::calibration::{Calibration, Residual};
 use crate::sound::fit::{self, Note};
 use std::path::{Path, PathBuf};
 
-/// Render one scripted stroke at `pitch` and `dynamic` to a mono WAV.
+/// Render one scripted stroke at `pitch` and `dynamic` to a mono WAV, heard in `room`.
 pub fn stroke(
-    pitch: &str,
-    dynamic: crate::score::Dynamic,
+    (pitch, dynamic): (&str, crate::score::Dynamic),
     seconds: f64,
+    room: crate::sound::Room,
     wav: &Path,
 ) -> anyhow::Result<()> {
     let pitch: crate::base::pitch::Pitch = pitch.parse()?;
@@ -18,7 +18,8 @@ pub fn stroke(
         anyhow::bail!("--seconds {seconds} is outside 0.1-60 s");
     }
     let kit = fit::kit_for(pitch.hz());
-    let (mono, contact) = fit::struck(&kit, dynamic, Calibration::shipped(), seconds)?;
+    let (mut mono, contact) = fit::struck(&kit, dynamic, Calibration::shipped(), seconds)?;
+    crate::sound::room::reverberate_mono(room, &mut mono);
     let audio = crate::sound::Audio {
         rate_hz: crate::sound::SAMPLE_RATE_HZ,
         channels: 1,
@@ -27,10 +28,15 @@ pub fn stroke(
     };
     crate::sound::write_wav(wav, &audio)?;
     println!(
-        "{} on the {} tuned to {pitch}: {:?}",
+        "{} on the {} tuned to {pitch}: {:?}{}",
         wav.display(),
         kit.drums[0].name,
-        dynamic
+        dynamic,
+        if room.is_dry() {
+            String::new()
+        } else {
+            format!(", in the {room}")
+        }
     );
     if let Some(c) = contact {
         println!(

@@ -34,7 +34,7 @@ use crate::motion::compose::{ComposeParams, Composition};
 use crate::motion::perform;
 use crate::motion::plan::{PlanError, PlanParams, PlannedStroke};
 use crate::score::{LoadedScore, Settings};
-use crate::sound::{Audio, SoundError, SoundModel, SoundState, Touch};
+use crate::sound::{Audio, Room, SoundError, SoundModel, SoundState, Touch, Voicing};
 use compensate::{Aims, Performance, Stage};
 use damping::DampReport;
 use glam::DVec3;
@@ -47,6 +47,8 @@ use strikes::{StrikeEvent, Timing};
 pub struct RenderParams {
     pub control: Pipeline,
     pub sound: SoundModel,
+    /// The room the drums are heard in.
+    pub room: Room,
     pub modes: ModeConfig,
     pub sim: SimParams,
     /// Hold the body within its performer's ranges of motion, the composition's joint
@@ -106,6 +108,14 @@ pub struct RenderParams {
 }
 
 impl RenderParams {
+    /// What the sound is heard as: the model and the room.
+    pub fn voicing(&self) -> Voicing {
+        Voicing {
+            model: self.sound,
+            room: self.room,
+        }
+    }
+
     /// The peak contact force aimed at for a stroke of `dynamic`, N.
     pub fn force_aim_n(&self, dynamic: crate::score::Dynamic) -> f64 {
         self.force_at_silence_n + self.force_range_n * dynamic.velocity()
@@ -125,6 +135,7 @@ impl RenderParams {
             },
             gain_scale: settings.gain_scale,
             sound: settings.sound,
+            room: settings.room,
             modes: ModeConfig {
                 count: settings.modes,
                 source: settings.frequencies,
@@ -139,6 +150,7 @@ impl Default for RenderParams {
         RenderParams {
             control: Pipeline::Himc,
             sound: SoundModel::Modal,
+            room: Room::Dry,
             modes: ModeConfig::default(),
             sim: SimParams::default(),
             joint_limits: false,
@@ -624,6 +636,7 @@ impl Run<'_> {
         (skeleton, sound): (&Skeleton, SoundState),
     ) -> (Result<bool, RenderError>, SoundState) {
         let (kit, comp, model) = (self.kit, self.composition, self.params.sound);
+        let voicing = self.params.voicing();
         std::thread::scope(|scope| {
             let (jobs, queue) = std::sync::mpsc::channel::<(DrumSet, Vec<Touch>, f64)>();
             let source = self.params.modes.source;
@@ -640,7 +653,7 @@ impl Run<'_> {
                         kit,
                         (&drums, &touches),
                         end_s,
-                        model,
+                        voicing,
                         Some(sound),
                         crate::sound::Cores::One,
                     )
@@ -742,7 +755,7 @@ impl Run<'_> {
             drums,
             touches,
             end_s.max(0.0),
-            self.params.sound,
+            self.params.voicing(),
             Some(previous),
         )?;
         state.sound = sound;

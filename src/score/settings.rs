@@ -1,10 +1,10 @@
 //! How a score is performed and heard, saved with it: the control pipeline,
-//! the IK method, the PD gains, the sound model, the membrane modes, and per-drum changes
+//! the IK method, the PD gains, the sound model and room, the membrane modes, and per-drum changes
 //! of the kit (head diameter, tension). Absent from a file means the defaults; a score
 //! with default settings is written without them.
 
 use crate::base::choices::{
-    DEFAULT_MODE_COUNT, FrequencySource, IkMethod, MAX_MODE_COUNT, Pipeline, SoundModel,
+    DEFAULT_MODE_COUNT, FrequencySource, IkMethod, MAX_MODE_COUNT, Pipeline, Room, SoundModel,
 };
 use crate::base::problem::Problem;
 use crate::kit::Kit;
@@ -43,6 +43,9 @@ pub struct Settings {
     /// Every PD gain multiplied by this (1 = nominal).
     pub gain_scale: f64,
     pub sound: SoundModel,
+    /// The room the drums are heard in (dry by default).
+    #[serde(skip_serializing_if = "Room::is_dry")]
+    pub room: Room,
     /// Membrane modes per head (both orientations of a pair count).
     pub modes: usize,
     pub frequencies: FrequencySource,
@@ -58,6 +61,7 @@ impl Default for Settings {
             ik: IkMethod::DampedLeastSquares,
             gain_scale: 1.0,
             sound: SoundModel::Modal,
+            room: Room::Dry,
             modes: DEFAULT_MODE_COUNT,
             frequencies: FrequencySource::Measured,
             drums: Vec::new(),

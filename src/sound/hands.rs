@@ -8,7 +8,7 @@
 //! driven by each hand's share.
 
 use super::modal::{self, DrumSynth, SoundHeads};
-use super::{Audio, SoundError, SoundModel, Touch, calibration, sympathy};
+use super::{Audio, SoundError, SoundModel, Touch, Voicing, calibration, room, sympathy};
 use crate::drum::DrumSet;
 use crate::kit::{Kit, Side};
 
@@ -18,9 +18,11 @@ pub fn hand_stems(
     kit: &Kit,
     (drums, touches): (&DrumSet, &[Touch]),
     duration_s: f64,
-    model: SoundModel,
+    voicing: impl Into<Voicing>,
 ) -> Result<[Audio; 2], SoundError> {
-    let (mix, _) = super::render_touched(kit, drums, touches, duration_s, model, None)?;
+    let voicing = voicing.into();
+    let model = voicing.model;
+    let (mix, _) = super::render_touched(kit, drums, touches, duration_s, voicing, None)?;
     let frames = mix.frames();
     let calibration = calibration::Calibration::shipped();
     // Per hand, per drum: the drum's synthesis of that hand's contacts.
@@ -81,6 +83,7 @@ pub fn hand_stems(
                 *s += x;
             }
         }
+        room::reverberate(voicing.room, &mut samples);
         Audio {
             samples,
             ..mix.clone()

@@ -11,6 +11,7 @@ pub mod hands;
 pub mod modal;
 pub mod partials;
 pub mod radiation;
+pub mod room;
 pub mod sample;
 pub mod signal;
 pub mod spectrum;
@@ -21,7 +22,7 @@ pub mod wav;
 pub use spectrum::spectrum;
 pub use wav::{WavFormat, write_wav, write_wav_as};
 
-pub use crate::base::choices::SoundModel;
+pub use crate::base::choices::{Room, SoundModel};
 use crate::drum::DrumSet;
 use crate::kit::Kit;
 use std::f64::consts::FRAC_PI_4;
@@ -137,6 +138,23 @@ pub fn pan_gains(x_m: f64) -> (f64, f64) {
     (angle.cos(), angle.sin())
 }
 
+/// What is heard: the sound model, and the room it is heard in. A bare [`SoundModel`] is
+/// heard dry.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Voicing {
+    pub model: SoundModel,
+    pub room: Room,
+}
+
+impl From<SoundModel> for Voicing {
+    fn from(model: SoundModel) -> Voicing {
+        Voicing {
+            model,
+            room: Room::Dry,
+        }
+    }
+}
+
 /// Frames per block over which a rendering keeps the mix's peak (0.1 s).
 const PEAK_BLOCK: usize = 4800;
 
@@ -152,6 +170,9 @@ pub struct SoundState {
     sympathy: Vec<sympathy::SympathyState>,
     /// Interleaved stereo mix before the normalisation gain.
     mix: Vec<f32>,
+    /// The mix heard in its room (nothing when dry).
+    room: room::RoomState,
+    /// Per block of what is heard (the mix, or the mix in its room).
     peaks: Vec<f32>,
 }
 
@@ -229,9 +250,17 @@ pub fn stems(
     kit: &Kit,
     (drums, touches): (&DrumSet, &[Touch]),
     duration_s: f64,
-    model: SoundModel,
+    voicing: impl Into<Voicing>,
 ) -> Result<Vec<Audio>, SoundError> {
-    let (mix, state) = render_touched(kit, drums, touches, duration_s, model, None)?;
+    let Voicing { model, room } = voicing.into();
+    let (mix, state) = render_touched(
+        kit,
+        drums,
+        touches,
+        duration_s,
+        Voicing { model, room },
+        None,
+    )?;
     Ok(state
         .drums
         .iter()
@@ -239,7 +268,9 @@ pub fn stems(
         .enumerate()
         .map(|(j, ((mono, _, _), drum))| {
             let sympathy = state.sympathy.get(j).map(|s| s.out.as_slice());
-            stem(drum, model, (mono, sympathy), mix.gain)
+            let mut stem = stem(drum, model, (mono, sympathy), mix.gain);
+            room::reverberate(room, &mut stem.samples);
+            stem
         })
         .collect())
 }
@@ -271,9 +302,9 @@ pub fn render(
     kit: &Kit,
     drums: &DrumSet,
     duration_s: f64,
-    model: SoundModel,
+    voicing: impl Into<Voicing>,
 ) -> Result<Audio, SoundError> {
-    render_resuming(kit, drums, duration_s, model, None).map(|(audio, _)| audio)
+    render_resuming(kit, drums, duration_s, voicing, None).map(|(audio, _)| audio)
 }
 
 /// [`render`], re-synthesising only what changed when `previous` (a rendering's state of
@@ -284,10 +315,10 @@ pub fn render_resuming(
     kit: &Kit,
     drums: &DrumSet,
     duration_s: f64,
-    model: SoundModel,
+    voicing: impl Into<Voicing>,
     previous: Option<SoundState>,
 ) -> Result<(Audio, SoundState), SoundError> {
-    render_touched(kit, drums, &[], duration_s, model, previous)
+    render_touched(kit, drums, &[], duration_s, voicing, previous)
 }
 
 /// Build (or find) the modal model's sounding head of every drum of `kit`, and of each
@@ -318,14 +349,14 @@ pub fn render_touched(
     drums: &DrumSet,
     touches: &[Touch],
     duration_s: f64,
-    model: SoundModel,
+    voicing: impl Into<Voicing>,
     previous: Option<SoundState>,
 ) -> Result<(Audio, SoundState), SoundError> {
     render_touched_on(
         kit,
         (drums, touches),
         duration_s,
-        model,
+        voicing,
         previous,
         Cores::All,
     )
@@ -343,7 +374,7 @@ pub fn render_calibrated(
         kit,
         (drums, touches),
         duration_s,
-        (model, calibration),
+        (model.into(), calibration),
         previous,
         Cores::All,
     )
@@ -372,7 +403,7 @@ pub fn render_touched_on(
     kit: &Kit,
     (drums, touches): (&DrumSet, &[Touch]),
     duration_s: f64,
-    model: SoundModel,
+    voicing: impl Into<Voicing>,
     previous: Option<SoundState>,
     cores: Cores,
 ) -> Result<(Audio, SoundState), SoundError> {
@@ -380,7 +411,7 @@ pub fn render_touched_on(
         kit,
         (drums, touches),
         duration_s,
-        (model, calibration::Calibration::shipped()),
+        (voicing.into(), calibration::Calibration::shipped()),
         previous,
         cores,
     )
@@ -391,11 +422,11 @@ fn render_on(
     kit: &Kit,
     sounding: (&DrumSet, &[Touch]),
     duration_s: f64,
-    model: (SoundModel, &calibration::Calibration),
+    voicing: (Voicing, &calibration::Calibration),
     previous: Option<SoundState>,
     cores: Cores,
 ) -> Result<(Audio, SoundState), SoundError> {
-    let state = synthesise_on(kit, sounding, duration_s, model, previous, cores)?;
+    let state = synthesise_on(kit, sounding, duration_s, voicing, previous, cores)?;
     Ok((state.audio(), state))
 }
 
@@ -406,7 +437,7 @@ pub fn resynthesise_on(
     kit: &Kit,
     sounding: (&DrumSet, &[Touch]),
     duration_s: f64,
-    model: SoundModel,
+    voicing: impl Into<Voicing>,
     previous: Option<SoundState>,
     cores: Cores,
 ) -> Result<SoundState, SoundError> {
@@ -415,7 +446,7 @@ pub fn resynthesise_on(
         kit,
         sounding,
         duration_s,
-        (model, calibration),
+        (voicing.into(), calibration),
         previous,
         cores,
     )
@@ -428,10 +459,11 @@ fn synthesise_on(
     kit: &Kit,
     (drums, touches): (&DrumSet, &[Touch]),
     duration_s: f64,
-    (model, calibration): (SoundModel, &calibration::Calibration),
+    (voicing, calibration): (Voicing, &calibration::Calibration),
     previous: Option<SoundState>,
     cores: Cores,
 ) -> Result<SoundState, SoundError> {
+    let model = voicing.model;
     if !(duration_s.is_finite() && (0.0..=86_400.0).contains(&duration_s)) {
         return Err(SoundError::Duration(duration_s));
     }
@@ -459,6 +491,7 @@ fn synthesise_on(
     };
     // The first frame any drum re-synthesises from.
     let mut start = state.mix.len() / 2;
+    let had_room = state.room.room();
     // Each drum on its own thread: they share nothing but what they read. The modal
     // model's threads also build (or find) their drum's sounding head, which the
     // sympathetic pass then reuses.
@@ -536,10 +569,24 @@ fn synthesise_on(
             frame[1] += r * s;
         }
     }
-    // Peaks of the blocks from the one `start` is in: the earlier ones are as they were.
-    let first_block = start / PEAK_BLOCK;
+    // What is heard: the mix, or the mix in its room (rewritten from where the room's
+    // network resumed, all of it when the room changed).
+    let (heard, first_block) = if voicing.room.is_dry() {
+        state.room = room::RoomState::default();
+        (&state.mix, start / PEAK_BLOCK)
+    } else {
+        let from = state.room.update(voicing.room, mix, start);
+        (&state.room.wet, from.min(start) / PEAK_BLOCK)
+    };
+    // Peaks of the blocks from the first one rewritten: the earlier ones are as they were.
+    // (A rendering that was dry before has no peaks of its room: all of them are made.)
+    let first_block = if had_room == voicing.room {
+        first_block
+    } else {
+        0
+    };
     state.peaks.truncate(first_block);
-    for (b, block) in mix.chunks(2 * PEAK_BLOCK).enumerate().skip(first_block) {
+    for (b, block) in heard.chunks(2 * PEAK_BLOCK).enumerate().skip(first_block) {
         let mut peak = 0.0f32;
         for (i, s) in block.iter().enumerate() {
             if !s.is_finite() {
@@ -564,13 +611,18 @@ impl SoundState {
         } else {
             1.0
         };
+        let heard = if self.room.wet.is_empty() {
+            &self.mix
+        } else {
+            &self.room.wet
+        };
         let samples = if gain < 1.0 {
-            self.mix
+            heard
                 .iter()
                 .map(|s| (f64::from(*s) * gain) as f32)
                 .collect()
         } else {
-            self.mix.clone()
+            heard.clone()
         };
         Audio {
             rate_hz: SAMPLE_RATE_HZ,
