@@ -311,6 +311,56 @@ fn bad_input_is_refused_by_name() {
     assert!(nan.to_string().contains("nan.wav") && nan.to_string().contains("sample 1"));
 }
 
+/// Sounds that are no playing: pink noise (5 and 30 s), white noise and a held tone, each
+/// starting at once — their only "stroke" is where they begin — are refused by name with
+/// how little their start stands out; a single struck note from silence is not.
+#[test]
+fn noise_and_held_tones_are_not_strokes() {
+    let kit = Kit::standard();
+    let fs = 48_000u32;
+    let mut rng = timpanist::base::rng::Rng::new(5);
+    // Pink noise by the Voss–McCartney sum of 16 held white rows.
+    let pink = |seconds: usize, rng: &mut timpanist::base::rng::Rng| -> Vec<f32> {
+        let mut rows = [0.0f64; 16];
+        (0..seconds * fs as usize)
+            .map(|n| {
+                let row = (n + 1).trailing_zeros().min(15) as usize;
+                rows[row] = rng.uniform(-1.0, 1.0);
+                (0.03 * rows.iter().sum::<f64>()) as f32
+            })
+            .collect()
+    };
+    let white: Vec<f32> = (0..5 * fs)
+        .map(|_| 0.3 * rng.uniform(-1.0, 1.0) as f32)
+        .collect();
+    let tone: Vec<f32> = (0..5 * fs)
+        .map(|n| {
+            (0.3 * (std::f64::consts::TAU * 147.0 * f64::from(n) / f64::from(fs)).sin()) as f32
+        })
+        .collect();
+    let cases = [
+        ("pink5.wav", pink(5, &mut rng)),
+        ("pink30.wav", pink(30, &mut rng)),
+        ("white.wav", white),
+        ("tone.wav", tone),
+    ];
+    for (name, samples) in cases {
+        let e = transcribe(&samples, fs, &kit, name, &Options::default()).unwrap_err();
+        assert!(matches!(e, TranscribeError::NoStrike { .. }), "{name}: {e}");
+        assert!(
+            e.to_string().contains(name) && e.to_string().contains("dB"),
+            "{e}"
+        );
+    }
+    let mut note = vec![0.0f32; fs as usize / 2];
+    note.extend((0..3 * fs).map(|n| {
+        let t = f64::from(n) / f64::from(fs);
+        (0.5 * (-t * 2.3).exp() * (std::f64::consts::TAU * 147.0 * t).sin()) as f32
+    }));
+    let (score, _) = transcribe(&note, fs, &kit, "note.wav", &Options::default()).unwrap();
+    assert_eq!(score.beats.len(), 1);
+}
+
 /// `timpanist transcribe`: a recording becomes a score file that loads; a bad file exits
 /// non-zero naming it and writes nothing.
 #[test]

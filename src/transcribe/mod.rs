@@ -79,6 +79,12 @@ pub enum TranscribeError {
     Read(#[from] ReadError),
     #[error("{file}: no strokes were heard (silence, or no clear attacks)")]
     Silent { file: String },
+    #[error(
+        "{file}: no strokes: what starts in it stands only {contrast_db:.1} dB above its median \
+         level (a stroke's attack stands {MIN_CONTRAST_DB} dB and more above: is it noise or \
+         a sustained sound?)"
+    )]
+    NoStrike { file: String, contrast_db: f64 },
     #[error("{file}: sample {frame} is not a finite number")]
     NonFinite { file: String, frame: usize },
     #[error("{file}: {seconds:.0} s of audio is longer than a score may last ({max:.0} s)")]
@@ -90,6 +96,13 @@ pub enum TranscribeError {
     #[error("the kit has no drums to put the strokes on")]
     NoDrums,
 }
+
+/// A recording from which fewer strokes than this are heard must stand, within
+/// [`ATTACK_S`] after one of them, this far above its median level (dB,
+/// `analysis::attack_contrast_db`), else it is refused as holding no playing.
+const MIN_STROKES_UNLESS_STRUCK: usize = 3;
+const MIN_CONTRAST_DB: f64 = analysis::MIN_STRIKE_CONTRAST_DB;
+const ATTACK_S: f64 = 0.05;
 
 /// Transcribe the WAV file `path` onto `kit`.
 pub fn transcribe_file(
@@ -142,6 +155,18 @@ pub fn transcribe(
     let times = dedup_sorted(found);
     if times.is_empty() {
         return Err(TranscribeError::Silent { file: source });
+    }
+    // A sound that only starts (noise, a held tone: one "stroke" where it begins) and does
+    // not stand out of its own level there is no playing; a roll keeps its level up but
+    // has many strokes.
+    if times.len() < MIN_STROKES_UNLESS_STRUCK
+        && let Some(contrast_db) = analysis::attack_contrast_db(samples, rate_hz, &times, ATTACK_S)
+        && contrast_db < MIN_CONTRAST_DB
+    {
+        return Err(TranscribeError::NoStrike {
+            file: source,
+            contrast_db,
+        });
     }
     let band = pitch_band(kit);
     let mut strokes: Vec<notate::Stroke> = times

@@ -28,6 +28,10 @@ pub const MIN_GAP_S: f64 = 0.03;
 const DELTA_OF_TOP: f64 = 0.06;
 /// …and at least this many times the median frame (the noise floor).
 const DELTA_OF_MEDIAN: f64 = 1.5;
+/// …and never under this: a stroke's strength is 10–200 (the quietest of a rendered roll's
+/// strokes 10.9; a note's the same at 0 and −60 dBFS), the frame-to-frame wiggle of a held
+/// tone's spectral leakage ≈ 0.02, which a file holding nothing else would otherwise pick.
+const MIN_STRENGTH: f64 = 1.0;
 /// A recording's first frames count as onsets only if they reach this share of its peak.
 const START_SHARE: f32 = 0.05;
 /// An onset must reach this share of the strongest onset strength of the last
@@ -196,7 +200,9 @@ fn threshold(v: &[f64]) -> f64 {
     let mut sorted = v.to_vec();
     sorted.sort_by(f64::total_cmp);
     let at = |q: f64| sorted[((sorted.len() - 1) as f64 * q) as usize];
-    (DELTA_OF_TOP * at(0.995)).max(DELTA_OF_MEDIAN * at(0.5))
+    (DELTA_OF_TOP * at(0.995))
+        .max(DELTA_OF_MEDIAN * at(0.5))
+        .max(MIN_STRENGTH)
 }
 
 /// Where within frame `frame`'s window the stroke begins, s: the first block of the
