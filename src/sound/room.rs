@@ -172,35 +172,28 @@ fn hadamard(x: &mut [f32; LINES]) {
 /// of it is written back, which holds while no line is shorter than a block.
 const BLOCK: usize = 256;
 
-/// One delay line: its samples (a ring), where it is read and written, its loss filter
-/// y = b0·x + a1·y⁻¹ and that filter's last output.
+/// One delay line: its samples (a ring) and where it is read and written.
 #[derive(Clone, Debug, PartialEq)]
 struct Line {
     ring: Vec<f32>,
     position: usize,
-    b0: f32,
-    a1: f32,
-    filtered: f32,
 }
 
 impl Line {
-    /// The next `out.len()` samples out of the line, through its loss filter, into
-    /// `out[k][i]`.
-    fn read(&mut self, out: &mut [[f32; LINES]], i: usize) {
+    /// The next `out.len()` samples out of the line into `out[k][i]`; the position stays
+    /// where they were read, for [`Line::write`].
+    fn read(&self, out: &mut [[f32; LINES]], i: usize) {
+        let mut at = self.position;
         for frame in out.iter_mut() {
-            let y = self.b0 * self.ring[self.position] + self.a1 * self.filtered;
-            self.filtered = y;
-            frame[i] = y;
-            self.position += 1;
-            if self.position == self.ring.len() {
-                self.position = 0;
+            frame[i] = self.ring[at];
+            at += 1;
+            if at == self.ring.len() {
+                at = 0;
             }
         }
-        let back = out.len() % self.ring.len();
-        self.position = (self.position + self.ring.len() - back) % self.ring.len();
     }
 
-    /// Write `into[k][i]` into the line where the block was read.
+    /// Write `into[k][i]` into the line where the block was read, and move on.
     fn write(&mut self, into: &[[f32; LINES]], i: usize) {
         for frame in into {
             self.ring[self.position] = frame[i];
@@ -212,10 +205,28 @@ impl Line {
     }
 }
 
+/// Σ row·values over the lines, in eight partial sums (a sum taken in order would
+/// chain every addition on the last one).
+#[inline]
+fn dot(row: &[f32; LINES], values: &[f32; LINES]) -> f32 {
+    let mut lanes = [0.0f32; 8];
+    for (r, v) in row.chunks_exact(8).zip(values.chunks_exact(8)) {
+        for j in 0..8 {
+            lanes[j] += r[j] * v[j];
+        }
+    }
+    ((lanes[0] + lanes[4]) + (lanes[1] + lanes[5]))
+        + ((lanes[2] + lanes[6]) + (lanes[3] + lanes[7]))
+}
+
 /// The feedback delay network's coefficients and state.
 #[derive(Clone, Debug, PartialEq)]
 struct Network {
     lines: Vec<Line>,
+    /// Per line: the loss filter y = b0·x + a1·y⁻¹, and its last output.
+    b0: [f32; LINES],
+    a1: [f32; LINES],
+    filtered: [f32; LINES],
     /// How the left and right inputs enter the lines, and how the lines make the left and
     /// right outputs (rows of the Hadamard matrix, scaled).
     input: [[f32; LINES]; 2],
@@ -225,25 +236,26 @@ struct Network {
 impl Network {
     /// A silent network for `acoustics`, its output scaled by `wet`.
     fn new(acoustics: &Acoustics, wet: f64) -> Network {
-        let lines = acoustics
-            .lengths()
-            .iter()
-            .map(|&length| {
-                debug_assert!(length >= BLOCK);
-                let (b0, a1) = acoustics.loss(length);
-                Line {
-                    ring: vec![0.0; length],
-                    position: 0,
-                    b0: b0 as f32,
-                    a1: a1 as f32,
-                    filtered: 0.0,
-                }
-            })
-            .collect();
+        let lengths = acoustics.lengths();
+        let (mut b0, mut a1) = ([0.0; LINES], [0.0; LINES]);
+        for (i, &length) in lengths.iter().enumerate() {
+            debug_assert!(length >= BLOCK);
+            let (b, a) = acoustics.loss(length);
+            (b0[i], a1[i]) = (b as f32, a as f32);
+        }
         let norm = 1.0 / (LINES as f64).sqrt();
         let scaled = |row: usize, by: f64| hadamard_row(row).map(|v| v * (by * norm) as f32);
         Network {
-            lines,
+            lines: lengths
+                .iter()
+                .map(|&length| Line {
+                    ring: vec![0.0; length],
+                    position: 0,
+                })
+                .collect(),
+            b0,
+            a1,
+            filtered: [0.0; LINES],
             input: [scaled(3, 1.0), scaled(5, 1.0)],
             output: [scaled(1, wet), scaled(2, wet)],
         }
@@ -255,15 +267,18 @@ impl Network {
         let mut frames = [[0.0f32; LINES]; BLOCK];
         for block in stereo.chunks_mut(2 * BLOCK) {
             let frames = &mut frames[..block.len() / 2];
-            for (i, line) in self.lines.iter_mut().enumerate() {
+            for (i, line) in self.lines.iter().enumerate() {
                 line.read(frames, i);
             }
             for (frame, io) in frames.iter_mut().zip(block.chunks_exact_mut(2)) {
                 let (left, right) = (io[0], io[1]);
-                let tap =
-                    |row: &[f32; LINES]| row.iter().zip(&*frame).map(|(c, y)| c * y).sum::<f32>();
-                io[0] += tap(&self.output[0]);
-                io[1] += tap(&self.output[1]);
+                let (b0, a1) = (&self.b0, &self.a1);
+                for (((f, x), b), a) in self.filtered.iter_mut().zip(&*frame).zip(b0).zip(a1) {
+                    *f = b * x + a * *f;
+                }
+                *frame = self.filtered;
+                io[0] += dot(&self.output[0], frame);
+                io[1] += dot(&self.output[1], frame);
                 hadamard(frame);
                 for ((y, l), r) in frame.iter_mut().zip(&self.input[0]).zip(&self.input[1]) {
                     *y += l * left + r * right;
