@@ -149,9 +149,9 @@ fn check(
 /// found, F 0.896 on the roll exercise, and 265 of 289 on the right drum: of the roll
 /// exercise's soft strokes 37 of 56). Heard in a concert hall (`sound::room`, one
 /// microphone: recordings are made in rooms): 94 % found, F ≥ 0.85, the right drum for
-/// 78 % (measured: 307 of 319 found, F 0.877 on the roll exercise, 246 of 307 on the right
+/// 78 % (measured: 309 of 319 found, F 0.908 on the roll exercise, 248 of 309 on the right
 /// drum — the hall carries the strokes before into each stroke's pitch; the roll
-/// exercise's roll 27 of 57, the minute study's 87 of 109).
+/// exercise's roll 28 of 59, the minute study's 87 of 109).
 #[test]
 fn rendered_demo_scores_transcribe_back() {
     let demos = rendered_demos();

@@ -498,6 +498,18 @@ fn print_stats(r: &Rendering) {
         s.sound.as_secs_f64(),
         s.wall().as_secs_f64()
     );
+    if let Some(room) = crate::sound::room::Acoustics::of(r.params.room) {
+        println!(
+            "room: {} ({:.0} m³, T60 {:.2} s at 125 Hz and {:.2} s at 4 kHz, microphones at \
+             {:.1} m: the reverberation {:.1} dB below the direct sound)",
+            r.params.room,
+            room.volume_m3,
+            room.t60_at(125.0),
+            room.t60_at(4000.0),
+            room.microphone_m,
+            10.0 * room.direct_to_reverberant().log10()
+        );
+    }
     let t = &r.timing;
     println!(
         "timing: median {:.2} ms, worst {:.2} ms, missed {} of {}; normalisation gain {:.3}",

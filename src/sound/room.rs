@@ -76,7 +76,7 @@ impl Acoustics {
             Room::Hall => Some(Acoustics {
                 volume_m3: 12_000.0,
                 t60_low_s: 2.2,
-                t60_high_s: 0.3,
+                t60_high_s: 0.5,
                 microphone_m: 3.0,
                 delays_s: (0.040, 0.130),
             }),
