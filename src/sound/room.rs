@@ -26,7 +26,7 @@
 //! Why a room: the recordings the sound is compared with were made in one. Their octave
 //! bands are measured over a Hann window on the first second, which hides a dry stroke's
 //! attack; a room carries the attack's low thump and brightness into that second (README,
-//! "Sound calibration").
+//! "The room").
 
 use super::SAMPLE_RATE_HZ;
 pub use crate::base::choices::Room;
