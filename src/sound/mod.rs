@@ -1,7 +1,8 @@
 //! Sound from the simulated strikes, 48 kHz stereo, the same code offline and
 //! live: three models — **modal** (a voice bank driven by the recorded contact force,
 //! seed 000 §4), **sample** replay and **signal**-based partials (seed 002) — each with a
-//! fixed calibration, mixed with a constant-power pan from each drum's placement x, then
+//! fixed calibration, mixed with a constant-power pan from each drum's placement x, heard
+//! in a room if one is asked ([`room`]: a studio's or a hall's reverberation added), then
 //! checked for NaN and held below −1 dBFS by scaling the whole render down if needed.
 
 pub mod analysis;
@@ -252,15 +253,8 @@ pub fn stems(
     duration_s: f64,
     voicing: impl Into<Voicing>,
 ) -> Result<Vec<Audio>, SoundError> {
-    let Voicing { model, room } = voicing.into();
-    let (mix, state) = render_touched(
-        kit,
-        drums,
-        touches,
-        duration_s,
-        Voicing { model, room },
-        None,
-    )?;
+    let voicing = voicing.into();
+    let (mix, state) = render_touched(kit, drums, touches, duration_s, voicing, None)?;
     Ok(state
         .drums
         .iter()
@@ -268,8 +262,8 @@ pub fn stems(
         .enumerate()
         .map(|(j, ((mono, _, _), drum))| {
             let sympathy = state.sympathy.get(j).map(|s| s.out.as_slice());
-            let mut stem = stem(drum, model, (mono, sympathy), mix.gain);
-            room::reverberate(room, &mut stem.samples);
+            let mut stem = stem(drum, voicing.model, (mono, sympathy), mix.gain);
+            room::reverberate(voicing.room, &mut stem.samples);
             stem
         })
         .collect())
