@@ -107,10 +107,7 @@ fn median_of(levels: &[f64]) -> f64 {
 /// tone, noise and sustained tones 2–5 dB (seconds of pink noise up to ~10 dB).
 pub fn strike_contrast_db(samples: &[f32], rate_hz: u32) -> Option<f64> {
     let (_, levels) = window_levels(samples, rate_hz);
-    let loudest = levels
-        .iter()
-        .copied()
-        .fold(None, |m: Option<f64>, l| Some(m.map_or(l, |m| m.max(l))))?;
+    let loudest = levels.iter().copied().reduce(f64::max)?;
     Some(10.0 * (loudest / median_of(&levels).max(1e-30)).log10())
 }
 

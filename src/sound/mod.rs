@@ -485,7 +485,6 @@ fn synthesise_on(
     };
     // The first frame any drum re-synthesises from.
     let mut start = state.mix.len() / 2;
-    let had_room = state.room.room();
     // Each drum on its own thread: they share nothing but what they read. The modal
     // model's threads also build (or find) their drum's sounding head, which the
     // sympathetic pass then reuses.
@@ -563,21 +562,17 @@ fn synthesise_on(
             frame[1] += r * s;
         }
     }
-    // What is heard: the mix, or the mix in its room (rewritten from where the room's
-    // network resumed, all of it when the room changed).
+    // What is heard: the mix, or the mix in its room (rewritten from the state the room's
+    // network resumed at, never after `start`; all of it when the room changed). Peaks are
+    // made again from the first block rewritten — all of them when a room is left, as
+    // they were of the room's sound.
     let (heard, first_block) = if voicing.room.is_dry() {
+        let from = if state.room.room().is_dry() { start } else { 0 };
         state.room = room::RoomState::default();
-        (&state.mix, start / PEAK_BLOCK)
+        (&state.mix, from / PEAK_BLOCK)
     } else {
         let from = state.room.update(voicing.room, mix, start);
-        (&state.room.wet, from.min(start) / PEAK_BLOCK)
-    };
-    // Peaks of the blocks from the first one rewritten: the earlier ones are as they were.
-    // (A rendering that was dry before has no peaks of its room: all of them are made.)
-    let first_block = if had_room == voicing.room {
-        first_block
-    } else {
-        0
+        (&state.room.wet, from / PEAK_BLOCK)
     };
     state.peaks.truncate(first_block);
     for (b, block) in heard.chunks(2 * PEAK_BLOCK).enumerate().skip(first_block) {
