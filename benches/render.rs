@@ -2,9 +2,10 @@
 //! study (60 s of music, 109 strokes), HIMC with the modal drums at 10 kHz and timing
 //! compensation, synthesised to 48 kHz stereo:
 //!
-//! * a full `timpanist render` (≈ 2.4 s per iteration, so this takes a few minutes), and
-//!   the same with the body stepped at 5 kHz, the drums and contact still at 10 kHz
-//!   (`SimParams::contact_substeps` 2, `render --body-hz 5000`);
+//! * a full `timpanist render` at the default, fast body step (5 kHz between contacts,
+//!   the drums and contact at 10 kHz; ≈ 1.4 s per iteration, so this takes a few
+//!   minutes), and the same at the 10 kHz reference (`BodyStep::Reference`, `render
+//!   --body-hz 10000`);
 //! * after a one-beat edit near 30 s (its dynamic changed), the rendering that resumes
 //!   the previous performance from its saved state before the edit and stops
 //!   `FIRST_STEP_S` (0.4 s) past the edited stroke (what the editor plays at once: its audio is final up
@@ -14,7 +15,7 @@
 
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use std::path::Path;
-use timpanist::body::sim::SimParams;
+use timpanist::body::sim::{BodyStep, SimParams};
 use timpanist::mocap::db::MotionDb;
 use timpanist::render::{FIRST_STEP_S, RenderParams, render, render_after};
 use timpanist::score::{Dynamic, LoadedScore};
@@ -27,16 +28,17 @@ fn bench(c: &mut Criterion) {
     c.bench_function("render the one-minute study (HIMC, modal)", |b| {
         b.iter(|| render(&loaded, &db, &params, &mut |_| true).expect("renders"))
     });
-    let coarse = RenderParams {
+    let reference = RenderParams {
         sim: SimParams {
-            contact_substeps: 2,
+            contact_substeps: BodyStep::Reference.contact_substeps(),
             ..params.sim.clone()
         },
         ..params.clone()
     };
-    c.bench_function("render the one-minute study, body at 5 kHz", |b| {
-        b.iter(|| render(&loaded, &db, &coarse, &mut |_| true).expect("renders"))
-    });
+    c.bench_function(
+        "render the one-minute study, body at the 10 kHz reference",
+        |b| b.iter(|| render(&loaded, &db, &reference, &mut |_| true).expect("renders")),
+    );
     let mut resume = None;
     let before =
         render_after(&mut resume, None, &loaded, &db, &params, &mut |_| true).expect("renders");

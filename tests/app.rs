@@ -369,12 +369,12 @@ fn space_plays_on_the_silent_clock() {
     h.get_by_label("Keyboard and mouse");
 }
 
-/// The inspector's physics and sound settings: picking a concert hall, the ID pipeline
-/// and the sample model, and typing a drum's diameter, are undoable edits of the score's
+/// The inspector's physics and sound settings: picking a concert hall, the ID pipeline,
+/// the sample model and the reference body step are undoable edits of the score's
 /// settings; undo and redo restore them; they are saved with the score and read back.
 #[test]
 fn inspector_edits_settings_undoably_and_saves_them() {
-    use timpanist::body::sim::Pipeline;
+    use timpanist::body::sim::{BodyStep, Pipeline};
     use timpanist::sound::{Room, SoundModel};
     let dir = tempfile::tempdir().unwrap();
     let mut h = harness(Some(demo()), dir.path());
@@ -393,9 +393,20 @@ fn inspector_edits_settings_undoably_and_saves_them() {
     settle(&mut h);
     h.get_by_label("sample replay").click();
     settle(&mut h);
+    h.get_by_label("Body step").click();
+    settle(&mut h);
+    h.get_by_label("reference (10 kHz)").click();
+    settle(&mut h);
     let s = &h.state().loaded().unwrap().score.settings;
     assert_eq!((s.control, s.sound), (Pipeline::Id, SoundModel::Sample));
-    assert_eq!(h.state().undo_steps(), 3);
+    assert_eq!(s.body_step, BodyStep::Reference);
+    assert_eq!(h.state().undo_steps(), 4);
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
+    settle(&mut h);
+    assert_eq!(
+        h.state().loaded().unwrap().score.settings.body_step,
+        BodyStep::Fast
+    );
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::Z);
     settle(&mut h);
     let s = &h.state().loaded().unwrap().score.settings;
@@ -417,6 +428,7 @@ fn inspector_edits_settings_undoably_and_saves_them() {
         text.contains("settings") && text.contains("Sample") && text.contains("room: Hall"),
         "{text}"
     );
+    assert!(!text.contains("body_step"), "{text}");
     let mut again = harness(Some(path), dir.path());
     settle(&mut again);
     let s = &again.state().loaded().unwrap().score.settings;

@@ -1,11 +1,11 @@
 //! The inspector's performance and sound settings: control pipeline, IK
-//! method, PD gain scale, sound model, membrane modes and frequency source, and the kit's
+//! method, PD gain scale, body step, sound model, membrane modes and frequency source, and the kit's
 //! drums with editable head diameter and tension. Every change is one undoable edit of
 //! the score's settings (a drag is one step) and the editor re-renders.
 
 use super::command::Command;
 use crate::body::ik::IkMethod;
-use crate::body::sim::Pipeline;
+use crate::body::sim::{BodyStep, Pipeline};
 use crate::drum::FrequencySource;
 use crate::score::LoadedScore;
 use crate::score::edit::ScoreEdit;
@@ -86,6 +86,15 @@ pub fn show(ui: &mut egui::Ui, doc: &LoadedScore, out: &mut Vec<Command>) {
                 .labelled_by(name.id);
             started |= begins(&r);
             ui.end_row();
+            started |= choose(
+                ui,
+                "Body step",
+                &mut after.body_step,
+                &[
+                    (BodyStep::Fast, "fast (5 kHz between contacts)"),
+                    (BodyStep::Reference, "reference (10 kHz)"),
+                ],
+            );
             started |= choose(
                 ui,
                 "Sound model",

@@ -27,7 +27,7 @@ use super::ik::{self, IkParams};
 use super::limits::JointLimits;
 use super::model::BodyModel;
 use super::skeleton::{JOINT_COUNT, Joint, Pose};
-pub use crate::base::choices::Pipeline;
+pub use crate::base::choices::{BodyStep, Pipeline};
 use crate::kit::Side;
 use glam::DVec3;
 

@@ -156,9 +156,10 @@ pub struct RenderArgs {
     /// then fail to render.
     #[arg(long)]
     pub joint_limits: bool,
-    /// The body's dynamics rate, Hz: 10000 steps the body with the drums and the
-    /// stick–head contact (the reference); 5000 or 2500 step it 2 or 4 times longer
-    /// while the contact and the drums keep 10 kHz [default: the score's settings].
+    /// The body's dynamics rate between contacts, Hz: 10000 steps the body with the
+    /// drums and the stick–head contact (the reference, a score's `body_step:
+    /// Reference`); 5000 (the fast default) or 2500 step it 2 or 4 times longer while
+    /// the contact and the drums keep 10 kHz [default: the score's settings].
     #[arg(long, value_parser = ["10000", "5000", "2500"])]
     pub body_hz: Option<String>,
 }

@@ -21,6 +21,7 @@ pub mod reference;
 pub mod replay;
 pub mod strikes;
 
+use crate::base::choices::BodyStep;
 use crate::body::Joint;
 use crate::body::ik::{self, IkParams};
 use crate::body::limits::JointLimits;
@@ -121,7 +122,7 @@ impl RenderParams {
         self.force_at_silence_n + self.force_range_n * dynamic.velocity()
     }
 
-    /// The defaults with a score's settings (control, IK, gains, sound, modes).
+    /// The defaults with a score's settings (control, IK, body step, gains, sound, modes).
     pub fn for_score(settings: &Settings) -> RenderParams {
         let sim = SimParams::default();
         RenderParams {
@@ -131,6 +132,7 @@ impl RenderParams {
                     method: settings.ik,
                     ..sim.ik.clone()
                 },
+                contact_substeps: settings.body_step.contact_substeps(),
                 ..sim
             },
             gain_scale: settings.gain_scale,
@@ -152,7 +154,10 @@ impl Default for RenderParams {
             sound: SoundModel::Modal,
             room: Room::Dry,
             modes: ModeConfig::default(),
-            sim: SimParams::default(),
+            sim: SimParams {
+                contact_substeps: BodyStep::default().contact_substeps(),
+                ..SimParams::default()
+            },
             joint_limits: false,
             plan: PlanParams::default(),
             compose: ComposeParams::default(),

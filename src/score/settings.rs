@@ -1,10 +1,11 @@
-//! How a score is performed and heard, saved with it: the control pipeline,
-//! the IK method, the PD gains, the sound model and room, the membrane modes, and per-drum changes
-//! of the kit (head diameter, tension). Absent from a file means the defaults; a score
-//! with default settings is written without them.
+//! How a score is performed and heard, saved with it: the control pipeline, the IK
+//! method, the PD gains, the body's step, the sound model and room, the membrane modes,
+//! and per-drum changes of the kit (head diameter, tension). Absent from a file means the
+//! defaults; a score with default settings is written without them.
 
 use crate::base::choices::{
-    DEFAULT_MODE_COUNT, FrequencySource, IkMethod, MAX_MODE_COUNT, Pipeline, Room, SoundModel,
+    BodyStep, DEFAULT_MODE_COUNT, FrequencySource, IkMethod, MAX_MODE_COUNT, Pipeline, Room,
+    SoundModel,
 };
 use crate::base::problem::Problem;
 use crate::kit::Kit;
@@ -42,6 +43,9 @@ pub struct Settings {
     pub ik: IkMethod,
     /// Every PD gain multiplied by this (1 = nominal).
     pub gain_scale: f64,
+    /// How finely the body is stepped between contacts (fast by default).
+    #[serde(skip_serializing_if = "BodyStep::is_default")]
+    pub body_step: BodyStep,
     pub sound: SoundModel,
     /// The room the drums are heard in (dry by default).
     #[serde(skip_serializing_if = "Room::is_dry")]
@@ -60,6 +64,7 @@ impl Default for Settings {
             control: Pipeline::Himc,
             ik: IkMethod::DampedLeastSquares,
             gain_scale: 1.0,
+            body_step: BodyStep::Fast,
             sound: SoundModel::Modal,
             room: Room::Dry,
             modes: DEFAULT_MODE_COUNT,
@@ -183,6 +188,31 @@ mod tests {
             tension_n_per_m: None,
         });
         assert!(s.is_default());
+    }
+
+    /// The body step is saved only when it is not the fast default, and read back; a
+    /// misspelt one is refused naming the choices.
+    #[test]
+    fn the_body_step_is_saved_when_it_is_the_reference() {
+        let fast = ron::to_string(&Settings::default()).unwrap();
+        assert!(!fast.contains("body_step"), "{fast}");
+        let reference = Settings {
+            body_step: BodyStep::Reference,
+            ..Settings::default()
+        };
+        let text = ron::to_string(&reference).unwrap();
+        assert!(text.contains("body_step:Reference"), "{text}");
+        assert_eq!(ron::from_str::<Settings>(&text).unwrap(), reference);
+        assert_eq!(
+            (
+                BodyStep::Fast.contact_substeps(),
+                BodyStep::Reference.contact_substeps()
+            ),
+            (2, 1)
+        );
+        let wrong = ron::from_str::<Settings>("(body_step: Slow)").unwrap_err();
+        assert!(wrong.to_string().contains("Fast"), "{wrong}");
+        assert_eq!("reference".parse::<BodyStep>(), Ok(BodyStep::Reference));
     }
 
     /// Out-of-range values are named by their place.
