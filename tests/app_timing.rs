@@ -241,6 +241,11 @@ fn render_worker_frames_and_edit_to_ready_audio() {
     let quick = !partial.complete;
     let from = partial.stats.resumed_from_s;
     let ready_s = partial.ready_s;
+    println!(
+        "the first step after the edit: simulating {:.1} ms, its sound {:.1} ms",
+        partial.stats.simulate.as_secs_f64() * 1e3,
+        partial.stats.sound.as_secs_f64() * 1e3
+    );
     let before = h.state().rendering().map(std::sync::Arc::as_ptr);
     if quick {
         step_until_rendering(&mut h, before, true, &mut after_edit, 120.0);

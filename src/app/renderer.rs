@@ -12,7 +12,8 @@ use super::tape::StereoSource;
 use super::worker::Job;
 use crate::motion::compose::Composition;
 use crate::render::{
-    FIRST_STEP_S, RESUME_STEP_S, RenderError, RenderParams, Rendering, Resume, render_composition,
+    FIRST_STEP_S, RESUME_STEP_GROWTH, RESUME_STEP_S, RenderError, RenderParams, Rendering, Resume,
+    render_composition,
 };
 use crate::score::LoadedScore;
 use std::sync::Arc;
@@ -140,7 +141,7 @@ pub fn job() -> impl FnMut(Request, &Job<Reply>) + Send + 'static {
             let stop_after_s = if origin.is_none() {
                 FIRST_STEP_S
             } else {
-                let next = 2.0 * step_s;
+                let next = RESUME_STEP_GROWTH * step_s;
                 std::mem::replace(&mut step_s, next)
             };
             let result = render_composition(

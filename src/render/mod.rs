@@ -313,11 +313,19 @@ pub const SOUND_AHEAD_S: f64 = 5.0;
 /// After an edit the editor first renders this far past the edited stroke, s, ready to
 /// play at once...
 pub const FIRST_STEP_S: f64 = 0.4;
-/// ...then the rest in steps, the first this long, s, and each next one twice the last
-/// (each several times faster than real time, so playback started at once never runs
-/// out; fewer steps hand over fewer whole copies of the audio and motion, and a longer
-/// one makes its sound beside its simulation, every [`SOUND_AHEAD_S`]).
+/// ...then the rest in steps, the first this long, s, and each next one
+/// [`RESUME_STEP_GROWTH`] times the last.
 pub const RESUME_STEP_S: f64 = 4.0;
+/// How much longer each step of the rest is than the one before. Playback started at the
+/// edit never runs out as long as the rendering runs more than this many times faster
+/// than real time (each step is then ready before the music reaches its start: the
+/// one-minute study renders at 28× real time at the reference body step, 40× at the fast
+/// one). Fewer steps hand over fewer whole copies of the audio and motion, and a longer
+/// one makes its sound beside its simulation, every [`SOUND_AHEAD_S`]: with 8 the rest of
+/// the one-minute study after an edit at 30 s is two steps (4 s, then all of it), the
+/// whole score current again after 0.91–0.94 s against 1.05–1.07 s with 2 (four steps:
+/// 4, 8, 16 s and the last).
+pub const RESUME_STEP_GROWTH: f64 = 8.0;
 
 /// What renderings leave behind to resume from after an edit: the settled performance,
 /// the sound's synthesis state and what they were made from. Whoever renders again keeps
