@@ -110,6 +110,8 @@ pub fn pd_torques(
 /// control: stiffness and feed-forward times `held`, damping times √`held` (the damping
 /// ratio unchanged), clamped to its torque limit. A relaxed grip (`held` ≪ 1) lets the
 /// stick turn freely about the fulcrum.
+// Inlined so `pd_torques`' constant `held` = 1 folds away (its factors are exactly 1).
+#[inline(always)]
 pub fn pd_torque(
     gains: &Gains,
     state: &State,
