@@ -4,7 +4,8 @@
 //! than [`CLUSTER_GAP_S`] (either hand) are settled together: from a saved state before
 //! the cluster, the body and the drums are simulated a little past its last stroke, the
 //! contacts measured, the cluster's shifts and depths corrected and the span simulated
-//! again, a few times (not once more when a correction would only repeat an attempt);
+//! again (from the latest state the attempt before saved that the corrected targets leave
+//! unchanged), a few times (not once more when a correction would only repeat an attempt);
 //! the best attempt is kept (fewest strokes missed, then re-contacts —
 //! the stick falling back on a head —, then contacts out of time, forces far off their
 //! aim, contacts pressed too long, forces a little off, then the worst timing) and the
@@ -63,6 +64,54 @@ const WARM_FROM: usize = 2;
 const DEPTH_LINE_FROM: usize = 8;
 /// Their force aims must span at least this, N, for a line.
 const DEPTH_LINE_SPAN_N: f64 = 5.0;
+
+/// Along an attempt, a state is saved every this many task-rate samples (40 ms), for the
+/// next attempt to resume from.
+const ATTEMPT_SAVE_EVERY: usize = 10;
+
+/// The targets an attempt followed over its span (what [`Targets::write`] writes: the
+/// tips and the grip).
+#[derive(Default)]
+struct Followed {
+    from: usize,
+    tips: [Vec<DVec3>; 2],
+    grip: [Vec<f64>; 2],
+}
+
+impl Followed {
+    /// `reference`'s targets over `span`.
+    fn of(reference: &Reference, span: Range<usize>) -> Followed {
+        Followed {
+            from: span.start,
+            tips: std::array::from_fn(|h| reference.tips[h][span.clone()].to_vec()),
+            grip: std::array::from_fn(|h| {
+                reference
+                    .grip
+                    .as_ref()
+                    .map_or_else(Vec::new, |g| g[h][span.clone()].to_vec())
+            }),
+        }
+    }
+
+    /// The first sample of `span` where `reference` differs from these targets (the span's
+    /// end when it does not; any sample before where these begin counts as changed).
+    fn first_change(&self, reference: &Reference, span: Range<usize>) -> usize {
+        let differs = |k: usize| {
+            let Some(i) = k.checked_sub(self.from) else {
+                return true;
+            };
+            (0..2).any(|h| {
+                self.tips[h].get(i) != Some(&reference.tips[h][k])
+                    || reference
+                        .grip
+                        .as_ref()
+                        .is_some_and(|g| self.grip[h].get(i) != Some(&g[h][k]))
+            })
+        };
+        let end = span.end;
+        span.into_iter().find(|&k| differs(k)).unwrap_or(end)
+    }
+}
 
 /// The depth (m) at force aim `aim` (N) on the least-squares line through `points`
 /// (force aim, depth), when their aims span [`DEPTH_LINE_SPAN_N`] and deeper aims
@@ -359,6 +408,25 @@ impl Performance {
         self.advance(until, stage)
     }
 
+    /// [`Self::advance`], saving a state into `along` at every multiple of `every`
+    /// samples.
+    fn advance_saving(
+        &mut self,
+        until: usize,
+        (along, every): (&mut Vec<(Checkpoint, DrumCheckpoint)>, usize),
+        stage: &mut Stage,
+    ) -> Result<(), SimError> {
+        let mut next = (self.sim.samples() / every)
+            .saturating_add(1)
+            .saturating_mul(every);
+        while next < until {
+            self.advance(next, stage)?;
+            along.push((self.sim.checkpoint(), self.drums.checkpoint()));
+            next += every;
+        }
+        self.advance(until, stage)
+    }
+
     fn advance(&mut self, until: usize, stage: &mut Stage) -> Result<(), SimError> {
         let from = self.sim.samples();
         let mut meeting = Meeting {
@@ -499,15 +567,34 @@ impl Performance {
         let mut placed: Vec<Vec<(f64, f64)>> = Vec::new();
         let mut attempt = 0;
         let mut diverged = false;
+        // States saved along the latest attempt, and the targets it followed: the next
+        // attempt resumes from the latest state its own targets leave unchanged (a roll
+        // settling from the front plays its settled strokes once, not once per attempt).
+        // (A single stroke's attempts change its targets from the commit on: none saved.)
+        let mut along: Vec<(Checkpoint, DrumCheckpoint)> = Vec::new();
+        let save_every = if cluster.len() > 1 {
+            ATTEMPT_SAVE_EVERY
+        } else {
+            usize::MAX
+        };
+        let mut followed = Followed::default();
         loop {
             attempt += 1;
-            if attempt > 1 {
-                self.sim.rewind(&commit.sim);
-                self.drums.rewind(&commit.drums);
-            }
             self.place(cluster.clone(), &commit, until);
+            let span = commit.samples..(until + 2).min(n);
+            if attempt > 1 {
+                let changed = followed.first_change(&self.reference, span.clone());
+                // A state of n samples read the targets up to sample n (one ahead).
+                along.retain(|(sim, _)| sim.samples() + 1 < changed);
+                let (sim, drums) = along
+                    .last()
+                    .map_or((&commit.sim, &commit.drums), |(s, d)| (s, d));
+                self.sim.rewind(sim);
+                self.drums.rewind(drums);
+            }
+            followed = Followed::of(&self.reference, span);
             self.attempts += 1;
-            match self.advance(until, stage) {
+            match self.advance_saving(until, (&mut along, save_every), stage) {
                 // A correction that makes the body diverge is dropped for the best so far;
                 // a warm start that does is replaced by no shift and the first depth.
                 Err(SimError::Diverged(_)) if best.is_some() => {
