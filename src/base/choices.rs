@@ -140,10 +140,6 @@ pub enum BodyStep {
 }
 
 impl BodyStep {
-    /// Every body step with its command-line name.
-    pub const ALL: [(BodyStep, &'static str); 2] =
-        [(BodyStep::Fast, "fast"), (BodyStep::Reference, "reference")];
-
     /// Whether this is the default (a score file then leaves it out).
     pub fn is_default(&self) -> bool {
         *self == BodyStep::default()
@@ -155,19 +151,6 @@ impl BodyStep {
             BodyStep::Fast => 2,
             BodyStep::Reference => 1,
         }
-    }
-}
-
-impl fmt::Display for BodyStep {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(name_in(&Self::ALL, self))
-    }
-}
-
-impl FromStr for BodyStep {
-    type Err = UnknownName;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        parse_in(&Self::ALL, s, ("body step", "fast or reference"))
     }
 }
 

@@ -71,7 +71,6 @@ const ATTEMPT_SAVE_EVERY: usize = 10;
 
 /// The targets an attempt followed over its span (what [`Targets::write`] writes: the
 /// tips and the grip).
-#[derive(Default)]
 struct Followed {
     from: usize,
     tips: [Vec<DVec3>; 2],
@@ -408,21 +407,19 @@ impl Performance {
         self.advance(until, stage)
     }
 
-    /// [`Self::advance`], saving a state into `along` at every multiple of `every`
-    /// samples.
+    /// [`Self::advance`], saving a state into `along` at every multiple of
+    /// [`ATTEMPT_SAVE_EVERY`] samples.
     fn advance_saving(
         &mut self,
         until: usize,
-        (along, every): (&mut Vec<(Checkpoint, DrumCheckpoint)>, usize),
+        along: &mut Vec<(Checkpoint, DrumCheckpoint)>,
         stage: &mut Stage,
     ) -> Result<(), SimError> {
-        let mut next = (self.sim.samples() / every)
-            .saturating_add(1)
-            .saturating_mul(every);
+        let mut next = (self.sim.samples() / ATTEMPT_SAVE_EVERY + 1) * ATTEMPT_SAVE_EVERY;
         while next < until {
             self.advance(next, stage)?;
             along.push((self.sim.checkpoint(), self.drums.checkpoint()));
-            next += every;
+            next += ATTEMPT_SAVE_EVERY;
         }
         self.advance(until, stage)
     }
@@ -571,30 +568,33 @@ impl Performance {
         // attempt resumes from the latest state its own targets leave unchanged (a roll
         // settling from the front plays its settled strokes once, not once per attempt).
         // (A single stroke's attempts change its targets from the commit on: none saved.)
+        let saving = cluster.len() > 1;
         let mut along: Vec<(Checkpoint, DrumCheckpoint)> = Vec::new();
-        let save_every = if cluster.len() > 1 {
-            ATTEMPT_SAVE_EVERY
-        } else {
-            usize::MAX
-        };
-        let mut followed = Followed::default();
+        let mut followed: Option<Followed> = None;
         loop {
             attempt += 1;
             self.place(cluster.clone(), &commit, until);
             let span = commit.samples..(until + 2).min(n);
             if attempt > 1 {
-                let changed = followed.first_change(&self.reference, span.clone());
-                // A state of n samples read the targets up to sample n (one ahead).
-                along.retain(|(sim, _)| sim.samples() + 1 < changed);
+                if let Some(followed) = &followed {
+                    let changed = followed.first_change(&self.reference, span.clone());
+                    // A state of n samples read the targets up to sample n (one ahead).
+                    along.retain(|(sim, _)| sim.samples() + 1 < changed);
+                }
                 let (sim, drums) = along
                     .last()
                     .map_or((&commit.sim, &commit.drums), |(s, d)| (s, d));
                 self.sim.rewind(sim);
                 self.drums.rewind(drums);
             }
-            followed = Followed::of(&self.reference, span);
             self.attempts += 1;
-            match self.advance_saving(until, (&mut along, save_every), stage) {
+            let outcome = if saving {
+                followed = Some(Followed::of(&self.reference, span));
+                self.advance_saving(until, &mut along, stage)
+            } else {
+                self.advance(until, stage)
+            };
+            match outcome {
                 // A correction that makes the body diverge is dropped for the best so far;
                 // a warm start that does is replaced by no shift and the first depth.
                 Err(SimError::Diverged(_)) if best.is_some() => {
