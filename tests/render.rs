@@ -674,9 +674,21 @@ fn recontact_sized(contacts: &[ContactEvent]) -> Vec<&ContactEvent> {
         .collect()
 }
 
+/// [`recontact_sized`] hand by hand, each in time order (two hands striking at once may
+/// start in either order).
+fn by_hand(contacts: &[ContactEvent]) -> Vec<&ContactEvent> {
+    let mut v = recontact_sized(contacts);
+    v.sort_by(|x, y| {
+        (x.side as u8)
+            .cmp(&(y.side as u8))
+            .then(x.start_s.total_cmp(&y.start_s))
+    });
+    v
+}
+
 /// How far two simulations of the same targets are apart: the tip paths (largest RMS
 /// over the tips, and at worst), and over the contacts of 5 N or more (the same drum and
-/// hand, one for one) the largest difference of start or length and of peak force.
+/// hand, one for one, each hand's in time order) the largest difference of start or length and of peak force.
 #[derive(Clone, Copy, Debug, Default)]
 struct Apart {
     rms_m: f64,
@@ -697,7 +709,7 @@ impl Apart {
             }
             apart.rms_m = apart.rms_m.max((squares / x.len() as f64).sqrt());
         }
-        let (ra, rb) = (recontact_sized(a.1), recontact_sized(b.1));
+        let (ra, rb) = (by_hand(a.1), by_hand(b.1));
         assert_eq!(ra.len(), rb.len(), "{name}: contacts of 5 N or more");
         for (r, f) in ra.iter().zip(&rb) {
             assert_eq!((r.side, r.drum), (f.side, f.drum), "{name}");
@@ -755,11 +767,12 @@ fn stepped(sim: &SimParams, hz: f64, contact_substeps: usize) -> SimParams {
 /// The 5 kHz step is the default (`BodyStep::Fast`): issue 22 asks tip paths within 1 mm,
 /// contact times within 0.3 ms and peak forces within 5 % of the reference before a larger
 /// step may be. The tip paths are within 1 mm in RMS (asserted below), not at their worst
-/// sample. Measured here: the 5 kHz step 0.23 mm
-/// RMS, 3.7 mm at worst, contacts 0.10 ms, forces 4.9 % from the reference; the reference
-/// 0.19 mm RMS, 3.8 mm at worst, 0.15 ms and 5.9 % from its own half step. The step
-/// converges at first order (20 → 40 kHz moves the tips half as far as 10 → 20 kHz), so
-/// the 10 kHz reference is itself ≈ 3.8 mm and ≈ 6 % from the converged motion at worst:
+/// sample. Measured here: the 5 kHz step 0.26 mm
+/// RMS, 3.7 mm at worst, contacts 0.10 ms, forces 2.6 % from the reference; the reference
+/// 0.19 mm RMS, 3.9 mm at worst, 0.15 ms and 2.3 % from its own half step (with the first,
+/// stiffer felt: 0.23 mm, 3.7 mm, 0.10 ms, 4.9 % and 0.19 mm, 3.8 mm, 0.15 ms, 5.9 %). The
+/// step converges at first order (20 → 40 kHz moves the tips half as far as 10 → 20 kHz), so
+/// the 10 kHz reference is itself ≈ 3.9 mm from the converged motion at worst:
 /// no more accurate step can come within 1 mm of it. The test holds the 5 kHz step
 /// within the reference's own step error (with a margin) and the first-order convergence.
 #[test]
@@ -810,7 +823,7 @@ fn a_body_at_5_khz_with_the_contact_at_10_khz_stays_near_the_reference() {
     println!("the reference from its own half step (20 kHz): {fine}");
     assert!(compared > 250, "{compared}");
     // The reference's own step error, and the coarser step within it.
-    assert!(fine.worst_m > 1e-3 && fine.force > 0.04, "{fine}");
+    assert!(fine.worst_m > 1e-3 && fine.force > 0.01, "{fine}");
     assert!(coarse.rms_m <= 1.5 * fine.rms_m, "{coarse} against {fine}");
     assert!(
         coarse.worst_m <= 1.2 * fine.worst_m,

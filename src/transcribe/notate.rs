@@ -197,9 +197,12 @@ pub fn place(
 
 /// Runs of strokes to write as rolls: (first, last) index, inclusive. Judged by timing
 /// alone — inside a roll each stroke adds little to a head already ringing, so its own
-/// pitch is unreliable — a roll is written on its first stroke's drum.
+/// pitch is unreliable — a roll is written on its first stroke's drum. Two runs one
+/// missed stroke apart (at the pace of both) are one roll: a roll's soft strokes can
+/// fall under the onset detector, and each half would otherwise be written on the drum
+/// its own first stroke was heard on.
 pub fn roll_runs(placed: &[Placed]) -> Vec<(usize, usize)> {
-    let mut runs = Vec::new();
+    let mut runs: Vec<(usize, usize)> = Vec::new();
     let mut i = 0;
     while i < placed.len() {
         let mut j = i;
@@ -210,11 +213,30 @@ pub fn roll_runs(placed: &[Placed]) -> Vec<(usize, usize)> {
             j += 1;
         }
         if j + 1 - i >= ROLL_MIN_STROKES && even(&placed[i..=j]) {
-            runs.push((i, j));
+            match runs.last_mut() {
+                Some(last) if last.1 + 1 == i && one_stroke_missed(placed, *last, (i, j)) => {
+                    last.1 = j;
+                }
+                _ => runs.push((i, j)),
+            }
         }
         i = j + 1;
     }
     runs
+}
+
+/// Mean gap between the strokes of a run of at least two, s.
+fn mean_gap(run: &[Placed]) -> f64 {
+    (run[run.len() - 1].time_s - run[0].time_s) / (run.len() - 1) as f64
+}
+
+/// Whether the runs `a` and `b` (next to each other) keep one pace, within
+/// [`ROLL_EVENNESS`] of a gap, with one stroke missing between them.
+fn one_stroke_missed(placed: &[Placed], a: (usize, usize), b: (usize, usize)) -> bool {
+    let (ga, gb) = (mean_gap(&placed[a.0..=a.1]), mean_gap(&placed[b.0..=b.1]));
+    let gap = 0.5 * (ga + gb);
+    let between = placed[b.0].time_s - placed[a.1].time_s;
+    (ga - gb).abs() <= ROLL_EVENNESS * gap && (between - 2.0 * gap).abs() <= ROLL_EVENNESS * gap
 }
 
 /// Whether the strokes of a run lie on an even grid: every one within [`ROLL_EVENNESS`]
@@ -375,5 +397,36 @@ mod tests {
             })
             .collect();
         assert!(roll_runs(&uneven).is_empty());
+    }
+
+    /// A roll of 30 strokes 80 ms apart whose 12th stroke the onsets missed, its second
+    /// part heard on another drum: one roll of 30 strokes on the first part's drum. A
+    /// second roll after a rest of two strokes stays apart.
+    #[test]
+    fn a_roll_missing_one_stroke_is_one_roll() {
+        let m = map(96.0);
+        let stroke = |k: u32| {
+            let t = 1.0 + f64::from(k) * 0.08;
+            Placed {
+                time_s: t,
+                tick: quantise(&m, 960, t, None),
+                drums: vec![if k < 11 {
+                    (0, Pitch(45))
+                } else {
+                    (1, Pitch(52))
+                }],
+                dynamic: Dynamic::Pp,
+            }
+        };
+        let placed: Vec<Placed> = (0..30).filter(|&k| k != 11).map(stroke).collect();
+        assert_eq!(roll_runs(&placed), vec![(0, 28)]);
+        let (beats, rolls) = beats(&placed, &Kit::standard(), 960);
+        assert_eq!((beats.len(), rolls), (1, 1));
+        assert_eq!(beats[0].drum, 0);
+        let rest: Vec<Placed> = (0..30)
+            .filter(|&k| k != 11 && k != 12)
+            .map(stroke)
+            .collect();
+        assert_eq!(roll_runs(&rest), vec![(0, 10), (11, 27)]);
     }
 }
