@@ -38,6 +38,9 @@ pub const REFERENCE_DISTANCE_M: f64 = 1.0;
 const DECIMATION: usize = 8;
 /// Blocks between saved states.
 const SAVE_EVERY_BLOCKS: usize = 64;
+/// Cut-off of the low-pass that takes the sub-step rate's images out of the output, Hz
+/// (see [`ImageFilter`]).
+const IMAGE_CUTOFF_HZ: f64 = 1500.0;
 
 /// One receiving head's coupling: its m ≤ 1 voices below [`MAX_HZ`], their forces per
 /// unit pressure and pressure gradient, and the drums it hears.
@@ -59,11 +62,61 @@ struct Receiver {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SympathyState {
     pub out: Vec<f32>,
-    /// Saved: (frame, bank state, the last sub-step's output).
-    saved: Vec<(usize, BankState, f32)>,
+    /// Saved: (frame, bank state, the last sub-step's output, the image filter).
+    saved: Vec<(usize, BankState, f32, ImageFilter)>,
     /// The voices it rang with per tuning, from its first frame (a change restarts it
     /// there).
     voices: Vec<(usize, Vec<Voice>)>,
+}
+
+/// The receiving heads run at the sub-step rate (6 kHz) and come back to 48 kHz by
+/// linear interpolation, which leaves images of every partial f at 6 kHz ± f only
+/// 30–40 dB down: faint inharmonic tones near 5–7 kHz on every head that rings
+/// sympathetically (a 570 Hz partial's image at 5.43 kHz carried more of the mix's 4 kHz
+/// octave band than the struck head's own modes). A fourth-order Butterworth low-pass at
+/// [`IMAGE_CUTOFF_HZ`] (two biquad sections, transposed direct form II) takes them out:
+/// −0.2 dB at 1 kHz, where the sympathetic partials stop ([`MAX_HZ`]), −45 dB at 5.4 kHz.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ImageFilter([[f64; 2]; 2]);
+
+impl ImageFilter {
+    /// Each section's (b0, b1, b2, a1, a2) at the audio rate (bilinear transform, the
+    /// cut-off pre-warped; the Butterworth pair's Q = 1/(2 cos(π/8)), 1/(2 cos(3π/8))).
+    fn sections() -> [[f64; 5]; 2] {
+        let k = (PI * IMAGE_CUTOFF_HZ / f64::from(SAMPLE_RATE_HZ)).tan();
+        [PI / 8.0, 3.0 * PI / 8.0].map(|angle| {
+            let q = 0.5 / angle.cos();
+            let norm = 1.0 / (1.0 + k / q + k * k);
+            let b0 = k * k * norm;
+            [
+                b0,
+                2.0 * b0,
+                b0,
+                2.0 * (k * k - 1.0) * norm,
+                (1.0 - k / q + k * k) * norm,
+            ]
+        })
+    }
+
+    /// One sample through both sections.
+    fn run(&mut self, sections: &[[f64; 5]; 2], x: f32) -> f32 {
+        let mut v = f64::from(x);
+        for (s, [b0, b1, b2, a1, a2]) in self.0.iter_mut().zip(sections) {
+            let y = b0 * v + s[0];
+            s[0] = b1 * v - a1 * y + s[1];
+            s[1] = b2 * v - a2 * y;
+            v = y;
+        }
+        v as f32
+    }
+
+    /// Whether its state has died away (below [`FLUSH_FLOOR`]).
+    fn is_silent(&self) -> bool {
+        self.0
+            .iter()
+            .flatten()
+            .all(|s| s.abs() < f64::from(FLUSH_FLOOR))
+    }
 }
 
 impl Receiver {
@@ -183,12 +236,14 @@ pub fn resynthesise(
     let mut index = tuning_at(tunings, start);
     let mut receiver = receivers[index].clone();
     let mut last = 0.0f32;
+    let mut images = ImageFilter::default();
     if let Some(k) = resume.filter(|_| start > 0) {
         if let Some(rx) = receiver.as_mut() {
             rx.bank.restore(&state.saved[k].1);
         }
-        last = state.saved[k].2;
+        (last, images) = (state.saved[k].2, state.saved[k].3);
     }
+    let sections = ImageFilter::sections();
     state.saved.retain(|(f, ..)| *f < start);
     state.out.resize(frames, 0.0);
     state.out[start..].fill(0.0);
@@ -206,13 +261,13 @@ pub fn resynthesise(
             ringing = false;
         }
         let Some(rx) = receiver.as_mut() else {
-            last = 0.0;
+            (last, images) = (0.0, ImageFilter::default());
             continue;
         };
         let stride = rx.bank.stride();
         let mut input = vec![0.0f32; steps * stride];
         if n0.is_multiple_of(SAVE_EVERY_BLOCKS * BLOCK) {
-            state.saved.push((n0, rx.bank.state(), last));
+            state.saved.push((n0, rx.bank.state(), last, images));
         }
         let n1 = (n0 + BLOCK).min(frames);
         let used = (n1 - n0).div_ceil(DECIMATION);
@@ -265,16 +320,53 @@ pub fn resynthesise(
         } else if ringing {
             rx.bank.render_free(&mut sub[..used]);
             ringing = !rx.bank.flush(FLUSH_FLOOR);
-        } else if last == 0.0 {
+        } else if last == 0.0 && images.is_silent() {
             continue;
         }
-        // Back to the audio rate: linear between the sub-steps' outputs.
+        // Back to the audio rate: linear between the sub-steps' outputs, the images of
+        // the sub-step rate filtered out.
         for (k, o) in state.out[n0..n1].iter_mut().enumerate() {
             let (step, phase) = (k / DECIMATION, (k % DECIMATION + 1) as f32);
             let from = if step == 0 { last } else { sub[step - 1] };
-            *o = from + (sub[step] - from) * phase / DECIMATION as f32;
+            *o = images.run(
+                &sections,
+                from + (sub[step] - from) * phase / DECIMATION as f32,
+            );
         }
         last = sub[used - 1];
     }
     start
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The image filter's gain on a steady sine after its start has died away, dB.
+    fn gain_db(hz: f64) -> f64 {
+        let (sections, mut filter) = (ImageFilter::sections(), ImageFilter::default());
+        let fs = f64::from(SAMPLE_RATE_HZ);
+        let (mut peak_in, mut peak_out) = (0.0f64, 0.0f64);
+        for n in 0..48_000 {
+            let x = (std::f64::consts::TAU * hz * n as f64 / fs).sin() as f32;
+            let y = filter.run(&sections, x);
+            if n > 24_000 {
+                peak_in = peak_in.max(f64::from(x.abs()));
+                peak_out = peak_out.max(f64::from(y.abs()));
+            }
+        }
+        20.0 * (peak_out / peak_in).log10()
+    }
+
+    /// Flat where the sympathetic partials ring (up to 1 kHz: within 0.3 dB), and the
+    /// images of the 6 kHz sub-step rate (5–7 kHz) at least 40 dB down.
+    #[test]
+    fn the_image_filter_passes_the_partials_and_stops_the_images() {
+        for hz in [100.0, 500.0, MAX_HZ] {
+            assert!(gain_db(hz).abs() < 0.3, "{hz} Hz: {:.2} dB", gain_db(hz));
+        }
+        for hz in [5000.0, 5430.0, 6600.0] {
+            assert!(gain_db(hz) < -40.0, "{hz} Hz: {:.1} dB", gain_db(hz));
+        }
+    }
 }

@@ -152,7 +152,9 @@ pub fn transcribe(
         .into_iter()
         .map(|f| onsets::place(samples, rate_hz, &strength, f))
         .collect();
-    let times = dedup_sorted(found);
+    let mut times = dedup_sorted(found);
+    // A head stopped by a hand is heard as a change, not as a stroke.
+    times.retain(|&t| !notes::is_damping(samples, rate_hz, t));
     if times.is_empty() {
         return Err(TranscribeError::Silent { file: source });
     }

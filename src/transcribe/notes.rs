@@ -201,9 +201,8 @@ fn added_spectrum(after: &[(f64, f64)], before: &[(f64, f64)]) -> Vec<(f64, f64)
         .collect()
 }
 
-/// Energy added by the stroke at `onset_s`: mean square over [`LEVEL_SPAN_S`] after it
-/// less the mean square over the same span before it, in dB re a full-scale sine (0.5).
-pub fn added_level_db(samples: &[f32], rate_hz: u32, onset_s: f64) -> f64 {
+/// Mean squares over [`LEVEL_SPAN_S`] before and after `onset_s`.
+fn energy_around(samples: &[f32], rate_hz: u32, onset_s: f64) -> (f64, f64) {
     let mean_square = |v: &[f32]| {
         v.iter().map(|&s| f64::from(s) * f64::from(s)).sum::<f64>() / v.len().max(1) as f64
     };
@@ -214,7 +213,35 @@ pub fn added_level_db(samples: &[f32], rate_hz: u32, onset_s: f64) -> f64 {
         onset_s - LEVEL_SPAN_S,
         LEVEL_SPAN_S,
     ));
+    (before, after)
+}
+
+/// Energy added by the stroke at `onset_s`: mean square over [`LEVEL_SPAN_S`] after it
+/// less the mean square over the same span before it, in dB re a full-scale sine (0.5).
+pub fn added_level_db(samples: &[f32], rate_hz: u32, onset_s: f64) -> f64 {
+    let (before, after) = energy_around(samples, rate_hz, onset_s);
     10.0 * ((after - before).max(1e-12) / 0.5).log10()
+}
+
+/// The sound falls across an onset to under this share of its energy before it (−10 dB;
+/// a stroke of a roll sounding after a louder one falls by up to 6 dB, a stopped head by
+/// 20 and more): a hand stopping a head, not a stroke…
+pub const DAMPED_SHARE: f64 = 0.1;
+/// …measured over this span after the onset (past the touch's own click, which the
+/// onset is placed on), s.
+const DAMPED_AFTER_S: (f64, f64) = (0.02, 0.06);
+
+/// Whether what changes at `onset_s` is a damping (20–60 ms after it the sound is 10 dB
+/// and more below its level over the [`LEVEL_SPAN_S`] before): a hand or a mute on a
+/// ringing head changes its spectrum at once, which the spectral flux sees as an onset,
+/// but it takes energy away where a stroke, however soft, adds some.
+pub fn is_damping(samples: &[f32], rate_hz: u32, onset_s: f64) -> bool {
+    let (before, _) = energy_around(samples, rate_hz, onset_s);
+    let (from, to) = DAMPED_AFTER_S;
+    let after = slice(samples, rate_hz, onset_s + from, to - from);
+    let after =
+        after.iter().map(|&s| f64::from(s).powi(2)).sum::<f64>() / after.len().max(1) as f64;
+    after < DAMPED_SHARE * before
 }
 
 #[cfg(test)]
@@ -233,6 +260,30 @@ mod tests {
     }
     use super::*;
     use crate::sound::analysis::KETTLEDRUM_RATIOS;
+
+    /// A ringing 147 Hz note stopped to a tenth of its amplitude at 0.5 s is a damping;
+    /// a second, softer note struck into it there (a quarter of its amplitude) is not.
+    #[test]
+    fn a_hand_stopping_a_head_is_no_stroke() {
+        let rate = 48_000u32;
+        let tone = |t: f64| (std::f64::consts::TAU * 147.0 * t).sin() * (-t).exp();
+        let render = |f: &dyn Fn(f64) -> f64| -> Vec<f32> {
+            (0..rate)
+                .map(|n| f(f64::from(n) / f64::from(rate)) as f32)
+                .collect()
+        };
+        let stopped = render(&|t| tone(t) * if t < 0.5 { 1.0 } else { 0.1 });
+        let struck = render(&|t| {
+            tone(t)
+                + if t < 0.5 {
+                    0.0
+                } else {
+                    0.25 * (std::f64::consts::TAU * 220.0 * t).sin()
+                }
+        });
+        assert!(is_damping(&stopped, rate, 0.5));
+        assert!(!is_damping(&struck, rate, 0.5));
+    }
 
     /// A kettledrum-like note (the five ratios, each partial 2 dB below the last) from `t0`.
     fn note(out: &mut [f32], rate: u32, t0: f64, hz: f64, amp: f64) {
