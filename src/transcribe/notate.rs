@@ -399,14 +399,14 @@ mod tests {
         assert!(roll_runs(&uneven).is_empty());
     }
 
-    /// A roll of 30 strokes 80 ms apart whose 12th stroke the onsets missed, its second
-    /// part heard on another drum: one roll of 30 strokes on the first part's drum. A
-    /// second roll after a rest of two strokes stays apart.
+    /// A roll of 30 strokes, eighths of a quarter at 96 bpm, whose 12th stroke the onsets
+    /// missed, its second part heard on another drum: one roll of 30 strokes on the first
+    /// part's drum. A second roll after a rest of two strokes stays apart.
     #[test]
     fn a_roll_missing_one_stroke_is_one_roll() {
         let m = map(96.0);
         let stroke = |k: u32| {
-            let t = 1.0 + f64::from(k) * 0.08;
+            let t = 1.0 + f64::from(k) * 0.078125;
             Placed {
                 time_s: t,
                 tick: quantise(&m, 960, t, None),
@@ -423,6 +423,11 @@ mod tests {
         let (beats, rolls) = beats(&placed, &Kit::standard(), 960);
         assert_eq!((beats.len(), rolls), (1, 1));
         assert_eq!(beats[0].drum, 0);
+        let roll = beats[0].roll.expect("written as a roll");
+        assert_eq!(
+            roll.length_ticks / u64::from(960 / roll.strokes_per_quarter),
+            30
+        );
         let rest: Vec<Placed> = (0..30)
             .filter(|&k| k != 11 && k != 12)
             .map(stroke)
