@@ -77,7 +77,7 @@ pub struct SympathyState {
 /// [`IMAGE_CUTOFF_HZ`] (two biquad sections, transposed direct form II) takes them out:
 /// −0.2 dB at 1 kHz, where the sympathetic partials stop ([`MAX_HZ`]), −45 dB at 5.4 kHz.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct ImageFilter([[f64; 2]; 2]);
+struct ImageFilter([[f64; 2]; 2]);
 
 impl ImageFilter {
     /// Each section's (b0, b1, b2, a1, a2) at the audio rate (bilinear transform, the

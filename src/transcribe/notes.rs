@@ -201,32 +201,24 @@ fn added_spectrum(after: &[(f64, f64)], before: &[(f64, f64)]) -> Vec<(f64, f64)
         .collect()
 }
 
-/// Mean squares over [`LEVEL_SPAN_S`] before and after `onset_s`.
-fn energy_around(samples: &[f32], rate_hz: u32, onset_s: f64) -> (f64, f64) {
-    let mean_square = |v: &[f32]| {
-        v.iter().map(|&s| f64::from(s) * f64::from(s)).sum::<f64>() / v.len().max(1) as f64
-    };
-    let after = mean_square(&slice(samples, rate_hz, onset_s, LEVEL_SPAN_S));
-    let before = mean_square(&slice(
-        samples,
-        rate_hz,
-        onset_s - LEVEL_SPAN_S,
-        LEVEL_SPAN_S,
-    ));
-    (before, after)
+/// Mean square of `samples` over `len_s` from `start_s` (zeros outside the recording).
+fn mean_square(samples: &[f32], rate_hz: u32, start_s: f64, len_s: f64) -> f64 {
+    let v = slice(samples, rate_hz, start_s, len_s);
+    v.iter().map(|&s| f64::from(s) * f64::from(s)).sum::<f64>() / v.len().max(1) as f64
 }
 
 /// Energy added by the stroke at `onset_s`: mean square over [`LEVEL_SPAN_S`] after it
 /// less the mean square over the same span before it, in dB re a full-scale sine (0.5).
 pub fn added_level_db(samples: &[f32], rate_hz: u32, onset_s: f64) -> f64 {
-    let (before, after) = energy_around(samples, rate_hz, onset_s);
+    let after = mean_square(samples, rate_hz, onset_s, LEVEL_SPAN_S);
+    let before = mean_square(samples, rate_hz, onset_s - LEVEL_SPAN_S, LEVEL_SPAN_S);
     10.0 * ((after - before).max(1e-12) / 0.5).log10()
 }
 
 /// The sound falls across an onset to under this share of its energy before it (−10 dB;
 /// a stroke of a roll sounding after a louder one falls by up to 6 dB, a stopped head by
 /// 20 and more): a hand stopping a head, not a stroke…
-pub const DAMPED_SHARE: f64 = 0.1;
+const DAMPED_SHARE: f64 = 0.1;
 /// …measured over this span after the onset (past the touch's own click, which the
 /// onset is placed on), s.
 const DAMPED_AFTER_S: (f64, f64) = (0.02, 0.06);
@@ -236,11 +228,9 @@ const DAMPED_AFTER_S: (f64, f64) = (0.02, 0.06);
 /// ringing head changes its spectrum at once, which the spectral flux sees as an onset,
 /// but it takes energy away where a stroke, however soft, adds some.
 pub fn is_damping(samples: &[f32], rate_hz: u32, onset_s: f64) -> bool {
-    let (before, _) = energy_around(samples, rate_hz, onset_s);
+    let before = mean_square(samples, rate_hz, onset_s - LEVEL_SPAN_S, LEVEL_SPAN_S);
     let (from, to) = DAMPED_AFTER_S;
-    let after = slice(samples, rate_hz, onset_s + from, to - from);
-    let after =
-        after.iter().map(|&s| f64::from(s).powi(2)).sum::<f64>() / after.len().max(1) as f64;
+    let after = mean_square(samples, rate_hz, onset_s + from, to - from);
     after < DAMPED_SHARE * before
 }
 
