@@ -122,8 +122,9 @@ fn cli_render_writes_wav_motion_and_events() {
     assert!(std::fs::read(&spectra).unwrap().starts_with(b"\x89PNG"));
 }
 
-/// `--body-hz 5000` steps the body at 5 kHz with the drums and the contact at 10 kHz
-/// (and says so); a rate it does not offer is refused.
+/// `--body-hz 5000` steps the body at 5 kHz with the drums and the contact at 10 kHz,
+/// and at 2.5 kHz while calm (and says so); `--body-hz 10000` at 10 kHz throughout; a
+/// rate it does not offer is refused.
 #[test]
 fn cli_render_steps_the_body_at_the_rate_asked() {
     let dir = tempfile::tempdir().unwrap();
@@ -140,8 +141,13 @@ fn cli_render_steps_the_body_at_the_rate_asked() {
     let out = run("5000");
     let stdout = succeeded(&out);
     assert!(
-        stdout.contains("at 5000 Hz (body), 10000 Hz (drums and contact)"),
+        stdout.contains("at 5000 Hz (body; 2500 Hz while calm), 10000 Hz (drums and contact)"),
         "{stdout}"
+    );
+    let reference = succeeded(&run("10000"));
+    assert!(
+        reference.contains("at 10000 Hz (body), 10000 Hz (drums and contact)"),
+        "{reference}"
     );
     let refused = run("3000");
     assert!(!refused.status.success());

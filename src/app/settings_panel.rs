@@ -91,7 +91,10 @@ pub fn show(ui: &mut egui::Ui, doc: &LoadedScore, out: &mut Vec<Command>) {
                 "Body step",
                 &mut after.body_step,
                 &[
-                    (BodyStep::Fast, "fast (5 kHz between contacts)"),
+                    (
+                        BodyStep::Fast,
+                        "fast (5 kHz between contacts, 2.5 kHz while calm)",
+                    ),
                     (BodyStep::Reference, "reference (10 kHz)"),
                 ],
             );

@@ -126,13 +126,15 @@ impl FromStr for SoundModel {
 
 /// How finely the body's dynamics are stepped. The drums and the stick–head contact step
 /// at 10 kHz either way, and the body steps with them while a stick is on a head; between
-/// contacts the fast step moves the body every 0.2 ms (README "Physics (HIMC)", "a
-/// coarser body step": 0.23 mm RMS from the reference's tip paths on the demo scores).
+/// contacts the fast step moves the body every 0.2 ms, and every 0.4 ms with its fast PD
+/// loops implicit while it is calm, away from strokes and hand placements (README
+/// "Physics (HIMC)", "a coarser body step" and "calm stretches": 0.38 mm RMS from the
+/// reference's tip paths on the demo scores).
 #[derive(
     Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
 )]
 pub enum BodyStep {
-    /// 5 kHz between contacts (the default).
+    /// 5 kHz between contacts, 2.5 kHz while calm (the default).
     #[default]
     Fast,
     /// 10 kHz throughout: the reference the fast step is measured against.
@@ -150,6 +152,15 @@ impl BodyStep {
         match self {
             BodyStep::Fast => 2,
             BodyStep::Reference => 1,
+        }
+    }
+
+    /// Contact steps (10 kHz) per body step while the body is calm, its PD loops stepped
+    /// implicitly (0: no coarser step).
+    pub fn calm_substeps(self) -> usize {
+        match self {
+            BodyStep::Fast => 4,
+            BodyStep::Reference => 0,
         }
     }
 }

@@ -5,6 +5,8 @@
 //! upward acceleration of the pelvis. The joint-space mass matrix comes from the
 //! composite-rigid-body algorithm (CRBA, §6.2). [`Dynamics::step`] integrates with
 //! semi-implicit (symplectic) Euler on the rotation group: w += dt·ẇ, then q ← q·exp(w·dt).
+//! A joint's equation may carry implicit terms K·ẇ ([`Implicit`]: a PD loop stepped
+//! implicitly), which the articulated pass folds into that joint's inertia.
 //! Its energy error is first order in dt: at dt = 1e-4 s a passive body swinging for 1 s
 //! drifts by 0.2 % of the energy it exchanges, a collapsing one that whips the sticks to
 //! some 260 rad/s by 1.9 % (see the `energy_is_conserved` test).
@@ -267,6 +269,20 @@ pub struct TipResponse {
     pub mobility: DMat3,
 }
 
+/// What an articulated child passes to its parent: a translational block alone (a free ball
+/// joint) or a whole spatial inertia (a joint with [`Implicit`] terms).
+enum Child {
+    Translational(DMat3),
+    Full(SpatialInertia),
+}
+
+/// Terms K (N·m·s²/rad, 3×3 per joint, child frame) each joint's equation carries on its
+/// acceleration, Sᵀ·(IA·a + pA) + K·ẇ = τ: a PD loop stepped implicitly over a step h
+/// (stable PD, Tan, Liu & Turk 2011) has K = h·Kd + h²·Kp, the loop's torque at the end of
+/// the step being τ − K·ẇ. Zero for a joint without them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Implicit(pub [DMat3; N]);
+
 /// Forward dynamics of a [`BodyModel`].
 #[derive(Clone, Debug)]
 pub struct Dynamics {
@@ -357,11 +373,17 @@ impl Dynamics {
         external: &[ExternalForce],
     ) -> [DVec3; N] {
         self.kinematics(state);
-        self.articulated(tau, external)
+        self.articulated(tau, external, None)
     }
 
-    /// ABA passes two and three, after [`Self::kinematics`] of the state.
-    fn articulated(&mut self, tau: &[DVec3; N], external: &[ExternalForce]) -> [DVec3; N] {
+    /// ABA passes two and three, after [`Self::kinematics`] of the state, each joint's
+    /// equation carrying `implicit` (see [`Implicit`]).
+    fn articulated(
+        &mut self,
+        tau: &[DVec3; N],
+        external: &[ExternalForce],
+        implicit: Option<&Implicit>,
+    ) -> [DVec3; N] {
         let s = &mut self.scratch;
         s.ia = self.inertia;
         for i in 0..N {
@@ -374,19 +396,39 @@ impl Dynamics {
             let point = rt * (f.point_world - s.pos[i]);
             s.pa[i] = s.pa[i] - SpatialVec::new(point.cross(force), force);
         }
-        // Articulated inertias and bias forces, tips to root. Through a ball joint only
-        // the translational block survives: IA − U·D⁻¹·Uᵀ = [0 0; 0 C − Bᵀ·A⁻¹·B].
+        // Articulated inertias and bias forces, tips to root.
         for i in (0..N).rev() {
             let SpatialInertia { a, b, c } = s.ia[i];
-            let d_inv = a.inverse();
             let u = tau[i] - s.pa[i].ang;
-            let ia_c = c - b.transpose() * d_inv * b;
-            // pA + Ia·c + U·D⁻¹·u with U = [A; Bᵀ] and Ia = [0 0; 0 Ia_c].
-            let k = d_inv * u;
-            let pa = s.pa[i] + SpatialVec::new(a * k, ia_c * s.c[i].lin + b.transpose() * k);
+            let extra = implicit.map_or(DMat3::ZERO, |k| k.0[i]);
+            let (d_inv, child, pa) = if extra == DMat3::ZERO {
+                // Through a free ball joint only the translational block survives:
+                // IA − U·D⁻¹·Uᵀ = [0 0; 0 C − Bᵀ·A⁻¹·B].
+                let d_inv = a.inverse();
+                let ia_c = c - b.transpose() * d_inv * b;
+                // pA + Ia·c + U·D⁻¹·u with U = [A; Bᵀ] and Ia = [0 0; 0 Ia_c].
+                let k = d_inv * u;
+                let pa = s.pa[i] + SpatialVec::new(a * k, ia_c * s.c[i].lin + b.transpose() * k);
+                (d_inv, Child::Translational(ia_c), pa)
+            } else {
+                // D = A + K: the joint's own terms keep a share of the rotational block.
+                let d_inv = (a + extra).inverse();
+                let (da, db) = (d_inv * a, d_inv * b);
+                let ia = SpatialInertia {
+                    a: a - a * da,
+                    b: b - a * db,
+                    c: c - b.transpose() * db,
+                };
+                let k = d_inv * u;
+                let pa = s.pa[i] + ia.mul(s.c[i]) + SpatialVec::new(a * k, b.transpose() * k);
+                (d_inv, Child::Full(ia), pa)
+            };
             (s.d_inv[i], s.u[i]) = (d_inv, u);
             if let Some(p) = self.parent[i] {
-                s.ia[p] += s.x[i].translational_inertia_to_parent(ia_c);
+                s.ia[p] += match child {
+                    Child::Translational(ia_c) => s.x[i].translational_inertia_to_parent(ia_c),
+                    Child::Full(ia) => s.x[i].inertia_to_parent(&ia),
+                };
                 s.pa[p] = s.pa[p] + s.x[i].force_to_parent(pa);
             }
         }
@@ -421,9 +463,15 @@ impl Dynamics {
     /// How the tip of `side`, at `tip` (m, performer frame), answers a force on it under
     /// joint torques `tau` (N·m), in the state of the latest kinematics pass: four
     /// articulated passes (none, and a newton along each axis).
-    fn tip_response(&mut self, tau: &[DVec3; N], side: Side, tip: DVec3) -> TipResponse {
+    fn tip_response(
+        &mut self,
+        tau: &[DVec3; N],
+        side: Side,
+        tip: DVec3,
+        implicit: Option<&Implicit>,
+    ) -> TipResponse {
         let segment = Joint::arm(side)[3].index();
-        self.articulated(tau, &[]);
+        self.articulated(tau, &[], implicit);
         let free = self.tip_acceleration(side);
         let column = |dynamics: &mut Dynamics, axis: DVec3| {
             let push = ExternalForce {
@@ -431,7 +479,7 @@ impl Dynamics {
                 point_world: tip,
                 force_world: axis,
             };
-            dynamics.articulated(tau, &[push]);
+            dynamics.articulated(tau, &[push], implicit);
             dynamics.tip_acceleration(side) - free
         };
         let mobility = DMat3::from_cols(
@@ -460,18 +508,18 @@ impl Dynamics {
     /// to ask how a tip ([left, right] index) answers a force ([`TipResponse`], asked only
     /// when needed: it costs four articulated passes), and returns the force on each (N,
     /// performer frame), applied at the tip during the step. One kinematics pass serves
-    /// all.
+    /// all. With `implicit`, each joint's equation carries its terms (see [`Implicit`]).
     pub fn step_with_tip_forces(
         &mut self,
         state: &mut State,
-        tau: &[DVec3; N],
+        (tau, implicit): (&[DVec3; N], Option<&Implicit>),
         contact: impl FnOnce([(DVec3, DVec3); 2], &mut dyn FnMut(usize) -> TipResponse) -> [DVec3; 2],
         dt: f64,
     ) -> [(DVec3, DVec3); 2] {
         self.kinematics(state);
         let tips = self.tips_from_kinematics();
         let forces = contact(tips, &mut |h| {
-            self.tip_response(tau, [Side::Left, Side::Right][h], tips[h].0)
+            self.tip_response(tau, [Side::Left, Side::Right][h], tips[h].0, implicit)
         });
         let external: [ExternalForce; 2] = std::array::from_fn(|h| ExternalForce {
             segment: Joint::arm([Side::Left, Side::Right][h])[3].index(),
@@ -484,7 +532,7 @@ impl Dynamics {
             [false, true] => &external[1..],
             [true, true] => &external,
         };
-        let qdd = self.articulated(tau, external);
+        let qdd = self.articulated(tau, external, implicit);
         integrate(state, &qdd, dt);
         tips
     }
@@ -827,6 +875,49 @@ mod tests {
             let expected: Vec<f64> = free.iter().zip(&forced).map(|(a, b)| a + b).collect();
             let error: Vec<f64> = aba.iter().zip(&expected).map(|(a, b)| a - b).collect();
             assert!(max_abs(&error) < 1e-9 * max_abs(&aba), "{error:?}");
+        }
+    }
+
+    /// With implicit terms K (symmetric, positive, per joint) the articulated pass solves
+    /// (M + K)·ẇ = τ + M·ẇ_free: the joints' own terms added to the mass matrix's diagonal
+    /// blocks, as an implicit PD step needs.
+    #[test]
+    fn implicit_terms_add_to_the_mass_matrix() {
+        let mut dynamics = dynamics();
+        let mut rng = Rng::new(13);
+        for _ in 0..20 {
+            let state = random_state(&mut rng, 3.0);
+            let tau: [DVec3; N] = std::array::from_fn(|_| random_vec(&mut rng, 5.0));
+            let implicit = Implicit(std::array::from_fn(|j| {
+                if j % 4 == 0 {
+                    return DMat3::ZERO;
+                }
+                let a = DMat3::from_cols(
+                    random_vec(&mut rng, 0.2),
+                    random_vec(&mut rng, 0.2),
+                    random_vec(&mut rng, 0.2),
+                );
+                a * a.transpose()
+            }));
+            let free = flatten(&dynamics.accelerations(&state, &[DVec3::ZERO; N], &[]));
+            dynamics.kinematics(&state);
+            let qdd = flatten(&dynamics.articulated(&tau, &[], Some(&implicit)));
+            let m = dynamics.mass_matrix(&state);
+            let residual: Vec<f64> = (0..DOF)
+                .map(|r| {
+                    let (j, row) = (r / 3, r % 3);
+                    let k = implicit.0[j].row(row);
+                    let mk: f64 = (0..DOF).map(|c| m[r * DOF + c] * qdd[c]).sum::<f64>()
+                        + (0..3).map(|c| k[c] * qdd[3 * j + c]).sum::<f64>();
+                    let rhs =
+                        flatten(&tau)[r] + (0..DOF).map(|c| m[r * DOF + c] * free[c]).sum::<f64>();
+                    mk - rhs
+                })
+                .collect();
+            assert!(
+                max_abs(&residual) < 1e-9 * max_abs(&flatten(&tau)),
+                "{residual:?}"
+            );
         }
     }
 

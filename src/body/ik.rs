@@ -308,15 +308,16 @@ fn chain_step(
     let jwjt = columns
         .iter()
         .fold(DMat3::ZERO, |m, &(_, _, c, w)| m + outer(c, c) * w);
+    // (JWJᵀ + λ²I)⁻¹, zero where singular: the damped solve of the step and of the
+    // null-space pull share it.
+    let damped = safe_inverse(jwjt + DMat3::IDENTITY * params.damping_m.powi(2), 0.0);
     let y = match params.method {
         IkMethod::Transpose => {
             let jjt_e = jwjt * e;
             e * (e.dot(jjt_e) / jjt_e.length_squared().max(1e-12))
         }
-        IkMethod::PseudoInverse => safe_solve(jwjt, e, 1e-9),
-        IkMethod::DampedLeastSquares => {
-            safe_solve(jwjt + DMat3::IDENTITY * params.damping_m.powi(2), e, 0.0)
-        }
+        IkMethod::PseudoInverse => safe_inverse(jwjt, 1e-9) * e,
+        IkMethod::DampedLeastSquares => damped * e,
     };
     let mut step = [DVec3::ZERO; JOINT_COUNT];
     for &(i, a, c, w) in columns {
@@ -328,14 +329,15 @@ fn chain_step(
             normals[j.index()] = *n;
         }
         add_null_space_pull(
-            &mut step, columns, frames, pose, reference, jwjt, params, &normals,
+            &mut step, columns, frames, pose, reference, damped, params, &normals,
         );
     }
     step
 }
 
-/// Add z − W·Jᵀ(JWJᵀ + λ²I)⁻¹·J·z, where z turns each chain joint toward `reference`
-/// (a clamped joint's turn without its component along its outward normal `normals`).
+/// Add z − W·Jᵀ(JWJᵀ + λ²I)⁻¹·J·z (`damped`: the inverse), where z turns each chain
+/// joint toward `reference` (a clamped joint's turn without its component along its
+/// outward normal `normals`).
 #[allow(clippy::too_many_arguments)]
 fn add_null_space_pull(
     step: &mut [DVec3],
@@ -343,7 +345,7 @@ fn add_null_space_pull(
     frames: &Frames,
     pose: &Pose,
     reference: &Pose,
-    jwjt: DMat3,
+    damped: DMat3,
     params: &IkParams,
     normals: &[Option<DVec3>; JOINT_COUNT],
 ) {
@@ -362,7 +364,7 @@ fn add_null_space_pull(
     let jz = columns
         .iter()
         .fold(DVec3::ZERO, |s, &(i, a, c, _)| s + c * a.dot(z[i]));
-    let y = safe_solve(jwjt + DMat3::IDENTITY * params.damping_m.powi(2), jz, 0.0);
+    let y = damped * jz;
     for &(i, a, c, w) in columns {
         step[i] -= a * (w * c.dot(y));
     }
@@ -375,13 +377,13 @@ fn outer(a: DVec3, b: DVec3) -> DMat3 {
     DMat3::from_cols(a * b.x, a * b.y, a * b.z)
 }
 
-/// Solve m·y = e, returning zero where `m` is singular.
-fn safe_solve(m: DMat3, e: DVec3, min_det: f64) -> DVec3 {
+/// The inverse of `m`, zero where `m` is singular (so a solve m⁻¹·e gives zero there).
+fn safe_inverse(m: DMat3, min_det: f64) -> DMat3 {
     let det = m.determinant();
     if det.abs() <= min_det.max(f64::MIN_POSITIVE) || !det.is_finite() {
-        DVec3::ZERO
+        DMat3::ZERO
     } else {
-        m.inverse() * e
+        m.inverse()
     }
 }
 

@@ -18,18 +18,22 @@
 //! Task rate 250 Hz and simulation rate 10 kHz by default (40 sub-steps). The body may
 //! step coarser than the drums and the stick–head contact
 //! ([`SimParams::contact_substeps`]): the contact then runs its own sub-steps, the tips
-//! moving as point masses between the body's steps. The run stops with an error naming
-//! the time if the state becomes non-finite or diverges.
+//! moving as point masses between the body's steps; and coarser still while it is calm,
+//! away from every stroke and hand placement ([`SimParams::calm_substeps`]), its fast PD
+//! loops then stepped implicitly (stable PD) so the light sticks no longer set the step.
+//! The run stops with an error naming the time if the state becomes non-finite or
+//! diverges.
 
 use super::control::{Gains, limit_torques, pd_torque, pd_torques, rotation_error};
-use super::dynamics::{Dynamics, State, TipResponse};
+use super::dynamics::{Dynamics, Implicit, State, TipResponse};
 use super::ik::{self, IkParams};
 use super::limits::JointLimits;
 use super::model::BodyModel;
 use super::skeleton::{JOINT_COUNT, Joint, Pose};
 pub use crate::base::choices::{BodyStep, Pipeline};
 use crate::kit::Side;
-use glam::DVec3;
+use glam::{DMat3, DVec3};
+use std::f64::consts::TAU;
 
 /// Simulation settings.
 #[derive(Clone, Debug, PartialEq)]
@@ -44,6 +48,11 @@ pub struct SimParams {
     /// body at `sim_hz` too (the reference). The largest divisor of the contact steps per
     /// task interval (`sim_hz` over the task rate) not above it is used.
     pub contact_substeps: usize,
+    /// Contact steps per body step while the body is calm — no stroke scored within
+    /// [`CALM_MARGIN_S`], no hand placed, no stick on a head — with the PD loops stepped
+    /// implicitly there (stable PD, [`Implicit`]: explicit loops of the light sticks
+    /// would not stay stable at that step); 0 keeps `contact_substeps` throughout.
+    pub calm_substeps: usize,
     /// Natural frequency of each joint's PD loop, Hz.
     pub frequency_hz: [f64; JOINT_COUNT],
     /// Damping ratio of the PD loops.
@@ -93,6 +102,7 @@ impl Default for SimParams {
         SimParams {
             sim_hz: 10_000.0,
             contact_substeps: 1,
+            calm_substeps: 0,
             frequency_hz: super::control::DEFAULT_FREQUENCY_HZ,
             zeta: 1.0,
             max_torque: 300.0,
@@ -139,6 +149,15 @@ pub struct Reference {
     /// when the hands only carry the sticks.
     pub hands: Option<HandTargets>,
 }
+
+/// A body is calm (see [`SimParams::calm_substeps`]) this long, s, before and after every
+/// scored stroke: the compensation moves a stroke's target by at most 35 ms, and its
+/// contact and rebound are over well within this.
+pub const CALM_MARGIN_S: f64 = 0.08;
+
+/// A PD loop whose ω·dt is below this over a body step is stepped explicitly even in a
+/// calm stretch (the 8 Hz loops of trunk, neck and head: 0.02 at 2.5 kHz).
+const SLOW_LOOP: f64 = 0.1;
 
 /// Rounds of [`place_hand`] in a task-rate IK solve.
 const HAND_SOLVE_ROUNDS: usize = 40;
@@ -471,8 +490,10 @@ pub struct Simulator {
     /// Contact steps per task interval, and their length, s.
     substeps: usize,
     dt: f64,
-    /// Contact steps per body step (a divisor of `substeps`).
+    /// Contact steps per body step (a divisor of `substeps`), and while calm (0: never
+    /// coarser).
     contact_substeps: usize,
+    calm_substeps: usize,
     initial: Pose,
     state: State,
     /// Whether each tip (left, right) felt a contact force in the latest step.
@@ -495,10 +516,19 @@ impl Simulator {
     ) -> Result<Simulator, SimError> {
         let substeps = (params.sim_hz / reference.rate_hz).round().max(1.0) as usize;
         // The largest divisor of the task interval's steps not above the setting.
-        let contact_substeps = (1..=params.contact_substeps.clamp(1, substeps))
-            .rev()
-            .find(|n| substeps.is_multiple_of(*n))
-            .unwrap_or(1);
+        // The largest divisor of the task interval's steps not above a setting.
+        let divisor = |setting: usize| {
+            (1..=setting.clamp(1, substeps))
+                .rev()
+                .find(|n| substeps.is_multiple_of(*n))
+                .unwrap_or(1)
+        };
+        let contact_substeps = divisor(params.contact_substeps);
+        let calm_substeps = if params.calm_substeps > contact_substeps {
+            divisor(params.calm_substeps)
+        } else {
+            0
+        };
         let mut dynamics = Dynamics::new(model.clone());
         // The body starts within its limits (a stop met at full depth would fling it).
         let initial: &Pose = &std::array::from_fn(|j| {
@@ -530,6 +560,7 @@ impl Simulator {
             substeps,
             dt: 1.0 / (reference.rate_hz * substeps as f64),
             contact_substeps,
+            calm_substeps,
             initial: *initial,
             state,
             touching: [false; 2],
@@ -700,7 +731,11 @@ impl Simulator {
         // a stick is on a head (as the reference does): a stiff contact stepped coarsely
         // by the body's semi-implicit Euler would leave the tip a little high each step
         // (by dt²·F/m) and strike a few per cent softer.
-        let coarse = self.contact_substeps;
+        let coarse = if self.is_calm(reference, k) {
+            self.calm_substeps
+        } else {
+            self.contact_substeps
+        };
         // The nested IK's goal, held between its solves.
         let mut solved: Option<Pose> = None;
         let mut c = 0;
@@ -794,6 +829,8 @@ impl Simulator {
                     }
                 }
             }
+            let implicit = (len > self.contact_substeps)
+                .then(|| self.implicit_terms(&mut tau, held, &target_w, dt));
             if self.params.limits.iter().any(Option::is_some) {
                 let mut stops = limit_torques(
                     &self.gains,
@@ -823,7 +860,7 @@ impl Simulator {
             let mut touching = [false; 2];
             self.dynamics.step_with_tip_forces(
                 &mut self.state,
-                &tau,
+                (&tau, implicit.as_ref()),
                 |tips, respond| {
                     let forces;
                     (forces, touching) =
@@ -855,6 +892,65 @@ impl Simulator {
         let q = self.state.q;
         self.record(&q);
         self.check_tracking(reference, k)
+    }
+
+    /// Whether the task interval ending at sample `k` is calm (see
+    /// [`SimParams::calm_substeps`]): coarser body steps are allowed, no stick on a head,
+    /// no hand placed at either end and no scored stroke within [`CALM_MARGIN_S`].
+    fn is_calm(&self, reference: &Reference, k: usize) -> bool {
+        if self.calm_substeps == 0 || self.touching.contains(&true) {
+            return false;
+        }
+        let placed = reference.hands.as_ref().is_some_and(|hands| {
+            hands
+                .weight
+                .iter()
+                .any(|w| w.get(k - 1..=k).is_some_and(|w| w.iter().any(|w| *w > 0.0)))
+        });
+        let (from, to) = (
+            (k - 1) as f64 / reference.rate_hz,
+            k as f64 / reference.rate_hz,
+        );
+        let first = reference
+            .beats
+            .partition_point(|(t, _)| *t < from - CALM_MARGIN_S);
+        let near = reference
+            .beats
+            .get(first)
+            .is_some_and(|(t, _)| *t <= to + CALM_MARGIN_S);
+        !placed && !near
+    }
+
+    /// The PD loops' implicit terms over a body step of `dt` s (see [`Implicit`]):
+    /// K = dt·Kd + dt²·Kp per joint, and `tau` less dt·Kp·(w − w_target), what the
+    /// stiffness loses as the joint moves over the step (the grips' gains scaled by the
+    /// fraction `held` as [`pd_torque`] scales them). A loop slow against the step
+    /// (ω·dt below [`SLOW_LOOP`]: the trunk, neck and head) stays explicit, which spares
+    /// the articulated pass a full inertia through its joint.
+    fn implicit_terms(
+        &self,
+        tau: &mut [DVec3; JOINT_COUNT],
+        held: Option<[f64; 2]>,
+        target_w: &[DVec3; JOINT_COUNT],
+        dt: f64,
+    ) -> Implicit {
+        let mut fraction = [1.0; JOINT_COUNT];
+        if let Some(held) = held {
+            for (side, f) in [Side::Left, Side::Right].into_iter().zip(held) {
+                fraction[Joint::arm(side)[3].index()] = f.min(1.0);
+            }
+        }
+        Implicit(std::array::from_fn(|j| {
+            if TAU * self.params.frequency_hz[j] * dt < SLOW_LOOP {
+                return DMat3::ZERO;
+            }
+            let (kp, kd) = (
+                self.gains.stiffness[j] * fraction[j],
+                self.gains.damping[j] * fraction[j].sqrt(),
+            );
+            tau[j] -= dt * (kp * (self.state.w[j] - target_w[j]));
+            kd * dt + kp * (dt * dt)
+        }))
     }
 
     /// Stop when a tip at task sample `k` is farther than the limit from its target.

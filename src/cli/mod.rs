@@ -171,8 +171,8 @@ pub enum Command {
         seed: u64,
     },
     /// Render a score to sound (and motion): compose, simulate the body striking the modal
-    /// drums (at 10 kHz, the body at 5 kHz between contacts) with timing compensation,
-    /// synthesise 48 kHz stereo.
+    /// drums (at 10 kHz, the body at 5 kHz between contacts and 2.5 kHz while calm) with
+    /// timing compensation, synthesise 48 kHz stereo.
     Render {
         /// The score (.ron).
         score: PathBuf,

@@ -10,7 +10,7 @@ use super::args::{
     WavFormatArg,
 };
 use crate::base::ron_file;
-use crate::body::sim::{Pipeline, SimParams};
+use crate::body::sim::{BodyStep, Pipeline, SimParams};
 use crate::exports;
 use crate::io::{bvh, figures, video};
 use crate::mocap::shipped::DbSource;
@@ -254,6 +254,12 @@ pub fn rendered(
             contact_substeps: body_hz.map_or(settings.sim.contact_substeps, |hz| {
                 (settings.sim.sim_hz / hz).round().max(1.0) as usize
             }),
+            // The fast step's calm stretches only at its own rate.
+            calm_substeps: body_hz.map_or(settings.sim.calm_substeps, |hz| {
+                let fast = BodyStep::Fast;
+                let rate = settings.sim.sim_hz / fast.contact_substeps() as f64;
+                if hz == rate { fast.calm_substeps() } else { 0 }
+            }),
             ..settings.sim.clone()
         },
         ..settings
@@ -465,8 +471,12 @@ fn print_stats(r: &Rendering) {
     let s = &r.stats;
     let contact_hz = 1.0 / r.drums.dt_s();
     let body_hz = contact_hz / r.params.sim.contact_substeps.max(1) as f64;
+    let calm = match r.params.sim.calm_substeps {
+        0 => String::new(),
+        n => format!("; {:.0} Hz while calm", contact_hz / n as f64),
+    };
     println!(
-        "score: {:.2} s of motion, {} strokes in {} clusters at {body_hz:.0} Hz (body), \
+        "score: {:.2} s of motion, {} strokes in {} clusters at {body_hz:.0} Hz (body{calm}), \
          {contact_hz:.0} Hz (drums and contact)",
         s.score_s,
         r.composition.strokes.len(),

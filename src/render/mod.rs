@@ -133,6 +133,7 @@ impl RenderParams {
                     ..sim.ik.clone()
                 },
                 contact_substeps: settings.body_step.contact_substeps(),
+                calm_substeps: settings.body_step.calm_substeps(),
                 ..sim
             },
             gain_scale: settings.gain_scale,
@@ -156,6 +157,7 @@ impl Default for RenderParams {
             modes: ModeConfig::default(),
             sim: SimParams {
                 contact_substeps: BodyStep::default().contact_substeps(),
+                calm_substeps: BodyStep::default().calm_substeps(),
                 ..SimParams::default()
             },
             joint_limits: false,
