@@ -515,7 +515,6 @@ impl Simulator {
         gains_scale: &[f64; JOINT_COUNT],
     ) -> Result<Simulator, SimError> {
         let substeps = (params.sim_hz / reference.rate_hz).round().max(1.0) as usize;
-        // The largest divisor of the task interval's steps not above the setting.
         // The largest divisor of the task interval's steps not above a setting.
         let divisor = |setting: usize| {
             (1..=setting.clamp(1, substeps))
