@@ -244,7 +244,7 @@ fn export_writes_wav_and_motion() {
     assert!(samples.len() > 2 * 48_000, "seconds of sound");
     let worst = samples
         .iter()
-        .zip(&r.audio.samples)
+        .zip(r.audio.samples.iter())
         .map(|(&s, &a)| (f64::from(s) / 32767.0 - f64::from(a)).abs())
         .fold(0.0, f64::max);
     assert!(worst < 1e-4, "16-bit rounding only: {worst}");

@@ -103,11 +103,11 @@ fn noise_is_refused_as_a_note() {
     let dir = tempfile::tempdir().unwrap();
     let noise = dir.path().join("room-tone.wav");
     let mut rng = timpanist::base::rng::Rng::new(9);
-    let samples = (0..88_200)
+    let samples: Vec<f32> = (0..88_200)
         .map(|_| rng.uniform(-0.05, 0.05) as f32)
         .collect();
     let audio = timpanist::sound::Audio {
-        samples,
+        samples: samples.into(),
         channels: 1,
         rate_hz: 44_100,
         gain: 1.0,

@@ -352,7 +352,7 @@ fn a_failure_midway_leaves_no_partial_pack() {
     let audio = timpanist::sound::Audio {
         rate_hz: 48_000,
         channels: 2,
-        samples: vec![0.1; 2 * 48_000 * 3],
+        samples: vec![0.1; 2 * 48_000 * 3].into(),
         gain: 1.0,
     };
     let performance = Performance {

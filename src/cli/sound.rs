@@ -23,7 +23,7 @@ pub fn stroke(
     let audio = crate::sound::Audio {
         rate_hz: crate::sound::SAMPLE_RATE_HZ,
         channels: 1,
-        samples: mono,
+        samples: mono.into(),
         gain: 1.0,
     };
     crate::sound::write_wav(wav, &audio)?;

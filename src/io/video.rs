@@ -335,7 +335,7 @@ mod tests {
         Audio {
             rate_hz: 48_000,
             channels: 2,
-            samples: vec![0.0; 2 * 4800],
+            samples: vec![0.0; 2 * 4800].into(),
             gain: 1.0,
         }
     }

@@ -79,13 +79,13 @@ pub fn hand_stems(
         for (j, (drum, mono)) in kit.drums.iter().zip(&monos).enumerate() {
             let sympathy = sympathies.get(j).map(Vec::as_slice);
             let stem = super::stem(drum, model, (mono, sympathy), mix.gain);
-            for (s, x) in samples.iter_mut().zip(&stem.samples) {
+            for (s, x) in samples.iter_mut().zip(stem.samples.iter()) {
                 *s += x;
             }
         }
         room::reverberate(voicing.room, &mut samples);
         Audio {
-            samples,
+            samples: samples.into(),
             ..mix.clone()
         }
     }))

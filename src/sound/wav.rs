@@ -60,7 +60,7 @@ pub fn write_wav_as(path: &Path, audio: &Audio, format: WavFormat) -> Result<(),
     {
         let mut writer = hound::WavWriter::new(&mut bytes, spec).map_err(wav)?;
         let full_scale = f64::from((1u32 << (format.bits() - 1)) - 1);
-        for &s in &audio.samples {
+        for &s in audio.samples.iter() {
             match format {
                 WavFormat::Float32 => writer.write_sample(s),
                 WavFormat::Pcm16 | WavFormat::Pcm24 => {
@@ -94,7 +94,7 @@ mod tests {
         let audio = Audio {
             rate_hz: 48_000,
             channels: 2,
-            samples: vec![0.0, 0.5, -0.5, 1.0, -1.0, 0.25],
+            samples: vec![0.0, 0.5, -0.5, 1.0, -1.0, 0.25].into(),
             gain: 1.0,
         };
         write_wav(&path, &audio).unwrap();
@@ -102,7 +102,7 @@ mod tests {
         assert_eq!(r.spec().channels, 2);
         assert_eq!(r.spec().sample_rate, 48_000);
         let back: Vec<i16> = r.samples::<i16>().map(|s| s.unwrap()).collect();
-        for (b, a) in back.iter().zip(&audio.samples) {
+        for (b, a) in back.iter().zip(audio.samples.iter()) {
             assert!((f64::from(*b) / 32767.0 - f64::from(*a)).abs() < 1e-4);
         }
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
@@ -124,7 +124,7 @@ mod tests {
         let audio = Audio {
             rate_hz: 48_000,
             channels: 2,
-            samples: vec![0.0, 0.123_456_79, -0.5, 1.0, -1.0, 1e-6],
+            samples: vec![0.0, 0.123_456_79, -0.5, 1.0, -1.0, 1e-6].into(),
             gain: 1.0,
         };
         let p24 = dir.path().join("24.wav");
@@ -132,7 +132,7 @@ mod tests {
         let mut r = hound::WavReader::open(&p24).unwrap();
         assert_eq!(r.spec().bits_per_sample, 24);
         let back: Vec<i32> = r.samples::<i32>().map(|s| s.unwrap()).collect();
-        for (b, a) in back.iter().zip(&audio.samples) {
+        for (b, a) in back.iter().zip(audio.samples.iter()) {
             assert!((f64::from(*b) / 8_388_607.0 - f64::from(*a)).abs() <= 0.5 / 8_388_607.0);
         }
         assert_eq!(back[3], 8_388_607);
@@ -141,6 +141,6 @@ mod tests {
         let mut r = hound::WavReader::open(&pf).unwrap();
         assert_eq!(r.spec().sample_format, hound::SampleFormat::Float);
         let back: Vec<f32> = r.samples::<f32>().map(|s| s.unwrap()).collect();
-        assert_eq!(back, audio.samples);
+        assert_eq!(back, *audio.samples);
     }
 }

@@ -334,7 +334,7 @@ mod tests {
         let audio = Audio {
             rate_hz: rate as u32,
             channels: 2,
-            samples,
+            samples: samples.into(),
             gain: 1.0,
         };
         let s = strike_spectrum(&audio, 0.5, ANALYSIS_S);

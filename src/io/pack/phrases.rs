@@ -122,7 +122,7 @@ pub fn slice(audio: &Audio, from_s: f64, to_s: f64) -> Audio {
     Audio {
         rate_hz: audio.rate_hz,
         channels: audio.channels,
-        samples,
+        samples: samples.into(),
         gain: audio.gain,
     }
 }
@@ -191,7 +191,7 @@ mod tests {
         let audio = Audio {
             rate_hz: 1000,
             channels: 2,
-            samples: vec![0.5; 2 * 3000],
+            samples: vec![0.5; 2 * 3000].into(),
             gain: 1.0,
         };
         let cut = slice(&audio, 1.0, 2.0);
