@@ -679,7 +679,11 @@ impl Run<'_> {
                 }
                 sound
             });
-            let mut sent_s = comp.start_s;
+            // Counted from where this rendering resumed: a job cuts the sound's state at
+            // its end, so one sent as soon as a resumed rendering settled its first
+            // cluster made every drum's sound be made again from there, also the drums
+            // whose strokes did not change.
+            let mut sent_s = comp.time(performance.sim.samples().max(1) - 1);
             let mut settled = |p: &Performance| {
                 let end_s = comp.time(p.sim.samples().max(1) - 1);
                 if model != SoundModel::Modal || end_s < sent_s + SOUND_AHEAD_S {
@@ -767,7 +771,10 @@ impl Run<'_> {
             let simulated_to_s = comp.start_s + samples as f64 / comp.rate_hz;
             (simulated_to_s, simulated_to_s - 2.0 * drums.dt_s())
         };
-        let previous = std::mem::take(&mut state.sound);
+        let mut previous = std::mem::take(&mut state.sound);
+        if !complete {
+            previous.hold_gain();
+        }
         let (audio, sound) = crate::sound::render_touched(
             self.kit,
             drums,

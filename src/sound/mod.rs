@@ -181,6 +181,9 @@ pub struct SoundState {
     heard: Arc<Vec<f32>>,
     /// The normalisation gain `heard` was scaled by ([`Audio::gain`]).
     gain: f64,
+    /// Whether the next synthesis keeps `gain` while its peaks stay within the limit with
+    /// it ([`SoundState::hold_gain`]).
+    hold_gain: bool,
 }
 
 /// When hands rest on drum `j`'s head, from when to when (s), in time order: the
@@ -447,6 +450,10 @@ pub fn resynthesise_on(
     cores: Cores,
 ) -> Result<SoundState, SoundError> {
     let calibration = calibration::Calibration::shipped();
+    let previous = previous.map(|mut state| {
+        state.hold_gain();
+        state
+    });
     synthesise_on(
         kit,
         sounding,
@@ -602,11 +609,13 @@ fn synthesise_on(
     // The audio: what is heard, scaled again from the first block rewritten (all of it
     // when the gain changed).
     let peak = state.peaks.iter().copied().fold(0.0f32, f32::max);
-    let gain = if f64::from(peak) > PEAK_LIMIT {
+    let own = if f64::from(peak) > PEAK_LIMIT {
         PEAK_LIMIT / f64::from(peak)
     } else {
         1.0
     };
+    let held = std::mem::take(&mut state.hold_gain) && state.gain > 0.0 && state.gain <= own;
+    let gain = if held { state.gain } else { own };
     let from = if gain == state.gain {
         2 * first_block * PEAK_BLOCK
     } else {
@@ -640,11 +649,31 @@ impl SoundState {
     pub fn own_audio(&mut self) {
         Arc::make_mut(&mut self.heard);
     }
+
+    /// Let the next synthesis keep this state's normalisation gain while its peaks stay
+    /// within [`PEAK_LIMIT`] with it, instead of taking the gain of its own peaks: for a
+    /// partial rendering, whose sound stops before the score ends (the rest, not made
+    /// again yet, is as loud as before, so the level does not jump when it comes, and only
+    /// what changed is scaled again). A whole rendering takes its own peaks' gain.
+    pub fn hold_gain(&mut self) {
+        self.hold_gain = true;
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The standard kit's 26-inch drum struck once by a scripted stick at `speed_mps`.
+    fn struck(kit: &Kit, speed_mps: f64) -> DrumSet {
+        use crate::drum::{ModeConfig, strike};
+        let (mallet, drum) = (&kit.mallets[0], &kit.drums[2]);
+        let mut drums = DrumSet::new(kit, mallet, &ModeConfig::default(), 1e-4).unwrap();
+        let point = drum.point_on_head(0.6, 0.0);
+        let side = crate::kit::Side::Right;
+        strike::scripted(&mut drums, drum, mallet, side, point, speed_mps, 0.5);
+        drums
+    }
 
     /// A rendering's audio is the sound state's own buffer, handed over without a copy;
     /// a synthesis resumed from that state while the audio is still played (a louder
@@ -652,17 +681,8 @@ mod tests {
     /// handed over as it was, and gives what a whole render gives.
     #[test]
     fn audio_is_shared_and_a_resumed_synthesis_leaves_it_alone() {
-        use crate::drum::{ModeConfig, strike};
-        use crate::kit::Side;
         let kit = Kit::standard();
-        let (mallet, drum) = (&kit.mallets[0], &kit.drums[2]);
-        let struck = |speed_mps: f64| {
-            let mut drums = DrumSet::new(&kit, mallet, &ModeConfig::default(), 1e-4).unwrap();
-            let point = drum.point_on_head(0.6, 0.0);
-            strike::scripted(&mut drums, drum, mallet, Side::Right, point, speed_mps, 0.5);
-            drums
-        };
-        let (soft, loud) = (struck(1.0), struck(20.0));
+        let (soft, loud) = (struck(&kit, 1.0), struck(&kit, 20.0));
         let (first, state) = render_resuming(&kit, &soft, 1.5, SoundModel::Modal, None).unwrap();
         assert!(
             Arc::ptr_eq(&first.samples, &state.heard),
@@ -680,6 +700,31 @@ mod tests {
             second.gain,
             first.gain
         );
+    }
+
+    /// A held gain: the next synthesis keeps the state's gain while its peaks stay within
+    /// the limit with it (its samples are the mix at that gain), and only the next; the
+    /// one after takes its own peaks' gain, as a whole render does.
+    #[test]
+    fn a_held_gain_lasts_one_synthesis() {
+        let kit = Kit::standard();
+        let (soft, loud) = (struck(&kit, 1.0), struck(&kit, 20.0));
+        let (_, mut state) = render_resuming(&kit, &loud, 1.5, SoundModel::Modal, None).unwrap();
+        let g = state.gain;
+        assert!(g < 1.0, "{g}");
+        state.hold_gain();
+        let (held, state) =
+            render_resuming(&kit, &soft, 1.5, SoundModel::Modal, Some(state)).unwrap();
+        let whole = render(&kit, &soft, 1.5, SoundModel::Modal).unwrap();
+        assert_eq!((held.gain, whole.gain), (g, 1.0));
+        assert!(
+            held.samples
+                .iter()
+                .zip(whole.samples.iter())
+                .all(|(h, w)| *h == (f64::from(*w) * g) as f32)
+        );
+        let (again, _) = render_resuming(&kit, &soft, 1.5, SoundModel::Modal, Some(state)).unwrap();
+        assert_eq!(again, whole);
     }
 
     /// A replayed note is untouched before a hand rests on the head, decays with the
