@@ -463,7 +463,7 @@ pub fn render_composition(
     }) {
         return Err(RenderError::Cancelled);
     }
-    let simulated_s = composition.time(state.performance.sim.samples().max(1) - 1);
+    let simulated_s = simulated_to_s(&composition, &state.performance);
     let (touches, damping) = damping::touches(
         &composition,
         state.performance.sim.motion(),
@@ -504,6 +504,11 @@ pub fn render_composition(
         touches,
         damping,
     })
+}
+
+/// The score time `performance` of `comp` is simulated to (its last sample), s.
+fn simulated_to_s(comp: &Composition, performance: &Performance) -> f64 {
+    comp.time(performance.sim.samples().max(1) - 1)
 }
 
 /// One rendering's fixed inputs.
@@ -683,9 +688,9 @@ impl Run<'_> {
             // its end, so one sent as soon as a resumed rendering settled its first
             // cluster made every drum's sound be made again from there, also the drums
             // whose strokes did not change.
-            let mut sent_s = comp.time(performance.sim.samples().max(1) - 1);
+            let mut sent_s = simulated_to_s(comp, performance);
             let mut settled = |p: &Performance| {
-                let end_s = comp.time(p.sim.samples().max(1) - 1);
+                let end_s = simulated_to_s(comp, p);
                 if model != SoundModel::Modal || end_s < sent_s + SOUND_AHEAD_S {
                     return;
                 }
@@ -764,11 +769,10 @@ impl Run<'_> {
         let comp = self.composition;
         let drums = &state.performance.drums;
         let (end_s, ready_s) = if complete {
-            let end_s = comp.start_s + (comp.len() - 1) as f64 / comp.rate_hz + self.params.tail_s;
+            let end_s = comp.time(comp.len() - 1) + self.params.tail_s;
             (end_s, end_s)
         } else {
-            let samples = state.performance.sim.samples().max(1) - 1;
-            let simulated_to_s = comp.start_s + samples as f64 / comp.rate_hz;
+            let simulated_to_s = simulated_to_s(comp, &state.performance);
             (simulated_to_s, simulated_to_s - 2.0 * drums.dt_s())
         };
         let mut previous = std::mem::take(&mut state.sound);

@@ -439,8 +439,9 @@ fn render_on(
 }
 
 /// [`render_touched_on`] without its audio: only the state a later rendering resumes
-/// (for sound made ahead while the body is still simulated, which nobody plays; it
-/// saves copying the whole mix).
+/// (for sound made ahead while the body is still simulated, which nobody plays), holding
+/// the state's normalisation gain ([`SoundState::hold_gain`]) so the audio it keeps is
+/// scaled again only where the sound changed.
 pub fn resynthesise_on(
     kit: &Kit,
     sounding: (&DrumSet, &[Touch]),
