@@ -3,10 +3,12 @@
 //! strict RON reading with atomic writing, the limits inputs are held to, the median, the
 //! words of a gesture score (side, hand, playing mode, grip, dynamic, impact location), a
 //! performed hit (`hit`: what `render` makes and `io` writes) and the choices its settings
-//! make (control pipeline, IK method, mode frequencies, sound model), and work spread
-//! over threads in order (`parallel`). Imports no other module of the crate.
+//! make (control pipeline, IK method, mode frequencies, sound model), work spread over
+//! threads in order (`parallel`) and records kept in shared chunks that clone without a
+//! copy (`chunks`). Imports no other module of the crate.
 
 pub mod choices;
+pub mod chunks;
 pub mod dirs;
 pub mod gesture;
 pub mod hit;

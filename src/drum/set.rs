@@ -24,6 +24,7 @@ use super::contact::HertzContact;
 use super::modes::HeadModes;
 use super::oscillator::ModeStep;
 use super::{DrumError, ModeConfig};
+use crate::base::chunks::SharedChunks;
 use crate::kit::{Kit, Mallet, Retune, Side};
 use glam::{DVec2, DVec3};
 use std::sync::Arc;
@@ -266,8 +267,10 @@ pub struct DrumSet {
     /// Time of step 0, s.
     first_time_s: f64,
     /// Every [`MEMBRANE_FRAME_STEPS`] steps from step 0, each head's coupled mode
-    /// displacements q_k (m), heads one after another: the membranes' motion to show.
-    membrane: Vec<f32>,
+    /// displacements q_k (m), heads one after another: the membranes' motion to show,
+    /// in chunks of whole frames shared with the set's clones (a rendering handed over
+    /// while the performance goes on does not copy it).
+    membrane: SharedChunks<f32>,
     /// Scratch: whether a tip came near each head this step.
     near: Vec<bool>,
     /// The pedal changes the heads carry out, in time order.
@@ -276,6 +279,8 @@ pub struct DrumSet {
 
 /// Steps between recorded membrane frames (10 ms at 10 kHz).
 pub const MEMBRANE_FRAME_STEPS: u64 = 100;
+/// Membrane frames per shared chunk of the record (1 s at 10 kHz).
+const MEMBRANE_CHUNK_FRAMES: usize = 100;
 
 const SIDES: [Side; 2] = [Side::Left, Side::Right];
 
@@ -297,6 +302,7 @@ impl DrumSet {
             .into_iter()
             .collect::<Result<Vec<_>, DrumError>>()?;
         let heads_len = heads.len();
+        let per_frame: usize = heads.iter().map(|h| h.coupled.len()).sum();
         let most = heads
             .iter()
             .map(|h| h.modes.modes().len())
@@ -314,7 +320,7 @@ impl DrumSet {
             excitation: Vec::new(),
             shapes: [vec![0.0; most], vec![0.0; most]],
             first_time_s: 0.0,
-            membrane: Vec::new(),
+            membrane: SharedChunks::new(per_frame * MEMBRANE_CHUNK_FRAMES),
             near: vec![false; heads_len],
             retunes: Vec::new(),
         })
@@ -565,7 +571,7 @@ impl DrumSet {
             excitation: self.excitation.clone(),
             shapes: self.shapes.clone(),
             first_time_s: self.first_time_s,
-            membrane: Vec::new(),
+            membrane: SharedChunks::new(1),
             near: self.near.clone(),
             retunes: self.retunes.clone(),
         }
@@ -637,7 +643,9 @@ impl DrumSet {
             return None;
         }
         let offset: usize = self.heads[..drum].iter().map(|h| h.coupled.len()).sum();
-        let q = &self.membrane[f as usize * per_frame + offset..][..head.coupled.len()];
+        let q = self
+            .membrane
+            .slice(f as usize * per_frame + offset, head.coupled.len());
         (!q.iter().all(|q| q.abs() < 1e-9)).then_some(q)
     }
 
@@ -766,7 +774,7 @@ mod tests {
         assert!(largest > 1e-5, "the head rings: {largest} m");
         assert!(lazy.heads[2].lag > 0 && stepped.heads[2].lag == 0);
         assert_eq!(lazy.membrane.len(), stepped.membrane.len());
-        for (a, b) in lazy.membrane.iter().zip(&stepped.membrane) {
+        for (a, b) in lazy.membrane.iter().zip(stepped.membrane.iter()) {
             assert!((a - b).abs() <= 1e-9, "{a} vs {b}");
         }
     }

@@ -226,11 +226,15 @@ pub fn resynthesise(
         .fold(usize::MAX, usize::min)
         .min(out.len());
     let touched = !entries.is_empty();
-    // A silent drum's output is zero: only what it held since `from` is cleared.
-    let start = if touched {
-        resume_frame(&synth.saved, from)
-    } else {
-        from
+    let was_silent = synth.heard.is_empty() && synth.saved.is_empty();
+    // A silent drum's output is zero: only what it held since `from` is cleared. One
+    // struck for the first time is at rest and silent until the block of its first
+    // entry, so it starts there (not at frame 0, which would make every head that hears
+    // it sympathetically ring again from the start too).
+    let start = match entries.first() {
+        None => from,
+        Some(e) if was_silent => span(e.time_s).1 / BLOCK * BLOCK,
+        Some(_) => resume_frame(&synth.saved, from),
     }
     .min(frames);
     synth.saved.retain(|s| s.frame <= start);

@@ -252,6 +252,7 @@ pub fn resynthesise(
     let fs = f64::from(SAMPLE_RATE_HZ);
     let damping = super::touch_factor(fs / DECIMATION as f64) as f32;
     let mut ringing = start > 0;
+    let mut input = Vec::new();
     for n0 in (start..frames).step_by(BLOCK) {
         let now = tuning_at(tunings, n0);
         if now != index {
@@ -265,7 +266,7 @@ pub fn resynthesise(
             continue;
         };
         let stride = rx.bank.stride();
-        let mut input = vec![0.0f32; steps * stride];
+        input.resize(steps * stride, 0.0);
         if n0.is_multiple_of(SAVE_EVERY_BLOCKS * BLOCK) {
             state.saved.push((n0, rx.bank.state(), last, images));
         }
@@ -283,15 +284,17 @@ pub fn resynthesise(
             let mut field = [0.0f64; 3];
             for (i, delay, scale, [cos, sin]) in &rx.sources {
                 let mono = monos[*i];
-                let sample = |m: usize| mono.get(m).map_or(0.0, |v| f64::from(*v));
-                // The radiated sound at frame n here: the source's derivative, delayed.
-                let at = |n: usize| {
-                    n.checked_sub(*delay).map_or(0.0, |m| {
-                        let before = if m == 0 { 0.0 } else { sample(m - 1) };
-                        (sample(m) - before) * fs
-                    })
+                // The source's output as heard here at frame n (delayed; 0 before it).
+                let heard = |n: usize| {
+                    n.checked_sub(*delay)
+                        .and_then(|m| mono.get(m))
+                        .map_or(0.0, |v| f64::from(*v))
                 };
-                let mean: f64 = (a..z).map(at).sum::<f64>() / (z - a) as f64;
+                let heard_before = |n: usize| if n == 0 { 0.0 } else { heard(n - 1) };
+                // The radiated sound at frame n here: the source's derivative, delayed.
+                let at = |n: usize| (heard(n) - heard_before(n)) * fs;
+                // Its mean over the sub-step telescopes to the ends.
+                let mean = (heard(z - 1) - heard_before(a)) * fs / (z - a) as f64;
                 let before = if a == 0 { 0.0 } else { at(a - 1) };
                 let gradient =
                     scale * (at(z - 1) - before) * fs / ((z - a) as f64 * SOUND_SPEED_MPS);

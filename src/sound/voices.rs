@@ -295,19 +295,24 @@ impl VoiceBank {
         let stride = self.stride();
         assert!(input.len() >= out.len() * stride, "input too short");
         self.active.fill(true);
+        let chunks = self.x1.len();
         for (o, row) in out.iter_mut().zip(input.chunks_exact(stride)) {
             let mut acc = [0.0f32; LANES];
-            for (c, u) in row.chunks_exact(LANES).enumerate() {
-                let (x1, x2) = (&mut self.x1[c], &mut self.x2[c]);
+            // Each chunk's lanes taken by value and put back, as in `render_free_lanes`:
+            // held in registers, the eight lanes run as one vector (through references
+            // into the arrays they ran one by one).
+            for (c, u) in row.chunks_exact(LANES).enumerate().take(chunks) {
+                let u: Lane = u.try_into().expect("a chunk of lanes");
                 let (a11, a12, a21, a22, b1, b2, g) = (
-                    &self.a11[c],
-                    &self.a12[c],
-                    &self.a21[c],
-                    &self.a22[c],
-                    &self.b1[c],
-                    &self.b2[c],
-                    &self.gain[c],
+                    self.a11[c],
+                    self.a12[c],
+                    self.a21[c],
+                    self.a22[c],
+                    self.b1[c],
+                    self.b2[c],
+                    self.gain[c],
                 );
+                let (mut x1, mut x2) = (self.x1[c], self.x2[c]);
                 for l in 0..LANES {
                     let n1 = a11[l] * x1[l] + a12[l] * x2[l] + b1[l] * u[l];
                     let n2 = a21[l] * x1[l] + a22[l] * x2[l] + b2[l] * u[l];
@@ -315,6 +320,7 @@ impl VoiceBank {
                     x2[l] = n2;
                     acc[l] += g[l] * n2;
                 }
+                (self.x1[c], self.x2[c]) = (x1, x2);
             }
             *o += acc.iter().sum::<f32>();
         }
