@@ -220,7 +220,7 @@ pub fn import(
     }
     limit_to_two_hands(&mut notes, &mut warnings);
     let octave_moves = move_into_range(&mut notes, kit, &mut warnings);
-    let beats = assign_drums(&notes, kit);
+    let beats = assign_drums(&notes, kit, &mut warnings);
     if matches!(clock, Clock::Timecode { .. }) {
         warnings.push(format!(
             "the file counts time in SMPTE frames; converted at a fixed {DEFAULT_BPM} bpm"
@@ -765,27 +765,64 @@ pub(super) fn move_into_range(notes: &mut [Note], kit: &Kit, warnings: &mut Vec<
 /// Give every note a drum as a timpanist would and make it a beat. Walking in time, each
 /// drum keeps its current tuning; a note goes to the drum its data names if that drum
 /// reaches it, else, among the drums that reach it (not already struck at this tick if
-/// possible), to one tuned to it, else to the one idle longest (it is retuned), ties to the
-/// nearest kit tuning.
-pub(super) fn assign_drums(notes: &[Note], kit: &Kit) -> Vec<Beat> {
+/// possible; for a roll, which takes both hands, one both hands reach if possible), to one
+/// tuned to it, else to the one idle longest (it is retuned), ties to the nearest kit
+/// tuning. The notes of one tick choose in order of how few drums reach them, so a chord
+/// of F3 and A3 on the standard kit takes the 26- and the 23-inch drum (in score order
+/// the F3 took the 23-inch drum, tuned to it, and left the A3, which only the 23-inch
+/// drum reaches, on the same drum at the same time). A chord note whose drums are all
+/// struck at that tick moves by the fewest octaves to a drum that is free (counted in one
+/// warning), as a timpanist would rewrite it.
+pub(super) fn assign_drums(notes: &[Note], kit: &Kit, warnings: &mut Vec<String>) -> Vec<Beat> {
     let mut tuning: Vec<Pitch> = kit.drums.iter().map(|d| d.tuning).collect();
     let mut last_used: Vec<Option<u64>> = vec![None; kit.drums.len()];
-    let mut taken: Vec<usize> = Vec::new();
-    let mut beats: Vec<Beat> = Vec::with_capacity(notes.len());
-    for n in notes {
-        if beats.last().is_some_and(|b| b.tick != n.tick) {
-            taken.clear();
-        }
-        let pitch = Pitch(n.key);
-        let drum = n
-            .data
-            .map(|d| d.2)
-            .filter(|&d| kit.drums.get(d).is_some_and(|drum| drum.in_range(pitch)))
-            .unwrap_or_else(|| {
+    let mut drums: Vec<usize> = vec![0; notes.len()];
+    let mut keys: Vec<u8> = notes.iter().map(|n| n.key).collect();
+    let both_hands_reach = both_hands_reach(kit);
+    let mut moves: BTreeMap<(Pitch, Pitch), usize> = BTreeMap::new();
+    let mut start = 0;
+    while start < notes.len() {
+        let tick = notes[start].tick;
+        let end = start + notes[start..].iter().take_while(|n| n.tick == tick).count();
+        let named = |n: &Note| {
+            n.data.map(|d| d.2).filter(|&d| {
+                kit.drums
+                    .get(d)
+                    .is_some_and(|drum| drum.in_range(Pitch(n.key)))
+            })
+        };
+        let mut order: Vec<usize> = (start..end).collect();
+        order.sort_by_key(|&i| {
+            let n = &notes[i];
+            let choices = if named(n).is_some() {
+                0
+            } else {
+                kit.drums_for(Pitch(n.key)).count()
+            };
+            (choices, i)
+        });
+        let mut taken: Vec<usize> = Vec::new();
+        for i in order {
+            let n = &notes[i];
+            let mut pitch = Pitch(n.key);
+            let free = |p: Pitch| kit.drums_for(p).any(|d| !taken.contains(&d));
+            if named(n).is_none() && !free(pitch) {
+                let moved = (1..=4)
+                    .flat_map(|k| [-12 * k, 12 * k])
+                    .filter_map(|shift| pitch.transposed(shift))
+                    .find(|p| free(*p));
+                if let Some(to) = moved {
+                    *moves.entry((pitch, to)).or_insert(0) += 1;
+                    pitch = to;
+                }
+            }
+            let roll = n.data.is_some_and(|d| d.4.is_some());
+            let drum = named(n).unwrap_or_else(|| {
                 kit.drums_for(pitch)
                     .min_by_key(|&d| {
                         (
                             taken.contains(&d),
+                            roll && !both_hands_reach[d],
                             tuning[d] != pitch,
                             last_used[d],
                             kit.drums[d].tuning.0.abs_diff(pitch.0),
@@ -793,31 +830,71 @@ pub(super) fn assign_drums(notes: &[Note], kit: &Kit) -> Vec<Beat> {
                     })
                     .expect("notes were moved into a drum's range")
             });
-        tuning[drum] = pitch;
-        last_used[drum] = Some(n.tick);
-        taken.push(drum);
-        let data = n.data.unwrap_or(BeatData(
-            Hand::Auto,
-            PlayingMode::Legato,
-            drum,
-            ImpactLocation::PlayingSpot,
-            None,
-        ));
-        beats.push(Beat {
-            tick: n.tick,
-            hand: data.0,
-            mode: data.1,
-            dynamic: Dynamic::from_midi_velocity(n.vel),
-            drum,
-            pitch: Some(pitch),
-            location: data.3,
-            roll: data.4,
-            // A MIDI note's length says nothing reliable about damping: let it ring.
-            damp: None,
-        });
+            tuning[drum] = pitch;
+            last_used[drum] = Some(tick);
+            taken.push(drum);
+            (drums[i], keys[i]) = (drum, pitch.0);
+        }
+        start = end;
     }
+    if !moves.is_empty() {
+        let list: Vec<String> = moves
+            .iter()
+            .map(|((from, to), n)| format!("{from} → {to} ×{n}"))
+            .collect();
+        warnings.push(format!(
+            "{} chord notes had no free drum that reaches them at once and were moved by \
+             octaves: {}",
+            moves.values().sum::<usize>(),
+            list.join(", ")
+        ));
+    }
+    let mut beats: Vec<Beat> = notes
+        .iter()
+        .zip(drums.into_iter().zip(keys))
+        .map(|(n, (drum, key))| {
+            let data = n.data.unwrap_or(BeatData(
+                Hand::Auto,
+                PlayingMode::Legato,
+                drum,
+                ImpactLocation::PlayingSpot,
+                None,
+            ));
+            Beat {
+                tick: n.tick,
+                hand: data.0,
+                mode: data.1,
+                dynamic: Dynamic::from_midi_velocity(n.vel),
+                drum,
+                pitch: Some(Pitch(key)),
+                location: data.3,
+                roll: data.4,
+                // A MIDI note's length says nothing reliable about damping: let it ring.
+                damp: None,
+            }
+        })
+        .collect();
     crate::score::tuning::drop_needless_pitches(&mut beats, kit);
     beats
+}
+
+/// Per drum, whether the default player reaches its playing spot with either hand (the
+/// stretched arm and stick from the shoulder, as the sticking and the renderer judge it).
+fn both_hands_reach(kit: &Kit) -> Vec<bool> {
+    use crate::body::skeleton::{DEFAULT_HEIGHT_M, Skeleton};
+    use crate::kit::Side;
+    let mallet_m = kit.mallets.first().map_or(0.0, |m| m.length_m);
+    let body = Skeleton::new(DEFAULT_HEIGHT_M, mallet_m);
+    let (r, angle) = ImpactLocation::PlayingSpot.polar();
+    kit.drums
+        .iter()
+        .map(|d| {
+            let spot = d.point_on_head(r, angle);
+            [Side::Left, Side::Right]
+                .into_iter()
+                .all(|h| body.reaches(h, spot))
+        })
+        .collect()
 }
 
 /// Shorten rolls that another beat starts inside (a roll takes both hands).
@@ -968,7 +1045,7 @@ mod tests {
             .enumerate()
             .map(|(i, &k)| note(i as u64 * 480, k))
             .collect();
-        let beats = assign_drums(&notes, &kit);
+        let beats = assign_drums(&notes, &kit, &mut Vec::new());
         let drums: Vec<usize> = beats.iter().map(|b| b.drum).collect();
         assert_eq!(drums, vec![2, 1, 2, 1, 1]);
         assert_eq!(beats[0].pitch, None);
@@ -993,7 +1070,7 @@ mod tests {
             .map(|(i, p)| note(i as u64 * 480, pitch(p)))
             .collect();
         let mut score = crate::score::Score::new("line");
-        score.beats = assign_drums(&notes, &kit);
+        score.beats = assign_drums(&notes, &kit, &mut Vec::new());
         let sounding: Vec<String> = (score.sounding_pitches(&kit).iter())
             .map(ToString::to_string)
             .collect();
@@ -1007,11 +1084,61 @@ mod tests {
     fn simultaneous_notes_use_two_drums() {
         let kit = Kit::standard();
         let notes = [note(0, pitch("Bb2")), note(0, pitch("C3"))];
-        let beats = assign_drums(&notes, &kit);
+        let beats = assign_drums(&notes, &kit, &mut Vec::new());
         assert_eq!((beats[0].drum, beats[1].drum), (1, 2));
         let notes = [note(0, pitch("Bb2")), note(10, pitch("C3"))];
-        let beats = assign_drums(&notes, &kit);
+        let beats = assign_drums(&notes, &kit, &mut Vec::new());
         assert_eq!(beats[1].drum, 2);
+        // F3 reaches the 26- and the 23-inch drum (tuned to F3), A3 only the 23-inch:
+        // the A3 chooses first, so the F3 takes the 26-inch, in either order.
+        for (a, b) in [("F3", "A3"), ("A3", "F3")] {
+            let notes = [note(0, pitch(a)), note(0, pitch(b))];
+            let beats = assign_drums(&notes, &kit, &mut Vec::new());
+            let on = |p: &str| beats[usize::from(b == p)].drum;
+            assert_eq!((on("F3"), on("A3")), (2, 3), "{a} then {b}");
+        }
+    }
+
+    /// A chord of two notes only the 23-inch drum reaches (G3, A3) cannot sound on one
+    /// drum: the note choosing second moves by an octave to a free drum, in one warning.
+    #[test]
+    fn a_chord_one_drum_cannot_play_moves_a_note_by_an_octave() {
+        let kit = Kit::standard();
+        let mut warnings = Vec::new();
+        let notes = [note(0, pitch("A3")), note(0, pitch("G3"))];
+        let beats = assign_drums(&notes, &kit, &mut warnings);
+        assert_ne!(beats[0].drum, beats[1].drum);
+        assert_eq!(beats[0].pitch, Some(Pitch(pitch("A3"))));
+        assert_eq!(beats[1].pitch, Some(Pitch(pitch("G2"))));
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert!(warnings[0].contains("G3 → G2 ×1"), "{warnings:?}");
+    }
+
+    /// A roll takes both hands: an F3 roll goes to the 26-inch drum, which both hands
+    /// reach, not to the 23-inch drum beside the player (tuned to F3), which the left
+    /// hand does not; a single F3 stroke still goes to the drum tuned to it.
+    #[test]
+    fn a_roll_goes_to_a_drum_both_hands_reach() {
+        let kit = Kit::standard();
+        let reach = both_hands_reach(&kit);
+        assert_eq!(reach, [false, true, true, false]);
+        let rolled = Note {
+            data: Some(BeatData(
+                Hand::Auto,
+                PlayingMode::Legato,
+                usize::MAX,
+                ImpactLocation::PlayingSpot,
+                Some(Roll {
+                    length_ticks: 960,
+                    strokes_per_quarter: 4,
+                }),
+            )),
+            ..note(0, pitch("F3"))
+        };
+        let beats = assign_drums(&[rolled], &kit, &mut Vec::new());
+        assert_eq!(beats[0].drum, 2);
+        let beats = assign_drums(&[note(0, pitch("F3"))], &kit, &mut Vec::new());
+        assert_eq!(beats[0].drum, 3);
     }
 
     /// Pitches no drum reaches move by the fewest octaves into some drum's range, counted

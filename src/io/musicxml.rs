@@ -252,7 +252,7 @@ pub fn import(
     let dynamics_of: Vec<(Dynamic, PlayingMode, Option<u64>)> =
         notes.iter().map(|n| exact[&(n.tick, n.key)]).collect();
     let octave_moves = midi::move_into_range(&mut notes, kit, &mut warnings);
-    let mut beats = midi::assign_drums(&notes, kit);
+    let mut beats = midi::assign_drums(&notes, kit, &mut warnings);
     for (b, (dynamic, mode, damp)) in beats.iter_mut().zip(dynamics_of) {
         b.dynamic = dynamic;
         b.mode = mode;
