@@ -15,9 +15,14 @@ use crate::motion::plan::PlannedStroke;
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error(
     "beat {beat} is out of the {} hand's reach: its target on drum {drum} is {distance_m:.2} m \
-     from the shoulder, the arm and stick reach {reach_m:.2} m (play it with the other hand, \
-     or nearer the player)",
-    if *hand == Side::Left { "left" } else { "right" }
+     from the shoulder, the arm and stick reach {reach_m:.2} m ({})",
+    if *hand == Side::Left { "left" } else { "right" },
+    if *roll {
+        "a roll takes both hands: roll on a drum both hands reach, tuned to this pitch, or \
+         move this drum nearer the player"
+    } else {
+        "play it with the other hand, or nearer the player"
+    }
 )]
 pub struct OutOfReach {
     pub beat: usize,
@@ -27,6 +32,8 @@ pub struct OutOfReach {
     pub distance_m: f64,
     /// How far the tip can go from the shoulder, m.
     pub reach_m: f64,
+    /// Whether both hands play the beat (a roll), so the other hand is no way out.
+    pub roll: bool,
 }
 
 /// The first stroke of `strokes` out of reach of `skeleton`, if any.
@@ -41,6 +48,7 @@ pub fn check(strokes: &[PlannedStroke], skeleton: &Skeleton) -> Result<(), OutOf
                 drum: s.drum,
                 distance_m,
                 reach_m,
+                roll: strokes.iter().any(|o| o.beat == s.beat && o.hand != s.hand),
             });
         }
     }
@@ -84,7 +92,21 @@ mod tests {
             err.to_string()
                 .starts_with("beat 4 is out of the right hand's reach")
         );
+        assert!(!err.roll && err.to_string().contains("play it with the other hand"));
         let r = skeleton.reach_m();
         assert!((0.9..1.1).contains(&r), "{r}");
+    }
+
+    /// A roll on the far-left drum (its strokes by both hands, one beat) is refused for
+    /// the right hand with the roll named: the other hand is no way out.
+    #[test]
+    fn a_roll_out_of_one_hands_reach_says_so() {
+        let kit = Kit::standard();
+        let skeleton = Skeleton::new(1.75, kit.mallets[0].length_m);
+        let far_left = kit.drums[0].point_on_head(0.0, 0.0) + DVec3::Z * 0.03;
+        let roll = [stroke(Side::Left, far_left), stroke(Side::Right, far_left)];
+        let err = check(&roll, &skeleton).unwrap_err();
+        assert!(err.roll && err.hand == Side::Right, "{err}");
+        assert!(err.to_string().contains("a roll takes both hands"), "{err}");
     }
 }
