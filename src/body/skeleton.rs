@@ -127,6 +127,16 @@ impl Default for Skeleton {
 }
 
 impl Skeleton {
+    /// The default player ([`DEFAULT_HEIGHT_M`]) holding `kit`'s first mallets (0.37 m
+    /// ones when it lists none): the body the sticking, the imports and the synthetic
+    /// motion database judge reach and posture by.
+    pub fn holding_mallets_of(kit: &crate::kit::Kit) -> Skeleton {
+        Skeleton::new(
+            DEFAULT_HEIGHT_M,
+            kit.mallets.first().map_or(0.37, |m| m.length_m),
+        )
+    }
+
     /// A skeleton scaled to `height_m` holding mallets of `mallet_length_m`.
     pub fn new(height_m: f64, mallet_length_m: f64) -> Skeleton {
         let h = height_m / DEFAULT_HEIGHT_M;

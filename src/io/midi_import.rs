@@ -719,21 +719,25 @@ pub(super) fn limit_to_two_hands(notes: &mut Vec<Note>, warnings: &mut Vec<Strin
     *notes = kept;
 }
 
+/// The pitch fewest octaves from `pitch` (downward on a tie) that `fits`, if any.
+fn nearest_octave(pitch: Pitch, fits: impl Fn(&Pitch) -> bool) -> Option<Pitch> {
+    (1..=10)
+        .flat_map(|k| [-12 * k, 12 * k])
+        .filter_map(|s| pitch.transposed(s))
+        .find(|p| fits(p))
+}
+
 /// The pitch nearest by octaves to `pitch` that some drum reaches (fewest octaves,
 /// downward on a tie), else the nearest pitch any drum reaches.
 fn reachable(pitch: Pitch, kit: &Kit) -> Pitch {
     let fits = |p: &Pitch| kit.drums_for(*p).next().is_some();
-    (1..=10)
-        .flat_map(|k| [-12 * k, 12 * k])
-        .filter_map(|s| pitch.transposed(s))
-        .find(fits)
-        .unwrap_or_else(|| {
-            (0..=127)
-                .map(Pitch)
-                .filter(fits)
-                .min_by_key(|p| p.0.abs_diff(pitch.0))
-                .expect("a valid kit has a drum")
-        })
+    nearest_octave(pitch, fits).unwrap_or_else(|| {
+        (0..=127)
+            .map(Pitch)
+            .filter(fits)
+            .min_by_key(|p| p.0.abs_diff(pitch.0))
+            .expect("a valid kit has a drum")
+    })
 }
 
 /// Move notes no drum can reach by octaves into a drum's range; one warning sums them up.
@@ -805,19 +809,17 @@ pub(super) fn assign_drums(notes: &[Note], kit: &Kit, warnings: &mut Vec<String>
         for i in order {
             let n = &notes[i];
             let mut pitch = Pitch(n.key);
-            let free = |p: Pitch| kit.drums_for(p).any(|d| !taken.contains(&d));
-            if named(n).is_none() && !free(pitch) {
-                let moved = (1..=4)
-                    .flat_map(|k| [-12 * k, 12 * k])
-                    .filter_map(|shift| pitch.transposed(shift))
-                    .find(|p| free(*p));
-                if let Some(to) = moved {
-                    *moves.entry((pitch, to)).or_insert(0) += 1;
-                    pitch = to;
-                }
+            let free = |p: &Pitch| kit.drums_for(*p).any(|d| !taken.contains(&d));
+            let named_drum = named(n);
+            if named_drum.is_none()
+                && !free(&pitch)
+                && let Some(to) = nearest_octave(pitch, free)
+            {
+                *moves.entry((pitch, to)).or_insert(0) += 1;
+                pitch = to;
             }
             let roll = n.data.is_some_and(|d| d.4.is_some());
-            let drum = named(n).unwrap_or_else(|| {
+            let drum = named_drum.unwrap_or_else(|| {
                 kit.drums_for(pitch)
                     .min_by_key(|&d| {
                         (
@@ -881,10 +883,8 @@ pub(super) fn assign_drums(notes: &[Note], kit: &Kit, warnings: &mut Vec<String>
 /// Per drum, whether the default player reaches its playing spot with either hand (the
 /// stretched arm and stick from the shoulder, as the sticking and the renderer judge it).
 fn both_hands_reach(kit: &Kit) -> Vec<bool> {
-    use crate::body::skeleton::{DEFAULT_HEIGHT_M, Skeleton};
     use crate::kit::Side;
-    let mallet_m = kit.mallets.first().map_or(0.0, |m| m.length_m);
-    let body = Skeleton::new(DEFAULT_HEIGHT_M, mallet_m);
+    let body = crate::body::skeleton::Skeleton::holding_mallets_of(kit);
     let (r, angle) = ImpactLocation::PlayingSpot.polar();
     kit.drums
         .iter()

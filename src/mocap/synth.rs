@@ -225,7 +225,7 @@ struct SynthTake {
 /// The synthetic performer's skeleton: 1.75 m tall, holding `kit`'s first mallets (the
 /// body the shipped database's joint angles belong to).
 pub fn performer_skeleton(kit: &Kit) -> Skeleton {
-    Skeleton::new(1.75, kit.mallets.first().map_or(0.37, |m| m.length_m))
+    Skeleton::holding_mallets_of(kit)
 }
 
 /// The synthetic performer.

@@ -47,7 +47,7 @@
 //! O(n · (beats per H + points)), linear in the number of beats n for a given
 //! density of notes and set of impact points.
 
-use crate::body::skeleton::{DEFAULT_HEIGHT_M, Skeleton};
+use crate::body::skeleton::Skeleton;
 use crate::kit::{Kit, Side};
 use crate::score::{Hand, Score};
 use glam::DVec2;
@@ -231,9 +231,7 @@ struct Prep {
 impl Prep {
     fn new(score: &Score, kit: &Kit) -> Prep {
         let map = score.tempo_map();
-        // The default player with the kit's first mallets.
-        let mallet_m = kit.mallets.first().map_or(0.37, |m| m.length_m);
-        let body = Skeleton::new(DEFAULT_HEIGHT_M, mallet_m);
+        let body = Skeleton::holding_mallets_of(kit);
         let seconds = |tick: u64| map.seconds_at(tick as f64);
         let mut ids: BTreeMap<(usize, u64, u64), usize> = BTreeMap::new();
         let mut points = Vec::new();
