@@ -223,7 +223,7 @@ fn rendered_improvisation() -> Vec<f32> {
     assert_eq!(rendering.audio.rate_hz, RATE);
     assert_eq!(rendering.audio.channels, 2);
     let mut samples = vec![0.0; RATE as usize];
-    samples.extend_from_slice(&rendering.audio.samples);
+    samples.extend(rendering.audio.samples.iter());
     samples
 }
 

@@ -460,7 +460,7 @@ fn partial_render_then_rest_equals_a_whole_render() {
     // before the gain are (each sample rounded once to f32 after the gain: 2^-24 each).
     let (a, b) = (&partial.audio, &whole.audio);
     if a.gain == b.gain {
-        assert_eq!(a.samples[..ready], b.samples[..ready]);
+        assert_eq!(a.samples.to_vec_of(0..ready), b.samples.to_vec_of(0..ready));
     }
     let first_off = (0..ready).find(|&k| {
         let (x, y) = (

@@ -22,7 +22,7 @@ fn study() -> Rendering {
 fn rms(audio: &sound::Audio, from_s: f64, to_s: f64) -> f64 {
     let rate = f64::from(audio.rate_hz);
     let range = (from_s * rate) as usize * 2..(to_s * rate) as usize * 2;
-    let window = &audio.samples[range];
+    let window = audio.samples.to_vec_of(range);
     (window.iter().map(|&x| f64::from(x).powi(2)).sum::<f64>() / window.len() as f64).sqrt()
 }
 

@@ -216,7 +216,7 @@ impl Playback {
     /// crossfaded over 5 ms. The audio replaced is dropped on a later call, on this
     /// thread.
     pub fn set_audio(&mut self, audio: Arc<dyn StereoSource>) -> Result<(), PlaybackError> {
-        let n = audio.interleaved().len();
+        let n = audio.sample_count();
         if !n.is_multiple_of(2) {
             return Err(PlaybackError::OddSampleCount(n));
         }

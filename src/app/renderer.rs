@@ -78,8 +78,13 @@ impl Rendered {
 
 /// Playback plays the rendering's audio in place (`Arc<Rendering>`, no copy).
 impl StereoSource for Rendering {
-    fn interleaved(&self) -> &[f32] {
-        &self.audio.samples
+    fn sample_count(&self) -> usize {
+        self.audio.samples.len()
+    }
+
+    fn frame(&self, i: usize) -> Option<[f32; 2]> {
+        let s = &self.audio.samples;
+        Some([*s.get(2 * i)?, *s.get(2 * i + 1)?])
     }
 }
 

@@ -44,13 +44,19 @@ const RETURN_CAPACITY: usize = 16;
 /// Interleaved stereo samples (left, right, left, …) at [`SOURCE_RATE_HZ`], in [−1, 1].
 /// A trailing odd sample is ignored.
 pub trait StereoSource: Send + Sync {
-    /// The samples.
-    fn interleaved(&self) -> &[f32];
+    /// Samples (twice the frames, plus a trailing odd one if any).
+    fn sample_count(&self) -> usize;
+    /// Frame `i` (left, right), if the source holds it whole.
+    fn frame(&self, i: usize) -> Option<[f32; 2]>;
 }
 
 impl StereoSource for Vec<f32> {
-    fn interleaved(&self) -> &[f32] {
-        self
+    fn sample_count(&self) -> usize {
+        self.len()
+    }
+
+    fn frame(&self, i: usize) -> Option<[f32; 2]> {
+        self.get(2 * i..2 * i + 2).map(|lr| [lr[0], lr[1]])
     }
 }
 
@@ -270,9 +276,8 @@ impl Voice {
         let Some(source) = &self.source else {
             return Frame::ZERO;
         };
-        let s = source.interleaved();
-        let at = |i: usize| match s.get(2 * i..2 * i + 2) {
-            Some(lr) => Frame::new(lr[0], lr[1]),
+        let at = |i: usize| match source.frame(i) {
+            Some([l, r]) => Frame::new(l, r),
             None => Frame::ZERO,
         };
         let i = self.pos.floor();

@@ -1,8 +1,10 @@
 //! A growing record kept in shared, fixed-size chunks: cloning it shares every chunk
 //! (copy on write), so a snapshot of a long record costs a pointer per chunk instead of
 //! a copy of the record. Appending to or truncating a shared record copies at most its
-//! last chunk. Used for records a rendering hands over while the performance that made
-//! them goes on (the drums' recorded membrane motion).
+//! last chunk, and rewriting a range copies only the shared chunks it leaves partly as
+//! they were. Used for records a rendering hands over while the performance that made
+//! them goes on (the drums' recorded membrane motion) and for audio a rendering hands
+//! to playback while the next one rewrites what changed.
 
 use std::sync::Arc;
 
@@ -36,14 +38,17 @@ impl<T: Clone> SharedChunks<T> {
 
     /// Append `values`, copying the last chunk first if another record shares it.
     pub fn extend(&mut self, values: impl IntoIterator<Item = T>) {
-        for v in values {
+        let mut values = values.into_iter().peekable();
+        while values.peek().is_some() {
             if self.len.is_multiple_of(self.chunk_len) {
                 self.chunks
                     .push(Arc::new(Vec::with_capacity(self.chunk_len)));
             }
-            let last = self.chunks.last_mut().expect("a chunk to append to");
-            Arc::make_mut(last).push(v);
-            self.len += 1;
+            let room = self.chunk_len - self.len % self.chunk_len;
+            let last = Arc::make_mut(self.chunks.last_mut().expect("a chunk to append to"));
+            let before = last.len();
+            last.extend(values.by_ref().take(room));
+            self.len += last.len() - before;
         }
     }
 
@@ -80,6 +85,107 @@ impl<T: Clone> SharedChunks<T> {
     /// Every value in order.
     pub fn iter(&self) -> impl Iterator<Item = &T> {
         self.chunks.iter().flat_map(|c| c.iter())
+    }
+
+    /// `values` in chunks of `chunk_len`.
+    pub fn from_vec(values: Vec<T>, chunk_len: usize) -> SharedChunks<T> {
+        let chunk_len = chunk_len.max(1);
+        SharedChunks {
+            len: values.len(),
+            chunks: values
+                .chunks(chunk_len)
+                .map(|c| Arc::new(c.to_vec()))
+                .collect(),
+            chunk_len,
+        }
+    }
+
+    /// The value at `index`, if there is one.
+    pub fn get(&self, index: usize) -> Option<&T> {
+        (index < self.len).then(|| &self.chunks[index / self.chunk_len][index % self.chunk_len])
+    }
+
+    /// The chunks in order, as slices (every one but the last `chunk_len` long).
+    pub fn chunks(&self) -> impl Iterator<Item = &[T]> {
+        self.chunks.iter().map(|c| c.as_slice())
+    }
+
+    /// How many chunks, place for place, are the very ones `other` holds (shared, not
+    /// copies).
+    pub fn shared_chunks(&self, other: &SharedChunks<T>) -> usize {
+        self.chunks
+            .iter()
+            .zip(&other.chunks)
+            .filter(|(a, b)| Arc::ptr_eq(a, b))
+            .count()
+    }
+
+    /// A copy of the values in `range`, which may span chunks.
+    ///
+    /// # Panics
+    /// When the range is outside the record.
+    pub fn to_vec_of(&self, range: std::ops::Range<usize>) -> Vec<T> {
+        assert!(range.end <= self.len, "range outside the record");
+        let mut out = Vec::with_capacity(range.len());
+        let mut at = range.start;
+        while at < range.end {
+            let (chunk, offset) = (at / self.chunk_len, at % self.chunk_len);
+            let take = (self.chunk_len - offset).min(range.end - at);
+            out.extend_from_slice(&self.chunks[chunk][offset..offset + take]);
+            at += take;
+        }
+        out
+    }
+
+    /// A copy of every value.
+    pub fn to_vec(&self) -> Vec<T> {
+        self.to_vec_of(0..self.len)
+    }
+
+    /// Make it `len` values long: cut, or padded with `value`.
+    pub fn resize(&mut self, len: usize, value: T) {
+        if len <= self.len {
+            self.truncate(len);
+        } else {
+            self.extend(std::iter::repeat_n(value, len - self.len));
+        }
+    }
+
+    /// Rewrite the values from `start` on with `f` of the values of `source` at the same
+    /// places (`source` as long as the record): a shared chunk rewritten whole is made
+    /// anew, one rewritten in part is copied first, the chunks before `start` stay
+    /// shared.
+    ///
+    /// # Panics
+    /// When `source` is not as long as the record.
+    pub fn rewrite_from<S>(&mut self, start: usize, source: &[S], f: impl Fn(&S) -> T) {
+        assert_eq!(source.len(), self.len, "a source as long as the record");
+        let chunk_len = self.chunk_len;
+        for (c, chunk) in self.chunks.iter_mut().enumerate().skip(start / chunk_len) {
+            let first = c * chunk_len;
+            let from = start.max(first);
+            let end = (first + chunk_len).min(source.len());
+            let rewritten = source[from..end].iter().map(&f);
+            if from == first && Arc::get_mut(chunk).is_none() {
+                *chunk = Arc::new(rewritten.collect());
+            } else {
+                let values = Arc::make_mut(chunk);
+                for (v, new) in values[from - first..].iter_mut().zip(rewritten) {
+                    *v = new;
+                }
+            }
+        }
+    }
+}
+
+impl<T> std::ops::Index<usize> for SharedChunks<T> {
+    type Output = T;
+
+    /// # Panics
+    /// When `index` is outside the record.
+    fn index(&self, index: usize) -> &T {
+        assert!(index < self.len, "index outside the record");
+        &self.chunks[index / self.chunk_len][index % self.chunk_len]
     }
 }
 
@@ -130,6 +236,64 @@ mod tests {
             [plain[0], plain[1], 99, 98]
         );
         assert_ne!(snapshot, chunks);
+    }
+
+    /// Rewriting from a point, resizing, indexing and copying ranges give what a plain
+    /// vector gives; a rewrite leaves the chunks before its start shared with a clone
+    /// and copies none it rewrites whole.
+    #[test]
+    fn rewrites_from_a_point_and_keeps_what_is_before_it_shared() {
+        let plain_of = |n: usize| (0..n as u32).collect::<Vec<_>>();
+        let mut plain = plain_of(23);
+        let mut chunks = SharedChunks::from_vec(plain.clone(), 5);
+        assert_eq!(chunks.to_vec(), plain);
+        assert_eq!(chunks.chunks().count(), 5);
+        let snapshot = chunks.clone();
+        let source: Vec<u32> = (0..23).map(|k| 100 + k).collect();
+        chunks.rewrite_from(7, &source, |v| v * 2);
+        for (k, v) in plain.iter_mut().enumerate().skip(7) {
+            *v = source[k] * 2;
+        }
+        assert_eq!(chunks.to_vec(), plain);
+        assert_eq!(
+            snapshot.to_vec(),
+            plain_of(23),
+            "the clone keeps its values"
+        );
+        assert_eq!(
+            chunks.shared_chunks(&snapshot),
+            1,
+            "only the chunk before: shared"
+        );
+        assert!(
+            !Arc::ptr_eq(&snapshot.chunks[1], &chunks.chunks[1]),
+            "in part: copied"
+        );
+        assert!(
+            !Arc::ptr_eq(&snapshot.chunks[2], &chunks.chunks[2]),
+            "whole: made anew"
+        );
+        for range in [0..0, 3..4, 4..11, 0..23, 22..23] {
+            assert_eq!(chunks.to_vec_of(range.clone()), plain[range]);
+        }
+        for k in [0, 4, 5, 22] {
+            assert_eq!(chunks[k], plain[k]);
+            assert_eq!(chunks.get(k), Some(&plain[k]));
+        }
+        assert_eq!(chunks.get(23), None);
+        chunks.resize(30, 7);
+        plain.resize(30, 7);
+        assert_eq!(chunks.to_vec(), plain);
+        chunks.resize(12, 0);
+        plain.truncate(12);
+        assert_eq!(chunks.to_vec(), plain);
+        let source: Vec<u32> = (0..12).collect();
+        chunks.rewrite_from(12, &source, |v| *v);
+        assert_eq!(
+            chunks.to_vec(),
+            plain,
+            "a rewrite from the end changes nothing"
+        );
     }
 
     /// A range across two chunks is refused rather than read wrong.

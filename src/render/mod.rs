@@ -662,9 +662,6 @@ impl Run<'_> {
             let source = self.params.modes.source;
             let worker = scope.spawn(move || {
                 let mut sound = sound;
-                // The audio the last rendering still plays is copied here, beside the
-                // simulation, rather than after it on the way to the next audio.
-                sound.own_audio();
                 crate::sound::prepare_heads(kit, self.retunes, source, model);
                 while let Ok(mut job) = queue.recv() {
                     // Only the latest record counts: it holds every earlier one.

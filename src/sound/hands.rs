@@ -78,7 +78,8 @@ pub fn hand_stems(
         let mut samples = vec![0.0f32; 2 * frames];
         for (j, (drum, mono)) in kit.drums.iter().zip(&monos).enumerate() {
             let sympathy = sympathies.get(j).map(Vec::as_slice);
-            let stem = super::stem(drum, model, (mono, sympathy), mix.gain);
+            // Dry: the hand's stem is heard in the room once summed.
+            let stem = super::stem(drum, model.into(), (mono, sympathy), mix.gain);
             for (s, x) in samples.iter_mut().zip(stem.samples.iter()) {
                 *s += x;
             }

@@ -141,6 +141,6 @@ mod tests {
         let mut r = hound::WavReader::open(&pf).unwrap();
         assert_eq!(r.spec().sample_format, hound::SampleFormat::Float);
         let back: Vec<f32> = r.samples::<f32>().map(|s| s.unwrap()).collect();
-        assert_eq!(back, *audio.samples);
+        assert_eq!(back, audio.samples.to_vec());
     }
 }

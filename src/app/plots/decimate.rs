@@ -4,6 +4,8 @@
 //! per time bucket, from per-block extremes when a bucket spans many blocks). Pure math,
 //! no egui.
 
+use crate::base::chunks::SharedChunks;
+
 /// The points of `points` (sorted by x) that draw the window `x0..=x1`: those inside it
 /// plus one neighbour on each side, so a line reaches the edges.
 pub fn visible(points: &[[f64; 2]], x0: f64, x1: f64) -> &[[f64; 2]] {
@@ -85,12 +87,27 @@ impl Envelope {
 
     /// The block extremes of `samples` (`channels` interleaved, `rate_hz` frames per second,
     /// frame 0 at time 0).
-    pub fn new(samples: &[f32], channels: usize, rate_hz: f64) -> Envelope {
+    pub fn new(samples: &SharedChunks<f32>, channels: usize, rate_hz: f64) -> Envelope {
         let channels = channels.max(1);
-        let blocks = samples
-            .chunks(Self::BLOCK * channels)
-            .map(|block| extremes(block, channels))
-            .collect();
+        const NONE: [f32; 2] = [f32::INFINITY, f32::NEG_INFINITY];
+        let mut blocks = Vec::with_capacity(samples.len().div_ceil(Self::BLOCK * channels));
+        let (mut block, mut sum, mut in_frame, mut in_block) = (NONE, 0.0f32, 0, 0);
+        for &v in samples.iter() {
+            sum += v;
+            in_frame += 1;
+            if in_frame == channels {
+                let mean = sum / channels as f32;
+                block = [block[0].min(mean), block[1].max(mean)];
+                (sum, in_frame, in_block) = (0.0, 0, in_block + 1);
+                if in_block == Self::BLOCK {
+                    blocks.push(std::mem::replace(&mut block, NONE));
+                    in_block = 0;
+                }
+            }
+        }
+        if in_block > 0 {
+            blocks.push(block);
+        }
         Envelope {
             rate_hz,
             channels,
@@ -103,7 +120,13 @@ impl Envelope {
     /// `t0..t1` s in `buckets` equal buckets: exact from the samples when a bucket holds
     /// fewer than four blocks, else from whole blocks (a bucket's edges then move by under
     /// a block, ≈ 5 ms at 48 kHz). Buckets outside the audio are left out.
-    pub fn buckets(&self, samples: &[f32], t0: f64, t1: f64, buckets: usize) -> Vec<Bucket> {
+    pub fn buckets(
+        &self,
+        samples: &SharedChunks<f32>,
+        t0: f64,
+        t1: f64,
+        buckets: usize,
+    ) -> Vec<Bucket> {
         if buckets == 0 || t1 <= t0 || self.frames == 0 {
             return Vec::new();
         }
@@ -130,7 +153,7 @@ impl Envelope {
                         })
                 } else {
                     extremes(
-                        &samples[fa * self.channels..fz * self.channels],
+                        &samples.to_vec_of(fa * self.channels..fz * self.channels),
                         self.channels,
                     )
                 };
@@ -252,9 +275,10 @@ mod tests {
             let v = 0.25 * t * (std::f64::consts::TAU * 440.0 * t).sin();
             samples.extend([(v + 0.1) as f32, (v - 0.1) as f32]);
         }
-        let env = Envelope::new(&samples, 2, rate);
+        let chunked = SharedChunks::from_vec(samples.clone(), 1000);
+        let env = Envelope::new(&chunked, 2, rate);
         // Coarse: 20 buckets of 0.1 s (≈ 19 blocks each).
-        let coarse = env.buckets(&samples, 0.0, 2.0, 20);
+        let coarse = env.buckets(&chunked, 0.0, 2.0, 20);
         assert_eq!(coarse.len(), 20);
         for b in &coarse {
             let peak = (0.25 * b.t1_s) as f32;
@@ -262,12 +286,12 @@ mod tests {
             assert!((b.min + peak).abs() < 0.01, "{b:?}");
         }
         // Fine: exact extremes of a 10 ms window.
-        let fine = env.buckets(&samples, 1.0, 1.01, 2);
+        let fine = env.buckets(&chunked, 1.0, 1.01, 2);
         let exact = |a: usize, z: usize| extremes(&samples[2 * a..2 * z], 2);
         assert_eq!([fine[0].min, fine[0].max], exact(48_000, 48_240));
         assert_eq!([fine[1].min, fine[1].max], exact(48_240, 48_480));
         // Past the end: nothing.
-        assert_eq!(env.buckets(&samples, 1.5, 3.0, 3).len(), 1);
-        assert!(env.buckets(&samples, 1.0, 1.0, 3).is_empty());
+        assert_eq!(env.buckets(&chunked, 1.5, 3.0, 3).len(), 1);
+        assert!(env.buckets(&chunked, 1.0, 1.0, 3).is_empty());
     }
 }

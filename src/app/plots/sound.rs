@@ -83,7 +83,9 @@ pub fn strike_spectrum(audio: &Audio, t0_s: f64, window_s: f64) -> Vec<[f64; 2]>
     let rate = f64::from(audio.rate_hz);
     let a = ((t0_s * rate).round().max(0.0) as usize).min(audio.frames());
     let z = (((t0_s + window_s) * rate).round().max(0.0) as usize).min(audio.frames());
-    let mono: Vec<f32> = audio.samples[a * ch..z * ch]
+    let mono: Vec<f32> = audio
+        .samples
+        .to_vec_of(a * ch..z * ch)
         .chunks_exact(ch)
         .map(|f| f.iter().sum::<f32>() / ch as f32)
         .collect();
