@@ -423,6 +423,18 @@ fn resumed_render_after_an_edit_equals_a_whole_render() {
             let from = resumed.stats.resumed_from_s.expect("a late edit resumes");
             assert!(from > 0.5, "resumed at {from} s, edit at {edit_s} s");
             assert!(resumed.stats.simulated_s < 0.8 * whole.stats.simulated_s);
+            // The audio before the resume point is the earlier rendering's own chunks,
+            // not a copy: the edit leaves the score's loudest peak, and so the
+            // normalisation gain, as it was, and nothing before the resume is rewritten.
+            assert_eq!(resumed.audio.gain, before.audio.gain);
+            let shared = resumed.audio.samples.shared_chunks(&before.audio.samples);
+            let before_from = (from - whole.start_s - 1.0).floor().max(0.0) as usize;
+            let chunks = resumed.audio.samples.chunks().count();
+            println!("{shared} of {chunks} one-second chunks shared, resumed at {from:.2} s");
+            assert!(
+                shared >= before_from && shared < chunks,
+                "{shared} of {chunks}"
+            );
         }
         assert_eq!(resumed.audio.samples, whole.audio.samples, "beat {beat}");
         assert_eq!(resumed.motion, whole.motion, "beat {beat}");
