@@ -177,6 +177,18 @@ fn skew(v: DVec3) -> DMat3 {
     )
 }
 
+/// skew(v)·m, column by column as cross products (27 flops against a product's 45).
+#[inline]
+fn skew_mul(v: DVec3, m: DMat3) -> DMat3 {
+    DMat3::from_cols(v.cross(m.x_axis), v.cross(m.y_axis), v.cross(m.z_axis))
+}
+
+/// m·skew(v) = −(skew(v)·mᵀ)ᵀ (skew(v) is antisymmetric).
+#[inline]
+fn mul_skew(m: DMat3, v: DVec3) -> DMat3 {
+    -skew_mul(v, m.transpose()).transpose()
+}
+
 /// Plücker transform from a parent frame to a child frame whose origin sits at `r` (parent
 /// coordinates) and whose axes are the parent's rotated by the joint: `e` maps parent
 /// coordinates to child coordinates.
@@ -207,11 +219,11 @@ impl Transform {
 
     /// An inertia from child to parent coordinates, Xᵀ·I·X.
     fn inertia_to_parent(&self, i: &SpatialInertia) -> SpatialInertia {
-        let (e, et, rx) = (self.e, self.e.transpose(), skew(self.r));
+        let (e, et, r) = (self.e, self.e.transpose(), self.r);
         let (a, b, c) = (et * i.a * e, et * i.b * e, et * i.c * e);
-        let rxc = rx * c;
+        let rxc = skew_mul(r, c);
         SpatialInertia {
-            a: a - b * rx + rx * b.transpose() - rxc * rx,
+            a: a - mul_skew(b, r) + skew_mul(r, b.transpose()) - mul_skew(rxc, r),
             b: b + rxc,
             c,
         }
@@ -222,11 +234,10 @@ impl Transform {
     /// C′ = EᵀCE.
     #[inline]
     fn translational_inertia_to_parent(&self, c: DMat3) -> SpatialInertia {
-        let rx = skew(self.r);
         let c = self.e.transpose() * c * self.e;
-        let rxc = rx * c;
+        let rxc = skew_mul(self.r, c);
         SpatialInertia {
-            a: -(rxc * rx),
+            a: -mul_skew(rxc, self.r),
             b: rxc,
             c,
         }
@@ -701,6 +712,16 @@ fn rotation_exp(v: DVec3) -> DQuat {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The cross-product forms of skew(v)·m and m·skew(v) are the matrix products.
+    #[test]
+    fn skew_products_by_cross_products() {
+        let v = DVec3::new(0.3, -1.2, 0.7);
+        let m = DMat3::from_cols_array(&[1.0, -2.0, 0.5, 3.0, 0.25, -1.5, 2.0, 4.0, -0.75]);
+        let near = |a: DMat3, b: DMat3| a.abs_diff_eq(b, 1e-12);
+        assert!(near(skew_mul(v, m), skew(v) * m));
+        assert!(near(mul_skew(m, v), m * skew(v)));
+    }
     use crate::base::rng::Rng;
 
     const DOF: usize = 3 * N;
