@@ -45,9 +45,13 @@ pub fn editor(score: Option<PathBuf>, dir: &Path, render: bool) -> Harness<'stat
     builder().build_eframe(move |_cc| EditorApp::with_options(options))
 }
 
-/// Let the composing worker finish, then run the UI until it is idle.
+/// Let the file jobs (saving, exporting, importing) and then the composing worker
+/// finish, then run the UI until it is idle. (Without waiting for the files, a save
+/// still writing under a loaded machine kept the status bar's spinner turning past the
+/// harness's 64 frames.)
 pub fn settle(h: &mut Harness<'static, EditorApp>) {
     h.step();
+    h.state_mut().wait_for_files();
     h.state_mut().wait_for_composition();
     h.run();
 }
