@@ -63,7 +63,7 @@ fn an_edit_is_composed_once_for_the_view_and_the_rendering() {
         Duration::ZERO,
         "the render composed"
     );
-    assert_eq!(Some(&rendering.composition), h.state().composition());
+    assert_eq!(Some(&*rendering.composition), h.state().composition());
     assert!(
         (rendering.composition.strokes.iter())
             .all(|s| s.mode == timpanist::score::PlayingMode::Tenuto),

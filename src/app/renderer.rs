@@ -153,7 +153,7 @@ pub fn job() -> impl FnMut(Request, &Job<Reply>) + Send + 'static {
                 &mut resume,
                 Some(stop_after_s),
                 &request.loaded,
-                (*request.composition).clone(),
+                std::sync::Arc::clone(&request.composition),
                 &params,
                 &mut |_| job.is_current(),
             );

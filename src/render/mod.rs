@@ -40,6 +40,7 @@ use compensate::{Aims, Performance, Stage};
 use damping::DampReport;
 use glam::DVec3;
 use reference::{Release, StrikeShape, Targets, Warp};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 use strikes::{StrikeEvent, Timing};
 
@@ -236,7 +237,7 @@ impl Stats {
 /// A rendered score.
 #[derive(Clone, Debug)]
 pub struct Rendering {
-    pub composition: Composition,
+    pub composition: Arc<Composition>,
     /// The targets the body followed (after strike-through and timing warp); time 0 is
     /// `start_s` of the score.
     pub reference: Reference,
@@ -374,8 +375,14 @@ pub fn render_after(
     let began = Instant::now();
     let composition = compose(loaded, db, params)?;
     let compose_time = began.elapsed();
-    let mut rendering =
-        render_composition(resume, stop_after_s, loaded, composition, params, progress)?;
+    let mut rendering = render_composition(
+        resume,
+        stop_after_s,
+        loaded,
+        Arc::new(composition),
+        params,
+        progress,
+    )?;
     rendering.stats.compose = compose_time;
     Ok(rendering)
 }
@@ -405,7 +412,7 @@ pub fn render_composition(
     resume: &mut Option<Resume>,
     stop_after_s: Option<f64>,
     loaded: &LoadedScore,
-    composition: Composition,
+    composition: Arc<Composition>,
     params: &RenderParams,
     progress: &mut dyn FnMut(Progress) -> bool,
 ) -> Result<Rendering, RenderError> {
