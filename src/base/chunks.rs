@@ -178,14 +178,13 @@ impl<T: Clone> SharedChunks<T> {
     }
 }
 
-impl<T> std::ops::Index<usize> for SharedChunks<T> {
+impl<T: Clone> std::ops::Index<usize> for SharedChunks<T> {
     type Output = T;
 
     /// # Panics
     /// When `index` is outside the record.
     fn index(&self, index: usize) -> &T {
-        assert!(index < self.len, "index outside the record");
-        &self.chunks[index / self.chunk_len][index % self.chunk_len]
+        self.get(index).expect("index outside the record")
     }
 }
 

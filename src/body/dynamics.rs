@@ -712,6 +712,7 @@ fn rotation_exp(v: DVec3) -> DQuat {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::base::rng::Rng;
 
     /// The cross-product forms of skew(v)·m and m·skew(v) are the matrix products.
     #[test]
@@ -722,7 +723,6 @@ mod tests {
         assert!(near(skew_mul(v, m), skew(v) * m));
         assert!(near(mul_skew(m, v), m * skew(v)));
     }
-    use crate::base::rng::Rng;
 
     const DOF: usize = 3 * N;
 

@@ -137,17 +137,17 @@ impl Audio {
 
     /// The mean of the channels.
     pub fn mono(&self) -> Vec<f32> {
+        self.mono_of(0..self.frames())
+    }
+
+    /// The mean of the channels over `frames` (within the audio).
+    pub fn mono_of(&self, frames: std::ops::Range<usize>) -> Vec<f32> {
         let ch = usize::from(self.channels.max(1));
-        let mean = |f: &[f32]| f.iter().sum::<f32>() / ch as f32;
-        if AUDIO_CHUNK.is_multiple_of(ch) {
-            // Every chunk holds whole frames.
-            self.samples
-                .chunks()
-                .flat_map(|c| c.chunks_exact(ch).map(mean))
-                .collect()
-        } else {
-            self.samples.to_vec().chunks_exact(ch).map(mean).collect()
-        }
+        self.samples
+            .to_vec_of(frames.start * ch..frames.end * ch)
+            .chunks_exact(ch)
+            .map(|f| f.iter().sum::<f32>() / ch as f32)
+            .collect()
     }
 }
 

@@ -89,25 +89,14 @@ impl Envelope {
     /// frame 0 at time 0).
     pub fn new(samples: &SharedChunks<f32>, channels: usize, rate_hz: f64) -> Envelope {
         let channels = channels.max(1);
-        const NONE: [f32; 2] = [f32::INFINITY, f32::NEG_INFINITY];
-        let mut blocks = Vec::with_capacity(samples.len().div_ceil(Self::BLOCK * channels));
-        let (mut block, mut sum, mut in_frame, mut in_block) = (NONE, 0.0f32, 0, 0);
-        for &v in samples.iter() {
-            sum += v;
-            in_frame += 1;
-            if in_frame == channels {
-                let mean = sum / channels as f32;
-                block = [block[0].min(mean), block[1].max(mean)];
-                (sum, in_frame, in_block) = (0.0, 0, in_block + 1);
-                if in_block == Self::BLOCK {
-                    blocks.push(std::mem::replace(&mut block, NONE));
-                    in_block = 0;
-                }
-            }
-        }
-        if in_block > 0 {
-            blocks.push(block);
-        }
+        let per_block = Self::BLOCK * channels;
+        let blocks = (0..samples.len())
+            .step_by(per_block)
+            .map(|a| {
+                let z = (a + per_block).min(samples.len());
+                extremes(&samples.to_vec_of(a..z), channels)
+            })
+            .collect();
         Envelope {
             rate_hz,
             channels,

@@ -79,16 +79,10 @@ pub fn selected_strike(
 /// (log10 of frequency in Hz, level in dB re full scale) from [`LOWEST_HZ`] to Nyquist,
 /// floored [`RANGE_DB`] below the strongest bin. Empty if the window holds no audio.
 pub fn strike_spectrum(audio: &Audio, t0_s: f64, window_s: f64) -> Vec<[f64; 2]> {
-    let ch = usize::from(audio.channels.max(1));
     let rate = f64::from(audio.rate_hz);
     let a = ((t0_s * rate).round().max(0.0) as usize).min(audio.frames());
     let z = (((t0_s + window_s) * rate).round().max(0.0) as usize).min(audio.frames());
-    let mono: Vec<f32> = audio
-        .samples
-        .to_vec_of(a * ch..z * ch)
-        .chunks_exact(ch)
-        .map(|f| f.iter().sum::<f32>() / ch as f32)
-        .collect();
+    let mono = audio.mono_of(a..z);
     let spec = crate::sound::spectrum(&mono, audio.rate_hz);
     let db = |amp: f64| 20.0 * amp.max(1e-12).log10();
     let top = spec
