@@ -86,7 +86,7 @@ impl Labels {
     pub fn cost(&self, u: &UnitEntry) -> f64 {
         let (r1, a1) = u.location.polar();
         let (r2, a2) = self.location.polar();
-        let angle = ((a1 - a2 + 540.0).rem_euclid(360.0) - 180.0).abs() / 180.0;
+        let angle = (turn_remainder(a1 - a2 + 540.0) - 180.0).abs() / 180.0;
         10.0 * f64::from(u.mode != self.mode)
             + 3.0 * (r1 - r2).abs()
             + 0.5 * angle
@@ -197,6 +197,20 @@ impl std::fmt::Display for Substitution {
     }
 }
 
+/// `x.rem_euclid(360.0)`, the same to the bit (x − 360 and x − 720 are exact where they
+/// are taken, by Sterbenz's lemma), without the division for the angles a cost compares.
+fn turn_remainder(x: f64) -> f64 {
+    if (0.0..360.0).contains(&x) {
+        x
+    } else if (360.0..720.0).contains(&x) {
+        x - 360.0
+    } else if (720.0..1080.0).contains(&x) {
+        x - 720.0
+    } else {
+        x.rem_euclid(360.0)
+    }
+}
+
 /// What `stroke` of `score` asks of its unit.
 pub fn wanted(stroke: &PlannedStroke, score: &Score) -> Labels {
     Labels {
@@ -285,18 +299,22 @@ pub fn plan(
 }
 
 /// Pick a unit for every stroke: the seeded choice among near equals, avoiding the unit
-/// the same hand used last when another is as good.
+/// the same hand used last when another is as good. The near equals depend only on what
+/// a stroke asks ([`wanted`]), so they are found once per distinct ask (a score asks a
+/// few dozen things of 1 440 units, not one per stroke).
 fn choose_units(strokes: &mut [PlannedStroke], score: &Score, db: &MotionDb, params: &PlanParams) {
     let rng = Rng::new(params.seed);
     let mut last = [usize::MAX; 2];
+    let mut asked: Vec<(Labels, Vec<usize>)> = Vec::new();
     for (i, s) in strokes.iter_mut().enumerate() {
         let wanted = wanted(s, score);
-        let costs: Vec<f64> = db.index.units.iter().map(|u| wanted.cost(u)).collect();
-        let best = costs.iter().copied().fold(f64::INFINITY, f64::min);
+        let known = asked.iter().position(|(labels, _)| *labels == wanted);
+        let k = known.unwrap_or_else(|| {
+            asked.push((wanted, near_equals(&wanted, db, params.near_equal)));
+            asked.len() - 1
+        });
+        let mut near = asked[k].1.clone();
         let h = crate::mocap::db::side_index(s.hand);
-        let mut near: Vec<usize> = (0..costs.len())
-            .filter(|&k| costs[k] <= best + params.near_equal)
-            .collect();
         if near.len() > 1 {
             near.retain(|&k| k != last[h]);
         }
@@ -304,6 +322,15 @@ fn choose_units(strokes: &mut [PlannedStroke], score: &Score, db: &MotionDb, par
         s.unit = pick;
         last[h] = pick;
     }
+}
+
+/// The units of `db` whose cost for `wanted` is within `near_equal` of the best, in order.
+fn near_equals(wanted: &Labels, db: &MotionDb, near_equal: f64) -> Vec<usize> {
+    let costs: Vec<f64> = db.index.units.iter().map(|u| wanted.cost(u)).collect();
+    let best = costs.iter().copied().fold(f64::INFINITY, f64::min);
+    (0..costs.len())
+        .filter(|&k| costs[k] <= best + near_equal)
+        .collect()
 }
 
 #[cfg(test)]
@@ -430,6 +457,29 @@ mod tests {
     }
 
     /// The same seed gives the same plan; another seed varies the units, not the strokes.
+    #[test]
+    fn turn_remainder_is_rem_euclid_to_the_bit() {
+        let mut rng = crate::base::rng::Rng::new(7);
+        let edges = [
+            0.0,
+            180.0,
+            359.999_999_999_999_94,
+            360.0,
+            540.0,
+            720.0,
+            1080.0,
+            -0.5,
+        ];
+        let drawn = (0..100_000).map(|_| rng.uniform(-400.0, 1500.0));
+        for x in edges.into_iter().chain(drawn) {
+            assert_eq!(
+                turn_remainder(x).to_bits(),
+                x.rem_euclid(360.0).to_bits(),
+                "{x}"
+            );
+        }
+    }
+
     #[test]
     fn seeded_and_deterministic() {
         let db = shipped_db();
