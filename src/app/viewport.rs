@@ -12,6 +12,7 @@ use super::selection::Selection;
 use crate::body::model::BodyModel;
 use crate::body::skeleton::Pose;
 use crate::drum::DrumSet;
+use crate::drum::set::recorded_sum;
 use crate::kit::Side;
 use crate::mocap::db::side_index;
 use crate::motion::compose::Composition;
@@ -25,6 +26,8 @@ use crate::score::edit::ScoreEdit;
 use crate::score::{Handle, ImpactPin, LoadedScore, SavedCamera};
 use eframe::egui::{self, Color32, Pos2, Rect, Sense, Shape, Stroke, Vec2};
 use glam::{DVec2, DVec3};
+use std::cell::RefCell;
+use std::collections::HashMap;
 
 /// Colour of each hand's composed (target) trajectory, [left, right].
 pub const TARGET_COLOURS: [Color32; 2] = [colour32(HAND_COLOURS[0]), colour32(HAND_COLOURS[1])];
@@ -38,6 +41,45 @@ pub const SIMULATED_COLOURS: [Color32; 2] = [
 /// time `time_s`, m, as recorded by the rendering in `drums`; zero without one.
 pub fn head_displacement(drums: Option<&DrumSet>, index: usize, time_s: f64, point: DVec3) -> f64 {
     drums.map_or(0.0, |d| d.recorded_displacement(index, time_s, point))
+}
+
+/// The flat view's head shapes: the coupled modes' shapes at each point a frame asks the
+/// displacement of (rings and spokes, the same points every frame), computed once per
+/// rendering — a few hundred points of a hundred Bessel modes each, which every frame
+/// computed again before.
+#[derive(Default)]
+struct PointShapes {
+    /// The drums they were computed for: address and contacts (as [`HeadShapes`]' key).
+    ///
+    /// [`HeadShapes`]: super::solid_frame::HeadShapes
+    key: Option<(usize, usize)>,
+    shapes: HashMap<(usize, [u64; 3]), Option<Vec<f64>>>,
+}
+
+impl PointShapes {
+    /// [`head_displacement`], from the shapes kept for `drums`.
+    fn displacement(
+        &mut self,
+        drums: Option<&DrumSet>,
+        index: usize,
+        time_s: f64,
+        point: DVec3,
+    ) -> f64 {
+        let Some(q) = drums.and_then(|d| d.recorded_modes(index, time_s).map(|q| (d, q))) else {
+            return 0.0;
+        };
+        let (drums, q) = q;
+        let key = (std::ptr::from_ref(drums) as usize, drums.contacts().len());
+        if self.key != Some(key) {
+            self.shapes.clear();
+            self.key = Some(key);
+        }
+        let at = (index, point.to_array().map(f64::to_bits));
+        (self.shapes.entry(at))
+            .or_insert_with(|| drums.coupled_shapes_at(index, point))
+            .as_ref()
+            .map_or(0.0, |shapes| recorded_sum(q, shapes))
+    }
 }
 
 /// What the viewport draws.
@@ -138,6 +180,8 @@ pub struct Viewport {
     pub gpu: Option<eframe::wgpu::TextureFormat>,
     /// The heads' mode shapes for the GPU view.
     heads: super::solid_frame::HeadShapes,
+    /// The heads' mode shapes for the flat view.
+    points: RefCell<PointShapes>,
 }
 
 fn to_pos(rect: Rect, p: DVec2) -> Pos2 {
@@ -335,7 +379,9 @@ impl Viewport {
             stage::floor(&proj, &mut marks);
             // Drums first: the body and sticks are above the heads, which are translucent.
             for (index, drum) in kit.drums.iter().enumerate() {
-                let membrane = |p: DVec3| head_displacement(input.drums, index, input.time_s, p);
+                let membrane = |p: DVec3| {
+                    (self.points.borrow_mut()).displacement(input.drums, index, input.time_s, p)
+                };
                 stage::drum(&proj, drum, &membrane, &mut marks);
             }
             for (ghost, tint) in input.ghosts {
@@ -495,7 +541,12 @@ impl Viewport {
                 _ => TARGET_COLOURS[h],
             };
             let block = |k: usize| shown.start + (k - shown.start) / piece * piece;
-            let colour = |k: usize| base(k).gamma_multiply(fade(block(k)) as f32);
+            // Opaque pieces (all of them without a window) keep their colour as it is:
+            // gamma_multiply(1.0) is the identity, and per sample it was most of a frame.
+            let colour = |k: usize| match fade(block(k)) as f32 {
+                1.0 => base(k),
+                f => base(k).gamma_multiply(f),
+            };
             draw_polyline(painter, rect, tips, shown.clone(), colour);
         }
         let score = &input.doc.score;

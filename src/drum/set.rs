@@ -622,13 +622,12 @@ impl DrumSet {
     /// point `point` at `time_s` (the frame before it, every 10 ms; coupled modes only);
     /// 0 off the head, for an unknown drum, or outside the recorded time.
     pub fn recorded_displacement(&self, drum: usize, time_s: f64, point: DVec3) -> f64 {
-        let (Some(q), Some(shapes)) = (
-            self.recorded_modes(drum, time_s),
-            self.coupled_shapes_at(drum, point),
-        ) else {
+        // The shapes (Bessel functions of every coupled mode) only for a head that moves.
+        let Some(q) = self.recorded_modes(drum, time_s) else {
             return 0.0;
         };
-        recorded_sum(q, &shapes)
+        self.coupled_shapes_at(drum, point)
+            .map_or(0.0, |shapes| recorded_sum(q, &shapes))
     }
 
     /// The recorded amplitudes (m) of drum `drum`'s coupled modes in the frame before
