@@ -348,6 +348,7 @@ fn a_failure_midway_leaves_no_partial_pack() {
         gaze: None,
         grip: None,
         hands: None,
+        lean: None,
     };
     let audio = timpanist::sound::Audio {
         rate_hz: 48_000,

@@ -7,6 +7,7 @@ pub mod control;
 pub mod dynamics;
 pub mod gaze;
 pub mod ik;
+pub mod lean;
 pub mod limits;
 pub mod model;
 pub mod sim;

@@ -32,7 +32,7 @@ use super::model::BodyModel;
 use super::skeleton::{JOINT_COUNT, Joint, Pose};
 pub use crate::base::choices::{BodyStep, Pipeline};
 use crate::kit::Side;
-use glam::{DMat3, DVec3};
+use glam::{DMat3, DQuat, DVec3};
 use std::f64::consts::TAU;
 
 /// Simulation settings.
@@ -148,6 +148,9 @@ pub struct Reference {
     /// Hands brought to points of their own (a hand resting on a head to damp it); `None`
     /// when the hands only carry the sticks.
     pub hands: Option<HandTargets>,
+    /// Per sample, the trunk's turn toward far strokes ([`super::lean::track`]: a world
+    /// rotation applied to the upright trunk the IK pulls toward); `None` keeps it upright.
+    pub lean: Option<Vec<DQuat>>,
 }
 
 /// A body is calm (see [`SimParams::calm_substeps`]) this long, s, before and after every
@@ -406,7 +409,9 @@ pub fn ik_target(
         None => {
             let mut pull = start;
             let trunk = Joint::Trunk.index();
-            pull[trunk] = posture[trunk];
+            pull[trunk] = reference.lean.as_ref().map_or(posture[trunk], |lean| {
+                (lean[k] * posture[trunk]).normalize()
+            });
             pull
         }
     };
@@ -1016,6 +1021,7 @@ mod tests {
             gaze: None,
             grip: None,
             hands: None,
+            lean: None,
         };
         let params = SimParams {
             frequency_hz: [2000.0; JOINT_COUNT],
@@ -1058,6 +1064,7 @@ mod tests {
             gaze: None,
             grip: None,
             hands: None,
+            lean: None,
         };
         let run = |limit: f64| {
             let params = SimParams {
@@ -1153,6 +1160,7 @@ mod tests {
             gaze: None,
             grip: None,
             hands: None,
+            lean: None,
         };
         let params = SimParams::default();
         let (a, b) = (reference(0.0), reference(0.5));

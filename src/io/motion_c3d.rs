@@ -89,6 +89,7 @@ mod tests {
             gaze: None,
             grip: None,
             hands: None,
+            lean: None,
         };
         let bytes = to_c3d(&motion, &reference, &skeleton);
         let back = read(Path::new("motion.c3d"), &bytes, None).unwrap();

@@ -265,6 +265,7 @@ fn unit_reference(db: &MotionDb, unit: &UnitEntry, tips: [Vec<DVec3>; 2]) -> Ref
         gaze: None,
         grip: None,
         hands: None,
+        lean: None,
     }
 }
 
@@ -324,6 +325,7 @@ fn solved_joints(tips: &[Vec<DVec3>; 2], rate_hz: f64) -> Vec<Pose> {
         gaze: None,
         grip: None,
         hands: None,
+        lean: None,
     };
     let model = BodyModel::new(skeleton, 70.0);
     ik_targets(&model, &reference, &SimParams::default(), &start)

@@ -438,7 +438,8 @@ pub fn render_composition(
         lead_s: params.strike_lead_s,
         release: params.release,
     };
-    let targets = Targets::new(&composition, &shape, params.strike_depth_m);
+    let mut targets = Targets::new(&composition, &shape, params.strike_depth_m);
+    targets.lean_for(&skeleton, &composition);
     let run = Run {
         kit,
         retunes: &retunes,

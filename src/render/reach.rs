@@ -1,11 +1,13 @@
 //! Whether the body can reach every stroke, checked before simulating: a stroke whose
 //! target lies farther from its hand's shoulder (in the upright rest posture) than the
-//! stretched arm and stick (`Skeleton::reach_m`) is refused with the beat named. Leaning
-//! the trunk could add some, but at speed the stretched arm oscillates first. Automatic
-//! sticking avoids such hands (`motion::sticking`). Simulated, such a reach leaves the arm
-//! fully stretched, where the nested IK and the PD loops oscillate and the stick flails
-//! (see `body::sim`'s loss-of-control check). With the standard kit these are the outer
-//! drums played across the body.
+//! stretched arm and stick (`Skeleton::reach_m`) plus what leaning the trunk toward it
+//! brings (`body::lean::gain_m`: up to 23°, about 0.1 m across the body) is refused with
+//! the beat named.
+//! Automatic sticking prefers the hand that reaches upright (`motion::sticking`).
+//! Simulated, a reach beyond that leaves the arm fully stretched, where the nested IK and
+//! the PD loops oscillate and the stick flails (see `body::sim`'s loss-of-control check).
+//! Within it, a far target leans the trunk (`body::lean`): on the standard kit, the outer
+//! drums played across the body — a roll on the 32- or the 23-inch drum.
 
 use crate::body::skeleton::Skeleton;
 use crate::kit::Side;
@@ -15,7 +17,8 @@ use crate::motion::plan::PlannedStroke;
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error(
     "beat {beat} is out of the {} hand's reach: its target on drum {drum} is {distance_m:.2} m \
-     from the shoulder, the arm and stick reach {reach_m:.2} m ({})",
+     from the upright shoulder, the arm and stick reach {reach_m:.2} m with the trunk leaning \
+     toward it ({})",
     if *hand == Side::Left { "left" } else { "right" },
     if *roll {
         "a roll takes both hands: roll on a drum both hands reach, tuned to this pitch, or \
@@ -30,7 +33,8 @@ pub struct OutOfReach {
     pub drum: usize,
     /// Distance from the shoulder to the target, m.
     pub distance_m: f64,
-    /// How far the tip can go from the shoulder, m.
+    /// How far the tip can go from the upright shoulder toward the target, the trunk
+    /// leaning ([`crate::body::lean::gain_m`]), m.
     pub reach_m: f64,
     /// Whether both hands play the beat (a roll), so the other hand is no way out.
     pub roll: bool,
@@ -38,9 +42,10 @@ pub struct OutOfReach {
 
 /// The first stroke of `strokes` out of reach of `skeleton`, if any.
 pub fn check(strokes: &[PlannedStroke], skeleton: &Skeleton) -> Result<(), OutOfReach> {
-    let reach_m = skeleton.reach_m();
+    let arm_m = skeleton.reach_m();
     for s in strokes {
         let distance_m = s.target.distance(skeleton.shoulder(s.hand));
+        let reach_m = arm_m + crate::body::lean::gain_m(skeleton, s.hand, s.target);
         if distance_m > reach_m {
             return Err(OutOfReach {
                 beat: s.beat,

@@ -15,7 +15,7 @@
 
 use crate::body::sim::{HandTargets, Reference};
 use crate::motion::compose::Composition;
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 use std::ops::Range;
 
 /// How the targets are shaped around impacts.
@@ -122,6 +122,8 @@ pub struct Targets {
     beats: Vec<(f64, usize)>,
     /// Where the performer looks, per sample (see `render::gaze`), m.
     gaze: Vec<DVec3>,
+    /// The trunk's turn toward far strokes, per sample ([`crate::body::lean::track`]).
+    lean: Option<Vec<DQuat>>,
     /// The fraction of each hand's grip control held per sample, [left, right].
     held: [Vec<f64>; 2],
     /// Where the hands damp heads (the composition's muffles), when any do.
@@ -190,6 +192,7 @@ impl Targets {
             dips,
             beats,
             gaze: super::gaze::gaze_points(comp),
+            lean: None,
             held,
             hands,
         };
@@ -271,7 +274,15 @@ impl Targets {
             gaze: Some(self.gaze.clone()),
             grip: Some(self.held.clone()),
             hands: self.hands.clone(),
+            lean: self.lean.clone(),
         }
+    }
+
+    /// Lean the trunk toward the composition's far strokes for a player of `skeleton`
+    /// ([`crate::body::lean::track`] of the composed tips, before any warp: a lean is
+    /// held over 0.3 s, far longer than a stroke's 35 ms shift).
+    pub fn lean_for(&mut self, skeleton: &crate::body::Skeleton, comp: &Composition) {
+        self.lean = crate::body::lean::track(skeleton, &comp.tips, comp.rate_hz);
     }
 
     /// Write samples `range` of `reference` (made by [`blank`](Targets::blank)) through
@@ -427,6 +438,7 @@ mod tests {
             dips: Vec::new(),
             beats: Vec::new(),
             gaze: Vec::new(),
+            lean: None,
             held: [vec![1.0; n], vec![1.0; n]],
             hands: None,
         }
