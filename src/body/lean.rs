@@ -1,5 +1,5 @@
 //! Leaning toward far strokes: a tip target farther from its (upright) shoulder than a
-//! comfortable reach ([`COMFORT_M`]) turns the trunk about its base so that shoulder comes
+//! comfortable reach ([`comfort_m`]) turns the trunk about its base so that shoulder comes
 //! toward it, as a player leans toward an outer drum played across the body — a roll on
 //! the 32- or the 23-inch drum, which takes the far hand too. The turn is held around the
 //! far targets ([`HOLD_S`]) and smoothed, so it does not follow each stroke's lift and
@@ -11,9 +11,17 @@ use super::skeleton::{Joint, REST, Skeleton};
 use crate::kit::Side;
 use glam::{DQuat, DVec3};
 
-/// A tip target within this distance of its upright shoulder needs no lean, m (the
-/// farthest demo stroke is 0.95 m from its shoulder).
-pub const COMFORT_M: f64 = 0.95;
+/// A tip target within the arm's reach less this of its upright shoulder needs no lean, m
+/// (0.95 m for the default player and mallets: the farthest demo stroke is 0.95 m from
+/// its shoulder).
+pub const COMFORT_MARGIN_M: f64 = 0.02;
+
+/// How far from its upright shoulder a tip target needs no lean, m: the stretched arm
+/// and stick ([`Skeleton::reach_m`]) less [`COMFORT_MARGIN_M`] — shorter mallets or a
+/// smaller player lean sooner.
+pub fn comfort_m(skeleton: &Skeleton) -> f64 {
+    skeleton.reach_m() - COMFORT_MARGIN_M
+}
 
 /// The largest lean, rad (about 23°).
 pub const MAX_LEAN_RAD: f64 = 0.4;
@@ -33,13 +41,13 @@ fn levers(skeleton: &Skeleton) -> (DVec3, [DVec3; 2]) {
 }
 
 /// The turn (rotation vector about the trunk's base, rad) that brings each shoulder as
-/// much nearer its target as the target is beyond [`COMFORT_M`], to first order: a
+/// much nearer its target as the target is beyond `comfort` (m), to first order: a
 /// rotation ω moves a shoulder by ω × lever, straight toward the target about
 /// lever × toward, |lever × toward| per radian.
-fn demand(pivot: DVec3, shoulders: [DVec3; 2], tips: [DVec3; 2]) -> DVec3 {
+fn demand(pivot: DVec3, shoulders: [DVec3; 2], tips: [DVec3; 2], comfort: f64) -> DVec3 {
     let mut turn = DVec3::ZERO;
     for (shoulder, tip) in shoulders.into_iter().zip(tips) {
-        let beyond = tip.distance(shoulder) - COMFORT_M;
+        let beyond = tip.distance(shoulder) - comfort;
         if beyond <= 0.0 {
             continue;
         }
@@ -69,9 +77,10 @@ pub fn gain_m(skeleton: &Skeleton, side: Side, target: DVec3) -> f64 {
 /// moving means of [`HOLD_S`], at most [`MAX_LEAN_RAD`]. `None` when no target is far.
 pub fn track(skeleton: &Skeleton, tips: &[Vec<DVec3>; 2], rate_hz: f64) -> Option<Vec<DQuat>> {
     let (pivot, shoulders) = levers(skeleton);
+    let comfort = comfort_m(skeleton);
     let n = tips[0].len().min(tips[1].len());
     let turn: Vec<DVec3> = (0..n)
-        .map(|k| demand(pivot, shoulders, [tips[0][k], tips[1][k]]))
+        .map(|k| demand(pivot, shoulders, [tips[0][k], tips[1][k]], comfort))
         .collect();
     if turn.iter().all(|t| *t == DVec3::ZERO) {
         return None;
@@ -113,7 +122,7 @@ mod tests {
     use super::*;
 
     fn skeleton() -> Skeleton {
-        Skeleton::new(1.75, 0.35)
+        Skeleton::new(1.75, 0.37)
     }
 
     /// A target `distance_m` from `side`'s upright shoulder, toward the other side at
@@ -125,6 +134,14 @@ mod tests {
         let drop = shoulder.z - 0.8;
         let run = (distance_m * distance_m - drop * drop).sqrt();
         shoulder + DVec3::new(x * run, 0.0, -drop)
+    }
+
+    /// The default player with the standard mallets leans beyond 0.95 m, a shorter
+    /// mallet sooner.
+    #[test]
+    fn comfort_follows_the_reach() {
+        assert!((comfort_m(&skeleton()) - 0.95).abs() < 0.01);
+        assert!(comfort_m(&Skeleton::new(1.75, 0.30)) < comfort_m(&skeleton()) - 0.04);
     }
 
     /// Targets within a comfortable reach lean nothing (no track at all); one beyond it
@@ -145,7 +162,7 @@ mod tests {
             far.distance(shoulder(&leaned)),
         );
         assert!(
-            (before - after - (1.03 - COMFORT_M)).abs() < 0.02,
+            (before - after - (1.03 - comfort_m(&s))).abs() < 0.02,
             "{before:.3} → {after:.3} m"
         );
         assert!(

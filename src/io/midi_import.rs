@@ -880,8 +880,10 @@ pub(super) fn assign_drums(notes: &[Note], kit: &Kit, warnings: &mut Vec<String>
     beats
 }
 
-/// Per drum, whether the default player reaches its playing spot with either hand (the
-/// stretched arm and stick from the shoulder, as the sticking and the renderer judge it).
+/// Per drum, whether the default player reaches its playing spot with either hand upright
+/// (the stretched arm and stick from the shoulder, as the sticking judges it; the renderer
+/// also lets the trunk lean toward a far stroke, but a roll is played on a drum both hands
+/// reach upright when one holds its pitch).
 fn both_hands_reach(kit: &Kit) -> Vec<bool> {
     use crate::kit::Side;
     let body = crate::body::skeleton::Skeleton::holding_mallets_of(kit);
