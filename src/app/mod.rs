@@ -57,7 +57,6 @@ pub use pose::Simulated;
 pub use recent::RecentFiles;
 pub use selection::Selection;
 pub use time_axis::{TimeAxis, snap};
-pub use viewport::head_displacement;
 
 use clipboard::Clipboard;
 use command::Command;

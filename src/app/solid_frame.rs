@@ -24,12 +24,18 @@ fn ghost_colour(tint: Rgba) -> [f32; 4] {
     linear(r, g, b, (f32::from(a) / 255.0 * 1.6).min(1.0))
 }
 
+/// Which rendering's drums `drums` are, for caches of what is computed once per rendering:
+/// their address and how many contacts they recorded.
+pub fn rendering_key(drums: &DrumSet) -> (usize, usize) {
+    (std::ptr::from_ref(drums) as usize, drums.contacts().len())
+}
+
 /// The mode shapes of every head at its grid points ([`solid::head_grid`]), for one
 /// rendering's drums and one kit.
 #[derive(Default)]
 pub struct HeadShapes {
-    /// The drums they were computed for: address, drum count, recorded frames' length.
-    key: Option<(usize, usize, usize)>,
+    /// The rendering they were computed for ([`rendering_key`]) and the kit's drum count.
+    key: Option<((usize, usize), usize)>,
     /// Per drum, per grid point, the shapes of its coupled modes (None off the head).
     shapes: Vec<Vec<Option<Vec<f64>>>>,
 }
@@ -40,11 +46,7 @@ impl HeadShapes {
         let Some(drums) = drums else {
             return vec![vec![0.0; solid::HEAD_GRID_POINTS]; kit.drums.len()];
         };
-        let key = (
-            std::ptr::from_ref(drums) as usize,
-            kit.drums.len(),
-            drums.contacts().len(),
-        );
+        let key = (rendering_key(drums), kit.drums.len());
         if self.key != Some(key) {
             self.shapes = (kit.drums.iter().map(solid::head_grid))
                 .enumerate()

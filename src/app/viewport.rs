@@ -9,6 +9,7 @@
 use super::command::Command;
 use super::picking::{drag_along_axis, drag_in_plane, pick_polyline};
 use super::selection::Selection;
+use super::solid_frame::rendering_key;
 use crate::body::model::BodyModel;
 use crate::body::skeleton::Pose;
 use crate::drum::DrumSet;
@@ -37,27 +38,21 @@ pub const SIMULATED_COLOURS: [Color32; 2] = [
     Color32::from_rgb(250, 220, 90),
 ];
 
-/// Vertical displacement of drum `index`'s head at `point` (performer frame) at score
-/// time `time_s`, m, as recorded by the rendering in `drums`; zero without one.
-pub fn head_displacement(drums: Option<&DrumSet>, index: usize, time_s: f64, point: DVec3) -> f64 {
-    drums.map_or(0.0, |d| d.recorded_displacement(index, time_s, point))
-}
-
 /// The flat view's head shapes: the coupled modes' shapes at each point a frame asks the
 /// displacement of (rings and spokes, the same points every frame), computed once per
 /// rendering — a few hundred points of a hundred Bessel modes each, which every frame
 /// computed again before.
 #[derive(Default)]
 struct PointShapes {
-    /// The drums they were computed for: address and contacts (as [`HeadShapes`]' key).
-    ///
-    /// [`HeadShapes`]: super::solid_frame::HeadShapes
+    /// The rendering they were computed for ([`rendering_key`]).
     key: Option<(usize, usize)>,
     shapes: HashMap<(usize, [u64; 3]), Option<Vec<f64>>>,
 }
 
 impl PointShapes {
-    /// [`head_displacement`], from the shapes kept for `drums`.
+    /// The vertical displacement (m) of drum `index`'s head at `point` (performer frame)
+    /// at score time `time_s`, as recorded by the rendering of `drums`; zero without one
+    /// ([`DrumSet::recorded_displacement`], from the shapes kept for `drums`).
     fn displacement(
         &mut self,
         drums: Option<&DrumSet>,
@@ -69,7 +64,7 @@ impl PointShapes {
             return 0.0;
         };
         let (drums, q) = q;
-        let key = (std::ptr::from_ref(drums) as usize, drums.contacts().len());
+        let key = rendering_key(drums);
         if self.key != Some(key) {
             self.shapes.clear();
             self.key = Some(key);

@@ -86,15 +86,18 @@ pub fn track(skeleton: &Skeleton, tips: &[Vec<DVec3>; 2], rate_hz: f64) -> Optio
         return None;
     }
     let w = ((HOLD_S * rate_hz).round() as usize).max(1);
+    // Each turn's length once, not once per window it falls in (2·w + 1 of them).
+    let lengths: Vec<f64> = turn.iter().map(|t| t.length()).collect();
     let held: Vec<DVec3> = (0..n)
         .map(|k| {
-            turn[k.saturating_sub(w)..(k + w + 1).min(n)]
-                .iter()
-                .copied()
-                .fold(
-                    DVec3::ZERO,
-                    |a, b| if b.length() > a.length() { b } else { a },
-                )
+            let window = k.saturating_sub(w)..(k + w + 1).min(n);
+            // The first longest in the window (none: no turn).
+            let longest = window.fold(None, |best: Option<usize>, j| match best {
+                Some(b) if lengths[j] <= lengths[b] => Some(b),
+                _ if lengths[j] > 0.0 => Some(j),
+                _ => best,
+            });
+            longest.map_or(DVec3::ZERO, |j| turn[j])
         })
         .collect();
     let eased = moving_mean(&moving_mean(&held, w / 2), w / 2);

@@ -243,7 +243,6 @@ impl VoiceBank {
     /// sums in the same order as one sample at a time, so the output is identical).
     pub fn render_free(&mut self, out: &mut [f32]) {
         #[cfg(target_arch = "x86_64")]
-        #[cfg(target_arch = "x86_64")]
         match width() {
             // SAFETY: the CPU has AVX-512F and VL (checked by `width`).
             Width::Avx512 => return unsafe { self.render_free_avx512(out) },
