@@ -692,6 +692,48 @@ fn rolls_on_the_outer_drums_lean_toward_them() {
     }
 }
 
+/// An edit that makes the trunk lean (eight of a run of sixteenths on the 26-inch drum,
+/// hands alternating, moved to the 32-inch drum) changes the lean before the edited
+/// strokes' own paths do — the lean is held 0.3 s and eased ahead of the far strokes — so
+/// a rendering resumed after it must resume before the lean changes: it gives bit for bit
+/// what rendering the edited score whole gives (before the resume compared the lean, it
+/// resumed at 4.80 s, after the lean had begun, and the audio differed).
+#[test]
+fn an_edit_that_leans_resumes_as_a_whole_render_does() {
+    let db = db();
+    let mut score = Score::new("lean edit");
+    score.tempo[0].bpm = 80.0;
+    score.beats = (0..40u64)
+        .map(|k| {
+            let mut b = Beat::plain(k * 240, 2);
+            b.hand = if k % 2 == 0 { Hand::Right } else { Hand::Left };
+            b
+        })
+        .collect();
+    let loaded = LoadedScore::from_score(&root().join("lean-edit.ron"), score).unwrap();
+    let params = RenderParams::default();
+    let mut resume: Option<Resume> = None;
+    render_after(&mut resume, None, &loaded, &db, &params, &mut |_| true).unwrap();
+    let mut edited = loaded.clone();
+    for b in &mut edited.score.beats[28..36] {
+        b.drum = 0;
+    }
+    let whole = render(&edited, &db, &params, &mut |_| true).unwrap();
+    let resumed = render_after(&mut resume, None, &edited, &db, &params, &mut |_| true).unwrap();
+    let leaned = |r: &Rendering| {
+        r.motion
+            .poses
+            .iter()
+            .map(|p| p[timpanist::body::Joint::Trunk.index()].angle_between(glam::DQuat::IDENTITY))
+            .fold(0.0, f64::max)
+            .to_degrees()
+    };
+    assert!(leaned(&whole) > 5.0, "leans {:.1}°", leaned(&whole));
+    let from = resumed.stats.resumed_from_s.expect("the edit resumes");
+    println!("resumed at {from:.2} s; leaning {:.1}°", leaned(&whole));
+    assert_same_performance(&resumed, &whole);
+}
+
 /// The head follows the hands: before each stroke that moves to another drum after a
 /// pause (0.6 s or more), the simulated face is turned toward that stroke's point on its
 /// head — its bearing from the pelvis, as far as the neck and head turn (70°; the eyes

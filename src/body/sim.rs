@@ -409,9 +409,12 @@ pub fn ik_target(
         None => {
             let mut pull = start;
             let trunk = Joint::Trunk.index();
-            pull[trunk] = reference.lean.as_ref().map_or(posture[trunk], |lean| {
-                (lean[k] * posture[trunk]).normalize()
-            });
+            // No turn is no lean, to the bit: a score whose lean is still zero here plays
+            // as one with none (an edit that adds a far stroke later resumes before it).
+            pull[trunk] = match reference.lean.as_ref().map(|lean| lean[k]) {
+                Some(turn) if turn != DQuat::IDENTITY => (turn * posture[trunk]).normalize(),
+                _ => posture[trunk],
+            };
             pull
         }
     };

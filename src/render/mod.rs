@@ -612,7 +612,9 @@ impl Run<'_> {
     /// The saved state of `previous` to resume from for this composition (none when the
     /// kit, parameters or timing differ), and where the change is heard: the first stroke
     /// that differs, else the first target sample that does (none for the same score: a
-    /// rendering continued).
+    /// rendering continued). A sample differs when a tip, the gaze or the trunk's lean
+    /// does: the lean looks ahead of the tips (it is held and eased before a far stroke),
+    /// so an edit that adds or moves a far stroke changes it before that stroke's path.
     fn resume_point(&self, previous: &Resume, targets: &Targets) -> Option<(usize, Option<f64>)> {
         let comp = self.composition;
         let same = previous.params == *self.params
@@ -631,6 +633,7 @@ impl Run<'_> {
             .find(|&k| {
                 (0..2).any(|h| previous.tips[h][k] != comp.tips[h][k])
                     || previous.gaze.get(k) != gaze.get(k)
+                    || previous.performance.targets.lean_at(k) != targets.lean_at(k)
             })
             .unwrap_or(common);
         let at = previous.performance.resumable(

@@ -285,6 +285,14 @@ impl Targets {
         self.lean = crate::body::lean::track(skeleton, &comp.tips, comp.rate_hz);
     }
 
+    /// The trunk's turn toward far strokes at sample `k` (none: the identity).
+    pub fn lean_at(&self, k: usize) -> DQuat {
+        self.lean
+            .as_ref()
+            .and_then(|lean| lean.get(k).copied())
+            .unwrap_or(DQuat::IDENTITY)
+    }
+
     /// Write samples `range` of `reference` (made by [`blank`](Targets::blank)) through
     /// `warp`: sample k at time t takes the shaped tip at t + shift(t).
     pub fn write(&self, warp: &Warp, reference: &mut Reference, range: Range<usize>) {
