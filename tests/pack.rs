@@ -335,11 +335,7 @@ fn a_failure_midway_leaves_no_partial_pack() {
     use timpanist::io::performance::Performance;
     let score = timpanist::score::demos::score("etude-modes").unwrap();
     let kit = timpanist::kit::Kit::bundled("standard").unwrap();
-    let motion = Motion {
-        rate_hz: 250.0,
-        tips: [Vec::new(), Vec::new()],
-        poses: Vec::new(),
-    };
+    let motion = Motion::new(250.0, [Vec::new(), Vec::new()], Vec::new());
     let reference = Reference {
         rate_hz: 250.0,
         tips: [Vec::new(), Vec::new()],

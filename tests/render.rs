@@ -435,6 +435,16 @@ fn resumed_render_after_an_edit_equals_a_whole_render() {
                 shared >= before_from && shared < chunks,
                 "{shared} of {chunks}"
             );
+            // So is the motion before it (the poses, in chunks of MOTION_CHUNK samples).
+            let poses = &resumed.motion.poses;
+            let shared = poses.shared_chunks(&before.motion.poses);
+            let chunk_s = timpanist::body::sim::MOTION_CHUNK as f64 / resumed.motion.rate_hz;
+            let before_from = ((from - whole.start_s) / chunk_s).floor() as usize;
+            println!("{shared} pose chunks shared, {before_from} before the resume at {from:.2} s");
+            assert!(
+                shared >= before_from && shared < poses.chunks().count(),
+                "{shared} pose chunks shared, resumed at {from:.2} s"
+            );
         }
         assert_eq!(resumed.audio.samples, whole.audio.samples, "beat {beat}");
         assert_eq!(resumed.motion, whole.motion, "beat {beat}");

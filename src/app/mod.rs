@@ -310,6 +310,9 @@ impl EditorApp {
             for a in keys::take_actions(ctx) {
                 self.pending.push(Command::Do(a));
             }
+            // Done before the frame is drawn: an edit by key is composed (and rendered)
+            // while the UI draws, instead of after it, and the frame shows it.
+            self.drain();
         }
         let title = self
             .doc

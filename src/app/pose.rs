@@ -175,11 +175,7 @@ mod tests {
     fn simulated_pose_lookup() {
         let mut second = REST;
         second[0] = DQuat::from_rotation_z(0.1);
-        let motion = |poses: Vec<Pose>| Motion {
-            rate_hz: 10.0,
-            tips: Default::default(),
-            poses,
-        };
+        let motion = |poses: Vec<Pose>| Motion::new(10.0, Default::default(), poses);
         let sim = Simulated::of_motion(1.0, motion(vec![REST, second]));
         assert_eq!(sim.pose_at(0.0), Some(&REST));
         assert_eq!(sim.pose_at(1.08), Some(&second));
@@ -214,14 +210,7 @@ mod tests {
                 p
             })
             .collect();
-        let sim = Simulated::of_motion(
-            0.0,
-            Motion {
-                rate_hz: 10.0,
-                tips: Default::default(),
-                poses: poses.clone(),
-            },
-        );
+        let sim = Simulated::of_motion(0.0, Motion::new(10.0, Default::default(), poses.clone()));
         let stroke = |beat: usize, time_s: f64| crate::motion::plan::PlannedStroke {
             beat,
             tick: 0,

@@ -52,6 +52,11 @@ impl<T: Clone> SharedChunks<T> {
         }
     }
 
+    /// Append `value` (see [`extend`](Self::extend)).
+    pub fn push(&mut self, value: T) {
+        self.extend(std::iter::once(value));
+    }
+
     /// Keep the first `len` values (all of them when there are fewer).
     pub fn truncate(&mut self, len: usize) {
         if len >= self.len {

@@ -64,11 +64,11 @@ pub fn run(
                 continue;
             };
             let motions = evaluate::trial(&model, reference, &params, &mut Rng::new(params.seed))?;
-            let captured = Motion {
-                rate_hz: reference.rate_hz,
-                tips: reference.tips.clone(),
-                poses: reference.poses.clone().unwrap_or_default(),
-            };
+            let captured = Motion::new(
+                reference.rate_hz,
+                reference.tips.clone(),
+                reference.poses.clone().unwrap_or_default(),
+            );
             let path = dir.join(format!("fig5-{}.png", mode.name().replace(' ', "-")));
             fig5(&model, (mode, unit.hand), &captured, &motions).save_png(&path)?;
             println!("wrote {}", path.display());

@@ -101,7 +101,7 @@ pub fn to_bvh(motion: &Motion, skeleton: &Skeleton, options: &Options) -> Result
     let order = depth_first();
     let mut out = String::from("HIERARCHY\n");
     write_joint(&mut out, skeleton, order[0], 0, scale);
-    let poses = resample(&motion.poses, source_hz, rate_hz);
+    let poses = resample(&motion.poses.to_vec(), source_hz, rate_hz);
     writeln!(out, "MOTION\nFrames: {}", poses.len()).expect("writing to a String");
     writeln!(out, "Frame Time: {:.8}", 1.0 / rate_hz).expect("writing to a String");
     let root = y_up::vector(skeleton.trunk_origin) * scale;
@@ -216,11 +216,7 @@ mod tests {
     use crate::body::skeleton::{JOINT_COUNT, REST};
 
     fn motion(poses: Vec<Pose>) -> Motion {
-        Motion {
-            rate_hz: 250.0,
-            tips: [Vec::new(), Vec::new()],
-            poses,
-        }
+        Motion::new(250.0, [Vec::new(), Vec::new()], poses)
     }
 
     /// The declared order's angles rebuild the rotation (R = Rx·Rz·Ry), also for the

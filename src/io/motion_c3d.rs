@@ -27,7 +27,7 @@ pub fn take_of(motion: &Motion, reference: &Reference, skeleton: &Skeleton) -> T
         .iter()
         .map(|&j| Track::empty(joint_label(j)))
         .collect();
-    for pose in &motion.poses {
+    for pose in motion.poses.iter() {
         let f = skeleton.forward(pose);
         for (track, p) in tracks.iter_mut().zip(f.position) {
             track.positions.push(Some(p));
@@ -76,11 +76,7 @@ mod tests {
                 vec![DVec3::new(0.3, 0.5, z); 3],
             ]
         };
-        let motion = Motion {
-            rate_hz: 250.0,
-            tips: tips(0.8),
-            poses: vec![REST, bent, REST],
-        };
+        let motion = Motion::new(250.0, tips(0.8), vec![REST, bent, REST]);
         let reference = Reference {
             rate_hz: 250.0,
             tips: tips(0.75),
