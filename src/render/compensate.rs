@@ -200,8 +200,9 @@ pub struct Stage<'a> {
     /// Told the fraction of the score simulated; `false` cancels.
     pub report: &'a mut dyn FnMut(f64) -> bool,
     /// Shown the performance each time a cluster is settled: everything it has simulated
-    /// is final then (later attempts rewind no further than the next cluster's lead-in).
-    pub settled: &'a mut dyn FnMut(&Performance),
+    /// is final then (later attempts rewind no further than the next cluster's lead-in);
+    /// `true` when it is the last this run settles (it goes on only to its horizon).
+    pub settled: &'a mut dyn FnMut(&Performance, bool),
 }
 
 /// The drums' wall time is read on one step in this many (by the drums' own step count:
@@ -361,12 +362,13 @@ impl Performance {
             let from = self.lead_from.unwrap_or(self.sim.samples());
             let lead = lead_in(&self.targets, cluster.clone(), rate, from);
             if let Some(h) = horizon.filter(|&h| lead > h) {
+                (stage.settled)(self, true);
                 // Up to the horizon the shifts are held as the lead-in would hold them.
                 self.lead_into(cluster.start, (from, lead), h, stage)?;
                 return Ok(false);
             }
             self.settle(cluster, strokes, aims, stage)?;
-            (stage.settled)(self);
+            (stage.settled)(self, false);
         }
         let (now, n) = (self.sim.samples(), self.targets.len());
         self.warp.anchor(now as f64 / rate);

@@ -655,8 +655,9 @@ impl Run<'_> {
     }
 
     /// [`settle`](Self::settle) with the modal sound of the settled clusters made on the
-    /// other core as the body is simulated (every [`SOUND_AHEAD_S`] of score, resuming
-    /// `sound`), so [`sound`](Self::sound) has only the rest left: the settled state and
+    /// other core as the body is simulated (every [`SOUND_AHEAD_S`] of score, and in a
+    /// step that stops at a horizon once its last cluster is settled, resuming `sound`),
+    /// so [`sound`](Self::sound) has only the rest left: the settled state and
     /// the sound's state to resume (bit for bit what it would be made in one go: the sound
     /// resumes where its record first differs).
     fn settle_sounding(
@@ -697,9 +698,13 @@ impl Run<'_> {
             // cluster made every drum's sound be made again from there, also the drums
             // whose strokes did not change.
             let mut sent_s = simulated_to_s(comp, performance);
-            let mut settled = |p: &Performance| {
+            // The last cluster a step settles before its horizon (the editor's first step
+            // after an edit: the edited stroke) is sounded at once, while the step goes
+            // on to its horizon, so only that stretch is left to sound after it.
+            let mut settled = |p: &Performance, last: bool| {
                 let end_s = simulated_to_s(comp, p);
-                if model != SoundModel::Modal || end_s < sent_s + SOUND_AHEAD_S {
+                let due = if last { sent_s } else { sent_s + SOUND_AHEAD_S };
+                if model != SoundModel::Modal || end_s <= due {
                     return;
                 }
                 sent_s = end_s;
@@ -723,7 +728,7 @@ impl Run<'_> {
         performance: &mut Performance,
         horizon: Option<usize>,
         (stats, progress): (&mut Stats, &mut dyn FnMut(Progress) -> bool),
-        settled: &mut dyn FnMut(&Performance),
+        settled: &mut dyn FnMut(&Performance, bool),
     ) -> Result<bool, RenderError> {
         let (comp, params) = (self.composition, self.params);
         let aims = Aims {

@@ -845,6 +845,38 @@ mod tests {
         );
     }
 
+    /// A synthesis cut anywhere (the sound made ahead of a simulation, an editor's step)
+    /// keeps a state at the start of its last block, so the next one resumes there — not
+    /// up to 8192 frames before — and gives what a whole render gives.
+    #[test]
+    fn a_cut_synthesis_resumes_at_its_end() {
+        let kit = Kit::standard();
+        let drums = struck_then(&kit, true);
+        let cut_s = 1.2345;
+        let cut = resynthesise_on(
+            &kit,
+            (&drums, &[]),
+            cut_s,
+            SoundModel::Modal,
+            None,
+            Cores::One,
+        )
+        .unwrap();
+        let frames = (cut_s * f64::from(SAMPLE_RATE_HZ)).round() as usize;
+        let struck = &cut.drums[2].1;
+        let saved = struck.latest_saved_frame().expect("a saved state");
+        assert!(
+            saved < frames && saved + modal::BLOCK >= frames,
+            "saved at {saved}, cut at {frames}"
+        );
+        let (resumed, _) =
+            render_resuming(&kit, &drums, 3.0, SoundModel::Modal, Some(cut)).unwrap();
+        assert_eq!(
+            resumed,
+            render(&kit, &drums, 3.0, SoundModel::Modal).unwrap()
+        );
+    }
+
     /// A replayed note is untouched before a hand rests on the head, decays with the
     /// touch's T60 while it rests, and stays stopped after (a later stroke does not bring
     /// it back); a touch before the note leaves it alone.

@@ -133,6 +133,11 @@ pub struct Saved {
     silent: bool,
 }
 
+/// Whether a state is saved at frame `n` whatever the synthesis's length.
+fn periodic(n: usize) -> bool {
+    n.is_multiple_of(SAVE_EVERY_BLOCKS * BLOCK)
+}
+
 /// The frame synthesis resumes from with states `saved`, for a change at frame `from`.
 fn resume_frame(saved: &[Saved], from: usize) -> usize {
     saved
@@ -154,6 +159,14 @@ pub struct DrumSynth {
     touches: Vec<(f64, f64)>,
     /// The voices of each of its tunings, from its first frame.
     voices: Vec<(usize, Vec<Voice>)>,
+}
+
+impl DrumSynth {
+    /// The frame of the latest saved state: where a synthesis of a record unchanged up to
+    /// its end resumes.
+    pub fn latest_saved_frame(&self) -> Option<usize> {
+        self.saved.last().map(|s| s.frame)
+    }
 }
 
 /// The time (s, by `time`) of the first entry where two time-ordered records differ: the
@@ -237,7 +250,10 @@ pub fn resynthesise(
         Some(_) => resume_frame(&synth.saved, from),
     }
     .min(frames);
-    synth.saved.retain(|s| s.frame <= start);
+    // The periodic states, and the one resumed from (a cut's: see below).
+    synth
+        .saved
+        .retain(|s| s.frame <= start && (periodic(s.frame) || s.frame == start));
     synth.heard = heard;
     synth.touches = touches;
     synth.voices = voices;
@@ -285,7 +301,10 @@ pub fn resynthesise(
             ..
         } = &mut tuned;
         let stride = bank.stride();
-        if n0.is_multiple_of(SAVE_EVERY_BLOCKS * BLOCK) {
+        // Also at the start of the last block: a synthesis cut here (the sound made
+        // ahead of a simulation, the editor's steps) is resumed from its end, not from
+        // up to SAVE_EVERY_BLOCKS blocks before it.
+        if periodic(n0) || n0 + BLOCK >= out.len() {
             saved.push(Saved {
                 frame: n0,
                 bank: bank.state(),

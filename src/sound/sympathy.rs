@@ -244,7 +244,9 @@ pub fn resynthesise(
         (last, images) = (state.saved[k].2, state.saved[k].3);
     }
     let sections = ImageFilter::sections();
-    state.saved.retain(|(f, ..)| *f < start);
+    state
+        .saved
+        .retain(|(f, ..)| *f < start && f.is_multiple_of(SAVE_EVERY_BLOCKS * BLOCK));
     state.out.resize(frames, 0.0);
     state.out[start..].fill(0.0);
     let steps = BLOCK / DECIMATION;
@@ -267,7 +269,9 @@ pub fn resynthesise(
         };
         let stride = rx.bank.stride();
         input.resize(steps * stride, 0.0);
-        if n0.is_multiple_of(SAVE_EVERY_BLOCKS * BLOCK) {
+        // Also at the start of the last block, where a cut synthesis resumes (see the
+        // drums' own synthesis).
+        if n0.is_multiple_of(SAVE_EVERY_BLOCKS * BLOCK) || n0 + BLOCK >= frames {
             state.saved.push((n0, rx.bank.state(), last, images));
         }
         let n1 = (n0 + BLOCK).min(frames);
