@@ -99,3 +99,37 @@ fn a_touched_head_falls_silent() {
         );
     }
 }
+
+/// Making a beat secco in the editor (a damp added to the study's beat at tick 9600 on
+/// the 29-inch drum) re-renders from a saved state before the edit and gives bit for bit
+/// what rendering the edited study whole gives: the damping hand's way to the head and
+/// its touch all come after the first target the edit changes.
+#[test]
+fn adding_a_damp_resumes_as_a_whole_render_does() {
+    use timpanist::render::{Resume, render_after};
+    let loaded = LoadedScore::load(&root().join("scores/secco-study.ron")).unwrap();
+    let db = MotionDb::load(&root().join("mocap")).unwrap();
+    let params = RenderParams::default();
+    let mut resume: Option<Resume> = None;
+    render_after(&mut resume, None, &loaded, &db, &params, &mut |_| true).unwrap();
+    let mut edited = loaded.clone();
+    let beat = edited
+        .score
+        .beats
+        .iter_mut()
+        .find(|b| b.tick == 9600)
+        .unwrap();
+    assert_eq!(beat.damp, None);
+    beat.damp = Some(480);
+    let whole = render(&edited, &db, &params, &mut |_| true).unwrap();
+    let resumed = render_after(&mut resume, None, &edited, &db, &params, &mut |_| true).unwrap();
+    let from = resumed.stats.resumed_from_s.expect("the edit resumes");
+    assert!(from > 1.0, "resumed at {from:.2} s");
+    assert!(whole.touches.len() > study().touches.len(), "the new touch");
+    assert!(
+        resumed.audio.samples == whole.audio.samples,
+        "the audio differs"
+    );
+    assert!(resumed.motion == whole.motion, "the motion differs");
+    assert_eq!(resumed.touches, whole.touches);
+}
