@@ -338,11 +338,10 @@ pub const RESUME_STEP_GROWTH: f64 = 8.0;
 pub struct Resume {
     performance: Performance,
     sound: SoundState,
-    /// The composition performed: its strokes and target tips, its start and rate, and
-    /// where the performer looked.
+    /// The composition performed: its strokes and target tips, its start and rate (where
+    /// the performer looked and leaned are its performance's targets).
     strokes: Vec<PlannedStroke>,
     tips: [Vec<DVec3>; 2],
-    gaze: Vec<DVec3>,
     limits: JointLimits,
     start_s: f64,
     rate_hz: f64,
@@ -557,7 +556,6 @@ impl Run<'_> {
         let (comp, params, kit) = (self.composition, self.params, self.kit);
         let (start_s, rate) = (comp.start_s, comp.rate_hz);
         let strokes = comp.strokes.len();
-        let gaze = targets.gaze().to_vec();
         let resumable = previous
             .as_ref()
             .and_then(|p| self.resume_point(p, &targets));
@@ -596,7 +594,6 @@ impl Run<'_> {
                 sound,
                 strokes: comp.strokes.clone(),
                 tips: comp.tips.clone(),
-                gaze,
                 limits: comp.limits,
                 start_s,
                 rate_hz: rate,
@@ -628,12 +625,12 @@ impl Run<'_> {
         }
         let old_len = previous.tips[0].len();
         let common = old_len.min(comp.len());
-        let gaze = targets.gaze();
+        let before = &previous.performance.targets;
         let same_until = (0..common)
             .find(|&k| {
                 (0..2).any(|h| previous.tips[h][k] != comp.tips[h][k])
-                    || previous.gaze.get(k) != gaze.get(k)
-                    || previous.performance.targets.lean_at(k) != targets.lean_at(k)
+                    || before.gaze().get(k) != targets.gaze().get(k)
+                    || before.lean_at(k) != targets.lean_at(k)
             })
             .unwrap_or(common);
         let at = previous.performance.resumable(

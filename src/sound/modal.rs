@@ -164,7 +164,8 @@ pub struct DrumSynth {
 impl DrumSynth {
     /// The frame of the latest saved state: where a synthesis of a record unchanged up to
     /// its end resumes.
-    pub fn latest_saved_frame(&self) -> Option<usize> {
+    #[cfg(test)]
+    pub(crate) fn latest_saved_frame(&self) -> Option<usize> {
         self.saved.last().map(|s| s.frame)
     }
 }
