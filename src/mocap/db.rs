@@ -214,8 +214,10 @@ impl MotionDb {
             .iter()
             .filter(|u| u.grip == grip && self.takes[u.take].joints.is_some())
             .collect();
-        std::array::from_fn(|j| {
-            let joint = Joint::ALL[j];
+        // Each joint's estimate is independent (its iterated mean is most of a render's
+        // start): spread over the cores, in joint order.
+        let estimates = crate::base::parallel::chunked(&Joint::ALL, |&joint| {
+            let j = joint.index();
             let samples: Vec<_> = units
                 .iter()
                 .filter(|u| !Joint::arm(u.hand.other()).contains(&joint))
@@ -228,7 +230,8 @@ impl MotionDb {
                 })
                 .collect();
             JointLimit::estimate(&samples)
-        })
+        });
+        std::array::from_fn(|j| estimates[j])
     }
 
     /// A database with no takes yet.
