@@ -463,9 +463,13 @@ pub fn decode_take(path: &Path, bytes: &[u8]) -> Result<TakeData, FileError> {
             format!("{joints} joints; expected 0 or {JOINT_COUNT}"),
         ));
     }
-    let mut body = Vec::new();
+    let limit = (n as u64 + 1) * 8 * (6 + 4 * JOINT_COUNT as u64) + 64;
+    // Room for all of it at once (no copies as it grows; pages left untouched cost
+    // nothing), never more than deflate's largest ratio (1032:1) over what is there.
+    let room = limit.min(bytes.len() as u64 * 1032);
+    let mut body = Vec::with_capacity(usize::try_from(room).unwrap_or(0));
     ZlibDecoder::new(&bytes[24..])
-        .take((n as u64 + 1) * 8 * (6 + 4 * JOINT_COUNT as u64) + 64)
+        .take(limit)
         .read_to_end(&mut body)
         .map_err(|e| bad("sample data", format!("corrupt compressed data: {e}")))?;
     // Every frame takes at least a byte in each channel (a tip's flags and three axes,
