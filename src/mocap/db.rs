@@ -465,8 +465,14 @@ pub fn decode_take(path: &Path, bytes: &[u8]) -> Result<TakeData, FileError> {
     }
     let limit = (n as u64 + 1) * 8 * (6 + 4 * JOINT_COUNT as u64) + 64;
     // Room for all of it at once (no copies as it grows; pages left untouched cost
-    // nothing), never more than deflate's largest ratio (1032:1) over what is there.
-    let room = limit.min(bytes.len() as u64 * 1032);
+    // nothing): twice the least the header's frames need (a sample's delta takes a byte
+    // or two), never more than deflate's largest ratio (1032:1) over what is there nor
+    // 256 MB (a corrupt header then only grows the buffer as data comes).
+    let least = (n as u64) * (2 * 4 + 4 * JOINT_COUNT as u64);
+    let room = (2 * least + 64)
+        .min(limit)
+        .min(bytes.len() as u64 * 1032)
+        .min(1 << 28);
     let mut body = Vec::with_capacity(usize::try_from(room).unwrap_or(0));
     ZlibDecoder::new(&bytes[24..])
         .take(limit)
