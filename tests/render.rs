@@ -391,12 +391,7 @@ fn random_edits_resume_as_whole_renders_do() {
             match (whole, resumed) {
                 (Ok(whole), Ok(resumed)) => {
                     resumed_count += usize::from(resumed.stats.resumed_from_s.is_some());
-                    assert!(
-                        resumed.audio.samples == whole.audio.samples,
-                        "{case}: audio"
-                    );
-                    assert!(resumed.motion == whole.motion, "{case}: motion");
-                    assert_eq!(resumed.events, whole.events, "{case}");
+                    assert_same_performance(&resumed, &whole, &case);
                 }
                 (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string(), "{case}"),
                 (a, b) => panic!("{case}: whole {:?}, resumed {:?}", a.err(), b.err()),
@@ -406,11 +401,6 @@ fn random_edits_resume_as_whole_renders_do() {
     assert!(resumed_count >= 4, "{resumed_count} of 8 edits resumed");
 }
 
-/// A uniform integer in 0..n.
-/// After a one-beat edit late in a score, resuming the previous rendering's performance
-/// from a saved state before the edit gives bit for bit what rendering the edited score
-/// from scratch gives (audio, motion, targets, events), simulating less; an edit at the
-/// first beat resumes (if at all) no later than it.
 /// The sound made on the other core while the body is simulated (every
 /// `render::SOUND_AHEAD_S` of settled score, resuming its state) is bit for bit the sound
 /// made afresh from the finished performance: with hands damping heads (the secco study)
@@ -444,6 +434,10 @@ fn sound_made_beside_the_simulation_equals_one_made_after_it() {
     }
 }
 
+/// After a one-beat edit late in a score, resuming the previous rendering's performance
+/// from a saved state before the edit gives bit for bit what rendering the edited score
+/// from scratch gives (audio, motion, targets, events), simulating less; an edit at the
+/// first beat resumes (if at all) no later than it.
 #[test]
 fn resumed_render_after_an_edit_equals_a_whole_render() {
     let db = db();
@@ -553,7 +547,7 @@ fn partial_render_then_rest_equals_a_whole_render() {
     assert_eq!(first_off, None, "gains {} and {}", a.gain, b.gain);
     let rest = render_after(&mut resume, None, &edited, &db, &params, &mut |_| true).unwrap();
     assert!(rest.complete && rest.stats.resumed_from_s.is_some());
-    assert_same_performance(&rest, &whole);
+    assert_same_performance(&rest, &whole, "the rest after a partial rendering");
 }
 
 /// The tempo-change demo rendered with the default parameters, and what it leaves to
@@ -568,10 +562,15 @@ fn tempo_change_rendered() -> (MotionDb, LoadedScore, RenderParams, Option<Resum
 }
 
 /// Bit for bit the same audio, motion and contacts.
-fn assert_same_performance(a: &Rendering, b: &Rendering) {
-    assert_eq!(a.audio.samples, b.audio.samples);
-    assert_eq!(a.motion, b.motion);
-    assert_eq!(a.events, b.events);
+/// `a` and `b` sound, move and strike bit for bit the same (`case` names them on failure;
+/// the audio and motion are compared whole, not printed).
+fn assert_same_performance(a: &Rendering, b: &Rendering, case: &str) {
+    assert!(
+        a.audio.samples == b.audio.samples,
+        "{case}: the audio differs"
+    );
+    assert!(a.motion == b.motion, "{case}: the motion differs");
+    assert_eq!(a.events, b.events, "{case}");
 }
 
 /// A rendering cancelled part way (the editor cancels one at each newer edit) leaves a
@@ -597,9 +596,14 @@ fn rendering_after_a_cancelled_one_equals_a_whole_render() {
     let whole = render(&second, &db, &params, &mut |_| true).unwrap();
     let resumed = render_after(&mut resume, None, &second, &db, &params, &mut |_| true).unwrap();
     assert!(resumed.stats.resumed_from_s.is_some(), "it resumes");
-    assert_same_performance(&resumed, &whole);
+    assert_same_performance(
+        &resumed,
+        &whole,
+        "rendering after a cancelled one equals a whole render",
+    );
 }
 
+/// A uniform integer in 0..n.
 fn below(rng: &mut Rng, n: u64) -> u64 {
     rng.next_u64() % n
 }
@@ -800,7 +804,11 @@ fn an_edit_that_leans_resumes_as_a_whole_render_does() {
     assert!(leaned(&whole) > 5.0, "leans {:.1}°", leaned(&whole));
     let from = resumed.stats.resumed_from_s.expect("the edit resumes");
     println!("resumed at {from:.2} s; leaning {:.1}°", leaned(&whole));
-    assert_same_performance(&resumed, &whole);
+    assert_same_performance(
+        &resumed,
+        &whole,
+        "an edit that leans resumes as a whole render does",
+    );
 }
 
 /// The head follows the hands: before each stroke that moves to another drum after a

@@ -133,8 +133,9 @@ pub struct Saved {
     silent: bool,
 }
 
-/// Whether a state is saved at frame `n` whatever the synthesis's length.
-fn periodic(n: usize) -> bool {
+/// Whether a state is saved at frame `n` whatever the synthesis's length (the drums'
+/// synthesis and the sympathetic heads' alike).
+pub(super) fn periodic(n: usize) -> bool {
     n.is_multiple_of(SAVE_EVERY_BLOCKS * BLOCK)
 }
 

@@ -20,7 +20,7 @@
 //! change the head starts again at rest at its new pitch.
 
 use super::SAMPLE_RATE_HZ;
-use super::modal::{BLOCK, FLUSH_FLOOR, SoundHeads, first_voice_change, tuning_at};
+use super::modal::{BLOCK, FLUSH_FLOOR, SoundHeads, first_voice_change, periodic, tuning_at};
 use super::partials::SoundHead;
 use super::radiation::SOUND_SPEED_MPS;
 use super::voices::{BankState, Voice, VoiceBank};
@@ -36,8 +36,6 @@ pub const REFERENCE_DISTANCE_M: f64 = 1.0;
 /// The receiving heads run at the audio rate over this (6 kHz: their modes are below
 /// [`MAX_HZ`]); their output is brought back by linear interpolation.
 const DECIMATION: usize = 8;
-/// Blocks between saved states.
-const SAVE_EVERY_BLOCKS: usize = 64;
 /// Cut-off of the low-pass that takes the sub-step rate's images out of the output, Hz
 /// (see [`ImageFilter`]).
 const IMAGE_CUTOFF_HZ: f64 = 1500.0;
@@ -244,9 +242,7 @@ pub fn resynthesise(
         (last, images) = (state.saved[k].2, state.saved[k].3);
     }
     let sections = ImageFilter::sections();
-    state
-        .saved
-        .retain(|(f, ..)| *f < start && f.is_multiple_of(SAVE_EVERY_BLOCKS * BLOCK));
+    state.saved.retain(|(f, ..)| *f < start && periodic(*f));
     state.out.resize(frames, 0.0);
     state.out[start..].fill(0.0);
     let steps = BLOCK / DECIMATION;
@@ -271,7 +267,7 @@ pub fn resynthesise(
         input.resize(steps * stride, 0.0);
         // Also at the start of the last block, where a cut synthesis resumes (see the
         // drums' own synthesis).
-        if n0.is_multiple_of(SAVE_EVERY_BLOCKS * BLOCK) || n0 + BLOCK >= frames {
+        if periodic(n0) || n0 + BLOCK >= frames {
             state.saved.push((n0, rx.bank.state(), last, images));
         }
         let n1 = (n0 + BLOCK).min(frames);
