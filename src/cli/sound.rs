@@ -81,6 +81,9 @@ pub fn fit(files: &[PathBuf], output: &Path) -> anyhow::Result<()> {
         );
     })?;
     cal.save(output)?;
+    for note in fit::bounds_reached(&cal) {
+        eprintln!("note: {note}");
+    }
     println!(
         "{} notes -> {}: worst band residual {:.1} dB",
         notes.len(),
