@@ -17,10 +17,9 @@
 use crate::drum::HeadModes;
 use crate::drum::bessel::{EXACT_ZERO_LIMIT, bessel_j};
 use crate::drum::modes::HeadMode;
+pub use crate::drum::modes::SOUND_SPEED_MPS;
 use std::f64::consts::{PI, TAU};
 
-/// Speed of sound in air at 20 °C, m/s.
-pub const SOUND_SPEED_MPS: f64 = 343.0;
 /// The listener's polar angle from the head's normal: a close microphone 45° above the
 /// plane of the head, rad.
 pub const LISTENER_POLAR_RAD: f64 = PI / 4.0;
