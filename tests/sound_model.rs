@@ -165,9 +165,9 @@ fn played_strokes_sound_like_the_recordings_and_brighten_with_the_dynamic() {
 }
 
 /// Tension modulation: an ff stroke's (1,1) starts at least 0.5 % sharp of where it is at
-/// 0.5 s; a p stroke's moves by under 0.25 % (0.21 % measured: the early window also
-/// holds the (0,1), which rings near 0.85 of the (1,1) for its first 0.1 s; the issue
-/// asks under 0.2 %).
+/// 0.5 s; a p stroke's moves by under 0.2 %, as the issue asks (2026-12-06: ff 0.73 %,
+/// p 0.16 %; the early window also holds the (0,1), which rings near 0.85 of the (1,1)
+/// for its first tens of milliseconds).
 #[test]
 fn loud_strokes_glide_down() {
     let kit = kit_for(146.83);
@@ -178,7 +178,7 @@ fn loud_strokes_glide_down() {
     };
     let (p, ff) = (glide(Dynamic::P), glide(Dynamic::Ff));
     assert!(ff >= 0.5, "ff glide {ff:.2} %");
-    assert!(p.abs() < 0.25, "p glide {p:.2} %");
+    assert!(p.abs() < 0.2, "p glide {p:.2} %");
 }
 
 /// A secco note: 200 ms after the hand touches the head, the (1,1) is at least 20 dB
