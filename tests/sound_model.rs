@@ -106,10 +106,11 @@ const RECORDED_D3_SPREAD_DB: [(f64, f64); 7] = [
 /// in D3, played by the body and heard dry (the measurement): each lies within
 /// the recorded D3 notes' spread ±3 dB in the octave bands 125 Hz – 4 kHz (not at 63 Hz,
 /// where nothing of a D3 drum rings dry: README "Sound calibration"), and from p to ff
-/// the spectral centroid rises by at least 10 % (16 % measured: 242 → 282 Hz; the
+/// the spectral centroid rises by at least 10 % (2026-12-06: 11 %, 244 → 271 Hz; the
 /// recordings 280 → 330 Hz), as the felt stiffens and the contact shortens (the first,
 /// stiffer felt: 9 %). The p stroke's 2 kHz band is the nearest to the spread's edge
-/// (−31.7 dB against −32).
+/// (−31.4 dB against −32). Single strokes and other drums do not brighten so (README
+/// "Drum and sound").
 #[test]
 fn played_strokes_sound_like_the_recordings_and_brighten_with_the_dynamic() {
     use timpanist::mocap::db::MotionDb;
