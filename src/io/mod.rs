@@ -18,7 +18,6 @@ pub mod motion_c3d;
 pub mod motion_csv;
 pub mod musicxml;
 pub mod musicxml_export;
-mod musicxml_repeats;
 pub mod open;
 pub mod osc;
 pub mod pack;

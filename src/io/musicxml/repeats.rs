@@ -1,7 +1,7 @@
 //! The order in which a MusicXML part's measures are performed: repeat bar lines
 //! (`<repeat direction="forward|backward" times="n">`, `times` counting every pass, 2 by
 //! default) and volta endings (`<ending number="1, 2" type="start|stop|discontinue">`)
-//! expanded, for [`super::musicxml`], as music21 and MuseScore do: a backward repeat
+//! expanded, for [`super`], as music21 and MuseScore do: a backward repeat
 //! returns to the forward repeat it closes, else to the start (so it encloses earlier
 //! repeats, which play all their passes again); one inside an ending jumps back until
 //! the highest ending number of its run of endings has been reached.
