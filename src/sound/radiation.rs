@@ -52,6 +52,15 @@ fn j_prev_at_zero(mode: &HeadMode) -> f64 {
     sign * (2.0 * w / PI).sqrt() / j
 }
 
+/// ∫₀^a J_m(α r) J_m(β r) r dr for `mode` of a head of radius `a` (α = j_mn/a) and an
+/// in-plane wavenumber `beta` (1/m): Lommel's closed form, −a·α·J_{m−1}(j_mn)·J_m(βa) /
+/// (α² − β²), m². A timpani head is subsonic (β < α), so the denominator never vanishes.
+pub fn radial_overlap(mode: &HeadMode, a: f64, beta: f64) -> f64 {
+    let alpha = mode.bessel_zero() / a;
+    -a * alpha * j_prev_at_zero(mode) * bessel_j(mode.m, beta * a)
+        / (alpha * alpha - beta * beta).max(1e-9 * alpha * alpha)
+}
+
 /// Far-field pressure per unit modal velocity of each mode of `head` toward the listener
 /// (arbitrary common unit: the calibration sets the level).
 pub fn weights(head: &HeadModes) -> Vec<f64> {
@@ -61,15 +70,13 @@ pub fn weights(head: &HeadModes) -> Vec<f64> {
         .map(|mode| {
             let m = mode.m;
             let omega = TAU * mode.freq_hz;
-            let alpha = mode.bessel_zero() / a;
             let beta = omega / SOUND_SPEED_MPS * LISTENER_POLAR_RAD.sin();
             let angular = directivity(mode);
             // J_m(x) for m > x + 25 is below 1e-7 of its peak: silent.
             if f64::from(m) > beta * a + 25.0 {
                 return 0.0;
             }
-            let radial = -a * alpha * j_prev_at_zero(mode) * bessel_j(m, beta * a)
-                / (alpha * alpha - beta * beta).max(1e-9 * alpha * alpha);
+            let radial = radial_overlap(mode, a, beta);
             let sign = if (m / 2) % 2 == 0 { 1.0 } else { -1.0 };
             omega * TAU * angular * radial * sign
         })

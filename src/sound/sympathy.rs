@@ -6,15 +6,24 @@
 //! dBFS, then peaks near 6.3 Pa ≈ 110 dB SPL at 1 m, the low end of what orchestral
 //! timpani reach up close: an assumption, not a measurement of ours). At
 //! another head, a distance d between centres, it arrives d/c later and (1 m)/d weaker;
-//! across that head the wave is taken as plane, p(x) ≈ p − (x·ŝ)/c·ṗ (ŝ the direction it
-//! travels). Its generalised force on the head's mode k is ∫ p Φ_k dA:
+//! across that head it is a plane wave grazing the head, p(x, t) = p(t − x·ŝ/c) (ŝ the
+//! direction it travels, at θ_s in the head's frame). Its generalised force on the head's
+//! mode k (shape J_m(j r/a)·cos or sin mθ) is ∫ p Φ_k dA; at the mode's own frequency
+//! ω_k, wavenumber k = ω_k/c (a mode answers only near its resonance), the plane wave's
+//! overlap with the shape is exact (Jacobi–Anger and Lommel, the reciprocal of the
+//! radiation's [`radiation::radial_overlap`]):
 //!
-//! * m = 0: p·A_k, A_k = ∫Φ_k dA = 2π a² J₁(j)/j (the uniform pressure);
-//! * m = 1: −(ṗ/c)·B_k·(cos θ_s or sin θ_s), B_k = π a³ J₂(j)/j (the pressure gradient);
+//! ∫ Φ_k e^{−i k x·ŝ} dA = 2π (−i)^m I_m (cos or sin mθ_s),  I_m = ∫₀^a J_m(j r/a) J_m(k r) r dr,
 //!
-//! and modes with m ≥ 2 see no net force from a plane wave at this order. Each receiving
-//! head runs those modes (its m ≤ 1 voices, gains as in its own sound) driven by F/M_k,
-//! and what they radiate is added to its own sound. One way only: the ringing of a
+//! so a mode with m even is driven by the pressure, (−1)^{m/2}·2π I_m·p, and one with m
+//! odd by its rate, −(−1)^{(m−1)/2}·2π I_m·ṗ/ω_k (a quarter period later), each times its
+//! angular factor. For ka ≪ 1 this is the uniform pressure on the axisymmetric modes
+//! (2π a² J₁(j)/j · p) and the pressure gradient on the m = 1 modes (π a³ J₂(j)/j · ṗ/c),
+//! as first modelled; at the heads' ka of 1–7 below 1 kHz the gradient alone
+//! overstated the m = 1 modes with nodal circles (a 29-inch head's (1,3) at 392 Hz, ka
+//! 2.6, by 8.5 dB) and left out m ≥ 2. Each receiving head runs its voices below
+//! [`MAX_HZ`] (gains as in its own sound) driven by F/M_k, and what they radiate is added
+//! to its own sound. One way only: the ringing of a
 //! receiving head does not drive the source back (it is 20 dB and more below it). A hand
 //! resting on a receiving head damps its ringing as it damps its own sound, and at a pedal
 //! change the head starts again at rest at its new pitch.
@@ -22,12 +31,12 @@
 use super::SAMPLE_RATE_HZ;
 use super::modal::{BLOCK, FLUSH_FLOOR, SoundHeads, first_voice_change, periodic, tuning_at};
 use super::partials::SoundHead;
+use super::radiation;
 use super::radiation::SOUND_SPEED_MPS;
 use super::voices::{BankState, Voice, VoiceBank};
-use crate::drum::bessel::bessel_j;
-use crate::drum::modes::Orientation;
+use crate::drum::modes::{HeadMode, Orientation};
 use crate::kit::Kit;
-use std::f64::consts::PI;
+use std::f64::consts::{PI, TAU};
 
 /// Pressure of a full-scale output at the reference distance, Pa.
 pub const FULL_SCALE_PA: f64 = 12.6;
@@ -40,19 +49,38 @@ const DECIMATION: usize = 8;
 /// (see [`ImageFilter`]).
 const IMAGE_CUTOFF_HZ: f64 = 1500.0;
 
-/// One receiving head's coupling: its m ≤ 1 voices below [`MAX_HZ`], their forces per
-/// unit pressure and pressure gradient, and the drums it hears.
+/// One receiving head's coupling: its voices below [`MAX_HZ`], their forces per unit
+/// pressure and pressure rate from each drum it hears, and those drums.
 #[derive(Clone, Debug)]
 struct Receiver {
     bank: VoiceBank,
     voices: Vec<Voice>,
     inv_mass: Vec<f64>,
-    /// Per voice: the force per unit pressure (m = 0: ∫Φ dA, m²) and per unit pressure
-    /// gradient along local x and y (m = 1: −B_k cos/sin, m³).
-    weights: Vec<[f64; 3]>,
-    /// Per source drum i ≠ j: (i, delay in frames, pressure per output unit, the direction
-    /// the wave travels in the head's local frame (cos θ_s, sin θ_s)).
-    sources: Vec<(usize, usize, f64, [f64; 2])>,
+    /// Per voice, per source (in the order of `sources`): the force per unit pressure (m
+    /// even) and per unit ṗ/c (m odd), m² and m³ (see the module docs).
+    weights: Vec<Vec<[f64; 2]>>,
+    /// Per source drum i ≠ j: (i, delay in frames, pressure per output unit).
+    sources: Vec<(usize, usize, f64)>,
+}
+
+/// The force on `mode` of a head of radius `a` per unit pressure and per unit ṗ/c of a
+/// plane wave grazing it at θ_s (`theta`, rad, head frame): the module docs' overlap at the
+/// mode's own wavenumber.
+fn plane_wave_coupling(mode: &HeadMode, a: f64, theta: f64) -> [f64; 2] {
+    let k = TAU * mode.freq_hz / SOUND_SPEED_MPS;
+    let m = mode.m;
+    let angle = f64::from(m) * theta;
+    let angular = match mode.orientation {
+        Orientation::Cos => angle.cos(),
+        Orientation::Sin => angle.sin(),
+    };
+    let overlap = TAU * radiation::radial_overlap(mode, a, k) * angular;
+    let sign = if (m / 2).is_multiple_of(2) { 1.0 } else { -1.0 };
+    if m.is_multiple_of(2) {
+        [sign * overlap, 0.0]
+    } else {
+        [0.0, -sign * overlap / k]
+    }
 }
 
 /// A receiving drum's sympathetic output (the same units as its own synthesis: summed
@@ -121,38 +149,8 @@ impl Receiver {
     /// Drum `j`'s receiver when its head is `head`; `heads` say which drums sound.
     fn new(kit: &Kit, heads: &SoundHeads, j: usize, head: &SoundHead) -> Option<Receiver> {
         let a = head.modes.radius_m();
-        let picked: Vec<usize> = (0..head.voices.len())
-            .filter(|&k| head.modes.modes()[k].m <= 1 && head.voices[k].freq_hz <= MAX_HZ)
-            .collect();
-        if picked.is_empty() {
-            return None;
-        }
-        let voices: Vec<_> = picked
-            .iter()
-            .map(|&k| super::modal::calibrated_voice(&head.voices[k]))
-            .collect();
-        let inv_mass = picked
-            .iter()
-            .map(|&k| 1.0 / head.modes.modes()[k].modal_mass_kg)
-            .collect();
         let centre = kit.drums[j].centre();
-        let weights = picked
-            .iter()
-            .map(|&k| {
-                let mode = &head.modes.modes()[k];
-                let j_mn = mode.bessel_zero();
-                if mode.m == 0 {
-                    [2.0 * PI * a * a * bessel_j(1, j_mn) / j_mn, 0.0, 0.0]
-                } else {
-                    let b = PI * a.powi(3) * bessel_j(2, j_mn) / j_mn;
-                    match mode.orientation {
-                        Orientation::Cos => [0.0, -b, 0.0],
-                        Orientation::Sin => [0.0, 0.0, -b],
-                    }
-                }
-            })
-            .collect();
-        let sources = (0..kit.drums.len())
+        let heard: Vec<(usize, usize, f64, f64)> = (0..kit.drums.len())
             .filter(|&i| {
                 i != j
                     && heads
@@ -165,9 +163,48 @@ impl Receiver {
                 let delay = (d / SOUND_SPEED_MPS * f64::from(SAMPLE_RATE_HZ)).round() as usize;
                 let scale = FULL_SCALE_PA * REFERENCE_DISTANCE_M / d;
                 let dir = head.modes.local(centre + (centre - from));
-                let theta = dir.y.atan2(dir.x);
-                (i, delay, scale, [theta.cos(), theta.sin()])
+                (i, delay, scale, dir.y.atan2(dir.x))
             })
+            .collect();
+        // Each voice below MAX_HZ with its couplings, and how loud it can ring: driven at
+        // resonance its output goes as the force per pascal (the rate's weight times k)
+        // over its modal mass, times its decay and its gain.
+        let candidates: Vec<(usize, Vec<[f64; 2]>, f64)> = (0..head.voices.len())
+            .filter(|&k| head.voices[k].freq_hz <= MAX_HZ)
+            .map(|k| {
+                let (mode, voice) = (&head.modes.modes()[k], &head.voices[k]);
+                let weights: Vec<[f64; 2]> = heard
+                    .iter()
+                    .map(|&(.., theta)| plane_wave_coupling(mode, a, theta))
+                    .collect();
+                let wavenumber = TAU * mode.freq_hz / SOUND_SPEED_MPS;
+                let force = weights
+                    .iter()
+                    .map(|[p, rate]| p.abs() + rate.abs() * wavenumber)
+                    .fold(0.0, f64::max);
+                let strength = force / mode.modal_mass_kg * voice.t60_s * voice.gain.abs();
+                (k, weights, strength)
+            })
+            .collect();
+        let loudest = candidates.iter().map(|c| c.2).fold(0.0, f64::max);
+        let floor = loudest * 10f64.powf(-RECEIVER_FLOOR_DB / 20.0);
+        let picked: Vec<(usize, Vec<[f64; 2]>, f64)> =
+            candidates.into_iter().filter(|c| c.2 > floor).collect();
+        if picked.is_empty() {
+            return None;
+        }
+        let voices: Vec<_> = picked
+            .iter()
+            .map(|(k, ..)| super::modal::calibrated_voice(&head.voices[*k]))
+            .collect();
+        let inv_mass = picked
+            .iter()
+            .map(|(k, ..)| 1.0 / head.modes.modes()[*k].modal_mass_kg)
+            .collect();
+        let weights = picked.into_iter().map(|(_, w, _)| w).collect();
+        let sources = heard
+            .iter()
+            .map(|&(i, delay, scale, _)| (i, delay, scale))
             .collect();
         Some(Receiver {
             bank: VoiceBank::new(&voices, f64::from(SAMPLE_RATE_HZ) / DECIMATION as f64),
@@ -182,6 +219,10 @@ impl Receiver {
 /// Highest mode frequency that rings sympathetically, Hz (the shared low partials; the
 /// coupling of higher modes is far below audibility and not worth the time).
 pub const MAX_HZ: f64 = 1000.0;
+/// A receiving head leaves out the modes that could ring this far below its loudest, dB
+/// (the many with several nodal diameters, which a plane wave barely drives and which
+/// radiate little).
+const RECEIVER_FLOOR_DB: f64 = 40.0;
 
 /// Drum `j`'s sympathetic output, `frames` long, from the other drums' radiated sound
 /// (the time derivative of their synthesis `monos[i]`, as the mix radiates it), its head
@@ -251,6 +292,7 @@ pub fn resynthesise(
     let damping = super::touch_factor(fs / DECIMATION as f64) as f32;
     let mut ringing = start > 0;
     let mut input = Vec::new();
+    let mut fields: Vec<[f64; 2]> = Vec::new();
     for n0 in (start..frames).step_by(BLOCK) {
         let now = tuning_at(tunings, n0);
         if now != index {
@@ -279,10 +321,10 @@ pub fn resynthesise(
             .zip((n0..n1).step_by(DECIMATION))
         {
             let z = (a + DECIMATION).min(n1);
-            // The mean pressure at the head's centre and its gradient over the sub-step
-            // (Pa, Pa/m; the gradient's mean telescopes to its ends).
-            let mut field = [0.0f64; 3];
-            for (i, delay, scale, [cos, sin]) in &rx.sources {
+            // Per source, the mean pressure at the head's centre and its rate over c over
+            // the sub-step (Pa, Pa/m; the rate's mean telescopes to its ends).
+            fields.clear();
+            for (i, delay, scale) in &rx.sources {
                 let mono = monos[*i];
                 // The source's output as heard here at frame n (delayed; 0 before it).
                 let heard = |n: usize| {
@@ -296,17 +338,19 @@ pub fn resynthesise(
                 // Its mean over the sub-step telescopes to the ends.
                 let mean = (heard(z - 1) - heard_before(a)) * fs / (z - a) as f64;
                 let before = if a == 0 { 0.0 } else { at(a - 1) };
-                let gradient =
-                    scale * (at(z - 1) - before) * fs / ((z - a) as f64 * SOUND_SPEED_MPS);
-                field[0] += scale * mean;
-                field[1] += gradient * cos;
-                field[2] += gradient * sin;
+                let rate = scale * (at(z - 1) - before) * fs / ((z - a) as f64 * SOUND_SPEED_MPS);
+                fields.push([scale * mean, rate]);
             }
-            if field == [0.0; 3] {
+            if fields.iter().all(|f| *f == [0.0; 2]) {
                 continue;
             }
             for ((r, w), im) in row.iter_mut().zip(&rx.weights).zip(&rx.inv_mass) {
-                *r = ((w[0] * field[0] + w[1] * field[1] + w[2] * field[2]) * im) as f32;
+                let force: f64 = w
+                    .iter()
+                    .zip(&fields)
+                    .map(|(w, f)| w[0] * f[0] + w[1] * f[1])
+                    .sum();
+                *r = (force * im) as f32;
             }
             driven = true;
         }
@@ -359,6 +403,75 @@ mod tests {
             }
         }
         20.0 * (peak_out / peak_in).log10()
+    }
+
+    /// The coupling of a grazing plane wave to a mode is its overlap with the mode's
+    /// shape, ∫ Φ e^{−i k x·ŝ} dA, by quadrature: real for m even (the pressure's
+    /// weight), imaginary for m odd (k times the weight of ṗ/c), for modes up to m = 4
+    /// and n = 3 of the 29-inch head; and at small ka it is the first-order expansion's
+    /// uniform pressure (m = 0) and gradient (m = 1).
+    #[test]
+    fn plane_wave_coupling_is_the_overlap_with_the_shape() {
+        use crate::drum::bessel::bessel_j;
+        use crate::drum::{FrequencySource, HeadModes};
+        let drum = &Kit::standard().drums[1];
+        let head = HeadModes::below_hz(drum, FrequencySource::Measured, MAX_HZ).unwrap();
+        let a = head.radius_m();
+        let theta_s = 0.7;
+        let mut checked = 0;
+        for mode in head.modes().iter().filter(|k| k.m <= 4 && k.n <= 3) {
+            let k = TAU * mode.freq_hz / SOUND_SPEED_MPS;
+            let (nr, nt) = (600, 256);
+            let (mut re, mut im) = (0.0, 0.0);
+            for i in 0..nr {
+                let r = (i as f64 + 0.5) / nr as f64 * a;
+                let radial = bessel_j(mode.m, mode.bessel_zero() * r / a) * r * a / nr as f64;
+                for t in 0..nt {
+                    let th = t as f64 / nt as f64 * TAU;
+                    let angular = match mode.orientation {
+                        Orientation::Cos => (f64::from(mode.m) * th).cos(),
+                        Orientation::Sin => (f64::from(mode.m) * th).sin(),
+                    };
+                    let phase = -k * r * (th - theta_s).cos();
+                    let w = radial * angular * TAU / nt as f64;
+                    re += w * phase.cos();
+                    im += w * phase.sin();
+                }
+            }
+            let [per_p, per_rate] = plane_wave_coupling(mode, a, theta_s);
+            let scale = a * a * 1e-4;
+            let (m, n) = (mode.m, mode.n);
+            if mode.m.is_multiple_of(2) {
+                assert!(
+                    (re - per_p).abs() < scale && im.abs() < scale,
+                    "({m},{n}): {re} {im} vs {per_p}"
+                );
+            } else {
+                assert!(
+                    (im / k - per_rate).abs() < scale / k && re.abs() < scale,
+                    "({m},{n}): {re} {im} vs {per_rate}"
+                );
+            }
+            checked += 1;
+        }
+        assert!(checked >= 12, "{checked}");
+        // At 5 Hz (ka 0.03) the first order: p·2πa²J₁(j)/j and −(ṗ/c)·πa³J₂(j)/j·cos θ_s.
+        let low = |m: u32| {
+            let mut mode = head
+                .modes()
+                .iter()
+                .find(|k| (k.m, k.n, k.orientation) == (m, 1, Orientation::Cos))
+                .unwrap()
+                .clone();
+            mode.freq_hz = 5.0;
+            (plane_wave_coupling(&mode, a, theta_s), mode.bessel_zero())
+        };
+        let ([p0, _], j0) = low(0);
+        let first = TAU * a * a * bessel_j(1, j0) / j0;
+        assert!((p0 / first - 1.0).abs() < 1e-3, "{p0} vs {first}");
+        let ([_, d1], j1) = low(1);
+        let first = -PI * a.powi(3) * bessel_j(2, j1) / j1 * theta_s.cos();
+        assert!((d1 / first - 1.0).abs() < 1e-3, "{d1} vs {first}");
     }
 
     /// Flat where the sympathetic partials ring (up to 1 kHz: within 0.3 dB), and the
