@@ -16,8 +16,7 @@
 
 use crate::drum::HeadModes;
 use crate::drum::bessel::{EXACT_ZERO_LIMIT, bessel_j};
-use crate::drum::modes::HeadMode;
-pub use crate::drum::modes::SOUND_SPEED_MPS;
+use crate::drum::modes::{HeadMode, SOUND_SPEED_MPS};
 use std::f64::consts::{PI, TAU};
 
 /// The listener's polar angle from the head's normal: a close microphone 45° above the
@@ -61,6 +60,12 @@ pub fn radial_overlap(mode: &HeadMode, a: f64, beta: f64) -> f64 {
         / (alpha * alpha - beta * beta).max(1e-9 * alpha * alpha)
 }
 
+/// (−1)^⌊m/2⌋: the sign a multipole's phase (±i)^m folds to — of the real weight for m
+/// even, of the quarter-period-shifted one for m odd.
+pub fn multipole_sign(m: u32) -> f64 {
+    if (m / 2).is_multiple_of(2) { 1.0 } else { -1.0 }
+}
+
 /// Far-field pressure per unit modal velocity of each mode of `head` toward the listener
 /// (arbitrary common unit: the calibration sets the level).
 pub fn weights(head: &HeadModes) -> Vec<f64> {
@@ -77,8 +82,7 @@ pub fn weights(head: &HeadModes) -> Vec<f64> {
                 return 0.0;
             }
             let radial = radial_overlap(mode, a, beta);
-            let sign = if (m / 2) % 2 == 0 { 1.0 } else { -1.0 };
-            omega * TAU * angular * radial * sign
+            omega * TAU * angular * radial * multipole_sign(m)
         })
         .collect()
 }

@@ -32,9 +32,8 @@ use super::SAMPLE_RATE_HZ;
 use super::modal::{BLOCK, FLUSH_FLOOR, SoundHeads, first_voice_change, periodic, tuning_at};
 use super::partials::SoundHead;
 use super::radiation;
-use super::radiation::SOUND_SPEED_MPS;
 use super::voices::{BankState, Voice, VoiceBank};
-use crate::drum::modes::{HeadMode, Orientation};
+use crate::drum::modes::{HeadMode, Orientation, SOUND_SPEED_MPS};
 use crate::kit::Kit;
 use std::f64::consts::{PI, TAU};
 
@@ -75,7 +74,7 @@ fn plane_wave_coupling(mode: &HeadMode, a: f64, theta: f64) -> [f64; 2] {
         Orientation::Sin => angle.sin(),
     };
     let overlap = TAU * radiation::radial_overlap(mode, a, k) * angular;
-    let sign = if (m / 2).is_multiple_of(2) { 1.0 } else { -1.0 };
+    let sign = radiation::multipole_sign(m);
     if m.is_multiple_of(2) {
         [sign * overlap, 0.0]
     } else {
