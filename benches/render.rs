@@ -11,6 +11,11 @@
 //!   `FIRST_STEP_S` (0.4 s) past the edited stroke (what the editor plays at once: its audio is final up
 //!   to there), and the resumed rendering of the whole rest.
 //!
+//! * what handing a compensation attempt to the other core would copy first, at the
+//!   study's end: the performance's simulator (its motion and targets so far), drums and
+//!   targets (README "Where the speed issue stands": a retry costs about as much wall
+//!   time as the copy).
+//!
 //! `cargo bench --bench render`.
 
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
@@ -42,6 +47,19 @@ fn bench(c: &mut Criterion) {
     let mut resume = None;
     let before =
         render_after(&mut resume, None, &loaded, &db, &params, &mut |_| true).expect("renders");
+    let performance = resume.as_ref().expect("a resumable state").performance();
+    c.bench_function(
+        "copy the simulator, drums and targets at the study's end",
+        |b| {
+            b.iter(|| {
+                (
+                    performance.sim.clone(),
+                    performance.drums.clone(),
+                    performance.reference.clone(),
+                )
+            })
+        },
+    );
     let mut edited = loaded.clone();
     let beat = before
         .composition

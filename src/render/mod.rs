@@ -350,6 +350,13 @@ pub struct Resume {
     retunes: Vec<Retune>,
 }
 
+impl Resume {
+    /// The settled performance (read-only: what a bench of handing it on copies).
+    pub fn performance(&self) -> &Performance {
+        &self.performance
+    }
+}
+
 /// [`render`], resuming from `resume` (when given, and for the same kit and parameters)
 /// at the latest saved state before the score changed, and its sound from there: bit
 /// for bit the same result, faster. Given `stop_after_s`, a resumed rendering stops
