@@ -55,9 +55,10 @@ struct Receiver {
     bank: VoiceBank,
     voices: Vec<Voice>,
     inv_mass: Vec<f64>,
-    /// Per voice, per source (in the order of `sources`): the force per unit pressure (m
-    /// even) and per unit ṗ/c (m odd), m² and m³ (see the module docs).
-    weights: Vec<Vec<[f64; 2]>>,
+    /// Per source (in the order of `sources`), per voice: the force per unit pressure (m
+    /// even) and per unit ṗ/c (m odd), m² and m³ (see the module docs) — source by
+    /// source, so the sum over the voices runs along contiguous lanes.
+    weights: Vec<[Vec<f64>; 2]>,
     /// Per source drum i ≠ j: (i, delay in frames, pressure per output unit).
     sources: Vec<(usize, usize, f64)>,
 }
@@ -200,7 +201,9 @@ impl Receiver {
             .iter()
             .map(|(k, ..)| 1.0 / head.modes.modes()[*k].modal_mass_kg)
             .collect();
-        let weights = picked.into_iter().map(|(_, w, _)| w).collect();
+        let weights = (0..heard.len())
+            .map(|s| [0, 1].map(|c| picked.iter().map(|(_, w, _)| w[s][c]).collect()))
+            .collect();
         let sources = heard
             .iter()
             .map(|&(i, delay, scale, _)| (i, delay, scale))
@@ -292,6 +295,7 @@ pub fn resynthesise(
     let mut ringing = start > 0;
     let mut input = Vec::new();
     let mut fields: Vec<[f64; 2]> = Vec::new();
+    let mut forces: Vec<f64> = Vec::new();
     for n0 in (start..frames).step_by(BLOCK) {
         let now = tuning_at(tunings, n0);
         if now != index {
@@ -343,12 +347,23 @@ pub fn resynthesise(
             if fields.iter().all(|f| *f == [0.0; 2]) {
                 continue;
             }
-            for ((r, w), im) in row.iter_mut().zip(&rx.weights).zip(&rx.inv_mass) {
-                let force: f64 = w
+            // Per voice, the sources' forces summed in their order (as `Sum` would: the
+            // first source's force, then each other's added).
+            forces.clear();
+            let [pressure, rate] = &rx.weights[0];
+            let [mean, slope] = fields[0];
+            forces.extend(
+                pressure
                     .iter()
-                    .zip(&fields)
-                    .map(|(w, f)| w[0] * f[0] + w[1] * f[1])
-                    .sum();
+                    .zip(rate)
+                    .map(|(w0, w1)| w0 * mean + w1 * slope),
+            );
+            for ([pressure, rate], [mean, slope]) in rx.weights.iter().zip(&fields).skip(1) {
+                for ((force, w0), w1) in forces.iter_mut().zip(pressure).zip(rate) {
+                    *force += w0 * mean + w1 * slope;
+                }
+            }
+            for ((r, force), im) in row.iter_mut().zip(&forces).zip(&rx.inv_mass) {
                 *r = (force * im) as f32;
             }
             driven = true;
