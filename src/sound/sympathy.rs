@@ -294,6 +294,8 @@ pub fn resynthesise(
     let damping = super::touch_factor(fs / DECIMATION as f64) as f32;
     let mut ringing = start > 0;
     let mut input = Vec::new();
+    // The (stride, voices) `input`'s rows are laid out for.
+    let mut layout = (0, 0);
     let mut fields: Vec<[f64; 2]> = Vec::new();
     let mut forces: Vec<f64> = Vec::new();
     for n0 in (start..frames).step_by(BLOCK) {
@@ -309,7 +311,11 @@ pub fn resynthesise(
             continue;
         };
         let stride = rx.bank.stride();
-        input.resize(steps * stride, 0.0);
+        if layout != (stride, rx.voices.len()) {
+            // Rows are written voice by voice below: their padding lanes stay zero.
+            layout = (stride, rx.voices.len());
+            input = vec![0.0; steps * stride];
+        }
         // Also at the start of the last block, where a cut synthesis resumes (see the
         // drums' own synthesis).
         if periodic(n0) || n0 + BLOCK >= frames {
@@ -317,7 +323,6 @@ pub fn resynthesise(
         }
         let n1 = (n0 + BLOCK).min(frames);
         let used = (n1 - n0).div_ceil(DECIMATION);
-        input.fill(0.0);
         let mut driven = false;
         for (row, a) in input
             .chunks_exact_mut(stride)
@@ -345,6 +350,7 @@ pub fn resynthesise(
                 fields.push([scale * mean, rate]);
             }
             if fields.iter().all(|f| *f == [0.0; 2]) {
+                row.fill(0.0);
                 continue;
             }
             // Per voice, the sources' forces summed in their order (as `Sum` would: the
