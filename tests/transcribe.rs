@@ -277,6 +277,14 @@ fn recorded_notes_joined_into_a_phrase() {
             report.onsets_s, report.tuning_cents
         );
         assert_eq!(found.len(), truth.len(), "{semitones:+}: {found:?}");
+        let unplayable = truth
+            .iter()
+            .filter(|(_, hz)| {
+                let want = Pitch((69.0 + 12.0 * (hz / 440.0).log2()).round() as u8);
+                !kit.drums.iter().any(|d| d.in_range(want))
+            })
+            .count();
+        assert_eq!(report.octave_moves, unplayable, "{semitones:+}");
         for ((t, hz), (beat, (at, _))) in truth.iter().zip(score.beats.iter().zip(&found)) {
             assert!((at - t).abs() <= TOLERANCE_S, "{semitones:+}: {at} vs {t}");
             let want = Pitch((69.0 + 12.0 * (hz / 440.0).log2()).round() as u8);
@@ -396,6 +404,22 @@ fn cli_transcribe() {
     let loaded = LoadedScore::load(&out).unwrap();
     assert_eq!(loaded.score.beats.len(), 1);
     assert_eq!(loaded.score.title, "Timpani_2L");
+    assert!(String::from_utf8_lossy(&run.stdout).contains("0 notes moved by octaves"));
+
+    // The C2 note: no drum of the standard kit reaches it, and the summary says so.
+    let low = root().join("kits/samples/Timpani_1L.wav");
+    let run = std::process::Command::new(exe)
+        .args([
+            "transcribe",
+            low.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(run.status.success());
+    let said = String::from_utf8_lossy(&run.stdout);
+    assert!(said.contains("1 notes moved by octaves"), "{said}");
 
     let bad = dir.path().join("broken.wav");
     std::fs::write(&bad, b"RIFF").unwrap();

@@ -31,7 +31,7 @@ pub fn run(
         &Imported {
             source: &source,
             duplicates_dropped: 0,
-            octave_moves: 0,
+            octave_moves: report.octave_moves,
         },
     )?;
     for n in &report.notices {

@@ -65,6 +65,8 @@ pub struct Report {
     pub bpm: f64,
     /// The recording's tuning against A4 = 440 Hz, cents.
     pub tuning_cents: f64,
+    /// Strokes whose pitch no drum reaches, moved by octaves into a drum's range.
+    pub octave_moves: usize,
     /// Where each stroke was heard, s (for checks and plots).
     pub onsets_s: Vec<f64>,
     /// Things the user should know.
@@ -238,6 +240,7 @@ pub fn transcribe(
         rolls,
         bpm: score.tempo.last().map_or(0.0, |p| p.bpm),
         tuning_cents: notate::tuning_offset_cents(&strokes),
+        octave_moves: found_notes.octave_moves,
         onsets_s: times,
         notices,
     };
