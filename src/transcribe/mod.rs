@@ -185,11 +185,20 @@ pub fn transcribe(
             }
         })
         .collect();
+    // A run that is one roll by its timing (written on one drum) takes the pitch heard
+    // over the whole run: each stroke alone is heard through a window of 60–120 ms,
+    // whose 8–16 Hz resolution misplaces a low drum's (1,1) by a semitone or more (a
+    // recorded D2 roll's first stroke reads C♯2) or hears a partial as the (1,1).
     for run in fast_runs(&times) {
         let span = (times[run.start], times[run.end - 1]);
         if let Some(run_hz) = notes::hear_run(samples, rate_hz, span, band) {
+            let roll = notate::is_roll(&times[run.clone()]);
             for stroke in &mut strokes[run] {
-                stroke.principal_hz = notes::onto_run(stroke.principal_hz, run_hz);
+                stroke.principal_hz = if roll {
+                    Some(run_hz)
+                } else {
+                    notes::onto_run(stroke.principal_hz, run_hz)
+                };
             }
         }
     }
@@ -281,8 +290,6 @@ fn lead_in_ticks(first_s: f64, period_s: f64, tpq: u32) -> u64 {
     ticks as u64
 }
 
-/// How much louder than timpanist's strokes the recording is, dB: its median stroke
-/// against an mf stroke at the median pitch.
 /// The runs of at least [`notes::RUN_STROKES`] onsets (`times`, s, sorted) each within
 /// [`notes::RUN_GAP_S`] of the next: index ranges.
 fn fast_runs(times: &[f64]) -> Vec<std::ops::Range<usize>> {
@@ -299,6 +306,8 @@ fn fast_runs(times: &[f64]) -> Vec<std::ops::Range<usize>> {
     runs
 }
 
+/// How much louder than timpanist's strokes the recording is, dB: its median stroke
+/// against an mf stroke at the median pitch.
 fn relative_shift(strokes: &[notate::Stroke], kit: &Kit) -> f64 {
     let mut levels: Vec<f64> = strokes.iter().map(|s| s.level_db).collect();
     levels.sort_by(f64::total_cmp);

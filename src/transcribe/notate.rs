@@ -212,7 +212,8 @@ pub fn roll_runs(placed: &[Placed]) -> Vec<(usize, usize)> {
         {
             j += 1;
         }
-        if j + 1 - i >= ROLL_MIN_STROKES && even(&placed[i..=j]) {
+        let times: Vec<f64> = placed[i..=j].iter().map(|p| p.time_s).collect();
+        if j + 1 - i >= ROLL_MIN_STROKES && even(&times) {
             match runs.last_mut() {
                 Some(last) if last.1 + 1 == i && one_stroke_missed(placed, *last, (i, j)) => {
                     last.1 = j;
@@ -239,22 +240,32 @@ fn one_stroke_missed(placed: &[Placed], a: (usize, usize), b: (usize, usize)) ->
     (ga - gb).abs() <= ROLL_EVENNESS * gap && (between - 2.0 * gap).abs() <= ROLL_EVENNESS * gap
 }
 
-/// Whether the strokes of a run lie on an even grid: every one within [`ROLL_EVENNESS`]
-/// of a gap from the least-squares line through their times.
-fn even(run: &[Placed]) -> bool {
-    let n = run.len() as f64;
+/// Whether strokes at `times` (s, sorted) lie on an even grid: every one within
+/// [`ROLL_EVENNESS`] of a gap from the least-squares line through them.
+fn even(times: &[f64]) -> bool {
+    let n = times.len() as f64;
     let mean_k = (n - 1.0) / 2.0;
-    let mean_t = run.iter().map(|p| p.time_s).sum::<f64>() / n;
+    let mean_t = times.iter().sum::<f64>() / n;
     let (mut num, mut den) = (0.0, 0.0);
-    for (k, p) in run.iter().enumerate() {
-        num += (k as f64 - mean_k) * (p.time_s - mean_t);
+    for (k, t) in times.iter().enumerate() {
+        num += (k as f64 - mean_k) * (t - mean_t);
         den += (k as f64 - mean_k).powi(2);
     }
     let gap = num / den;
     gap > 0.0
-        && run.iter().enumerate().all(|(k, p)| {
-            (mean_t + gap * (k as f64 - mean_k) - p.time_s).abs() <= ROLL_EVENNESS * gap
-        })
+        && times
+            .iter()
+            .enumerate()
+            .all(|(k, t)| (mean_t + gap * (k as f64 - mean_k) - t).abs() <= ROLL_EVENNESS * gap)
+}
+
+/// Whether strokes at `times` (s, sorted) are one roll by their timing, as [`roll_runs`]
+/// judges it: at least [`ROLL_MIN_STROKES`], each at most [`ROLL_MAX_GAP_S`] after the
+/// previous, on an even grid.
+pub fn is_roll(times: &[f64]) -> bool {
+    times.len() >= ROLL_MIN_STROKES
+        && times.windows(2).all(|w| w[1] - w[0] <= ROLL_MAX_GAP_S)
+        && even(times)
 }
 
 /// A roll over `run`: strokes per quarter the divisor of `tpq` (1–32) nearest the run's
