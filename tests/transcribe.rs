@@ -145,10 +145,10 @@ fn check(
 /// half, heard by its (2,1) — an even roll of eighths of a quarter at 96 bpm meets the
 /// (1,1) in opposite phase stroke after stroke — was written on the D3 drum: 287 of 315).
 /// Damaged: 85 % of the strokes found, F ≥ 0.6 on every score, the right drum for 88 %
-/// (measured: 292 of 319 found, F 0.754 on the roll exercise, and 270 of 292 on the right
-/// drum). Heard in a concert hall (`sound::room`, one microphone: recordings are made in
-/// rooms): 93 % found, F ≥ 0.75, the right drum for 78 % (measured: 299 of 319 found, F
-/// 0.763 on the roll exercise, 262 of 299 on the right drum — the hall carries the
+/// (measured 2026-12-06: 295 of 319 found, F 0.789 on the roll exercise, and 270 of 295
+/// on the right drum). Heard in a concert hall (`sound::room`, one microphone: recordings
+/// are made in rooms): 93 % found, F ≥ 0.75, the right drum for 78 % (measured: 306 of
+/// 319 found, F 0.892 on the roll exercise, 267 of 306 on the right drum — the hall carries the
 /// strokes before into each stroke's pitch, and blurs the roll exercise's A2 roll into
 /// onsets too uneven to be one roll, whose pieces after the first are heard by the
 /// (2,1) on the D3 drum: 22 of 50. Before the sympathetic heads' images at 5–7 kHz were

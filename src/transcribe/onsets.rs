@@ -41,6 +41,9 @@ const START_SHARE: f32 = 0.05;
 /// strokes of a roll after its first 13–35 %.
 const MASKED_SHARE: f64 = 0.08;
 const MASKED_S: f64 = 3.0;
+/// An onset is placed within this of its frame's centre, s (half a frame at 32 kHz; the
+/// 2048-sample frames at 44.1 and 48 kHz reach ±21–23 ms, into a fast roll's neighbours).
+const PLACE_WITHIN_S: f64 = 0.016;
 /// Energy blocks of the high-passed signal for placing an onset, s.
 const BLOCK_S: f64 = 0.0005;
 /// The rise is measured against the mean energy of this span before, s.
@@ -208,7 +211,8 @@ fn threshold(v: &[f64]) -> f64 {
         .max(MIN_STRENGTH)
 }
 
-/// Where within frame `frame`'s window the stroke begins, s: the first block of the
+/// Where within frame `frame`'s window (at most [`PLACE_WITHIN_S`] either side of its
+/// centre) the stroke begins, s: the first block of the
 /// high-passed signal rising at least half as much as the block that rises most above the
 /// largest block of the [`RISE_BEFORE_S`] before it (a drum still ringing stays near its
 /// own largest block; a stroke's click does not).
@@ -217,7 +221,7 @@ pub fn place(samples: &[f32], rate_hz: u32, strength: &Strength, frame: usize) -
     let block = ((BLOCK_S * rate).round() as usize).max(1);
     let before = ((RISE_BEFORE_S / BLOCK_S).round() as usize).max(1);
     let centre = strength.time_s(frame) * rate;
-    let half = strength.frame_s * rate / 2.0;
+    let half = (strength.frame_s / 2.0).min(PLACE_WITHIN_S) * rate;
     let first = ((centre - half).max(0.0) as usize) / block;
     let last = ((centre + half) as usize).min(samples.len()) / block;
     let energy = |b: usize| -> f64 {
