@@ -32,6 +32,29 @@ pub struct TempoPoint {
     pub change: TempoChange,
 }
 
+/// A map of steps from `first_bpm` at tick 0 and `events` (tick, bpm) in time order: an
+/// event at the tick of the one before replaces it, and a step to the tempo already
+/// holding is left out (imported files repeat their tempo marks).
+pub fn steps(first_bpm: f64, events: impl IntoIterator<Item = (u64, f64)>) -> Vec<TempoPoint> {
+    let step = |tick, bpm| TempoPoint {
+        tick,
+        bpm,
+        change: TempoChange::Step,
+    };
+    let mut points = vec![step(0, first_bpm)];
+    for (tick, bpm) in events {
+        let last = points.last_mut().expect("points start with one");
+        if last.tick == tick {
+            last.bpm = bpm;
+        } else if last.bpm != bpm {
+            points.push(step(tick, bpm));
+        }
+    }
+    // A later event at the same tick may have made a point repeat the one before.
+    points.dedup_by(|b, a| a.bpm == b.bpm);
+    points
+}
+
 /// One stretch of the map between two tempo points.
 #[derive(Clone, Copy, Debug)]
 struct Segment {
@@ -181,6 +204,26 @@ mod tests {
 
     fn point(tick: u64, bpm: f64, change: TempoChange) -> TempoPoint {
         TempoPoint { tick, bpm, change }
+    }
+
+    /// Steps from imported tempo marks: a mark at tick 0 replaces the first tempo, a later
+    /// mark at the same tick the earlier, a repeated tempo is left out, and a replacement
+    /// that makes a point repeat the one before merges them.
+    #[test]
+    fn steps_merge_repeats_and_same_ticks() {
+        let step = |tick, bpm| point(tick, bpm, TempoChange::Step);
+        assert_eq!(steps(120.0, []), vec![step(0, 120.0)]);
+        assert_eq!(
+            steps(
+                120.0,
+                [(0, 90.0), (960, 90.0), (1920, 100.0), (1920, 110.0)]
+            ),
+            vec![step(0, 90.0), step(1920, 110.0)]
+        );
+        assert_eq!(
+            steps(120.0, [(960, 100.0), (960, 120.0), (1920, 80.0)]),
+            vec![step(0, 120.0), step(1920, 80.0)]
+        );
     }
 
     /// A constant 120 bpm: one quarter (960 ticks) every half second, and back.

@@ -17,10 +17,10 @@ use super::midi_export::{BeatData, GM_TIMPANI};
 use crate::base::pitch::Pitch;
 use crate::kit::Kit;
 use crate::score::meter;
-use crate::score::tempo::BPM_RANGE;
+use crate::score::tempo::{self, BPM_RANGE};
 use crate::score::{
     Beat, Dynamic, Hand, ImpactLocation, MeterChange, MeterMap, PlayingMode, Roll, Score,
-    TempoChange, TempoPoint,
+    TempoPoint,
 };
 use midly::{Format, MetaMessage, MidiMessage, Smf, Timing, TrackEventKind};
 use std::cmp::Reverse;

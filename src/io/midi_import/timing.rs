@@ -21,31 +21,21 @@ pub(super) fn tempo_points(
     clock: &Clock,
     warnings: &mut Vec<String>,
 ) -> Vec<TempoPoint> {
-    let step = |tick, bpm| TempoPoint {
-        tick,
-        bpm,
-        change: TempoChange::Step,
-    };
-    let mut points = vec![step(0, DEFAULT_BPM)];
     if matches!(clock, Clock::Timecode { .. }) {
-        return points;
+        return tempo::steps(DEFAULT_BPM, []);
     }
     let mut sorted = tempos.to_vec();
     sorted.sort_by_key(|t| t.0);
     let mut clamped = 0;
-    for &(tick, us) in &sorted {
-        let exact = bpm_of(us);
-        let bpm = exact.clamp(*BPM_RANGE.start(), *BPM_RANGE.end());
-        clamped += usize::from(bpm != exact);
-        let last = points.last_mut().expect("points start with one");
-        if last.tick == tick {
-            last.bpm = bpm;
-        } else if last.bpm != bpm {
-            points.push(step(tick, bpm));
-        }
-    }
-    // A later event at the same tick may have made a point repeat the one before.
-    points.dedup_by(|b, a| a.bpm == b.bpm);
+    let points = tempo::steps(
+        DEFAULT_BPM,
+        sorted.iter().map(|&(tick, us)| {
+            let exact = bpm_of(us);
+            let bpm = exact.clamp(*BPM_RANGE.start(), *BPM_RANGE.end());
+            clamped += usize::from(bpm != exact);
+            (tick, bpm)
+        }),
+    );
     if clamped > 0 {
         warnings.push(format!(
             "{clamped} tempo events outside {}–{} bpm were clamped into that range",

@@ -26,9 +26,9 @@
 use super::midi_import::{self as midi, ANY_DRUM, Note};
 use crate::kit::Kit;
 use crate::score::meter;
-use crate::score::tempo::BPM_RANGE;
+use crate::score::tempo::{self, BPM_RANGE};
 use crate::score::{
-    Dynamic, Hand, ImpactLocation, MeterChange, PlayingMode, Roll, Score, TempoChange, TempoPoint,
+    Dynamic, Hand, ImpactLocation, MeterChange, PlayingMode, Roll, Score, TempoPoint,
 };
 use roxmltree::{Document, Node};
 use std::collections::BTreeMap;

@@ -6,35 +6,25 @@ use super::*;
 /// Tempo points from (tick, bpm, from `<sound>`): a `<sound tempo>` wins over a metronome
 /// mark at the same tick; 120 bpm until the first; steps; clamped into the score's range.
 pub(super) fn tempo_points(tempos: &[(u64, f64, bool)], notices: &mut Notices) -> Vec<TempoPoint> {
-    let step = |tick, bpm| TempoPoint {
-        tick,
-        bpm,
-        change: TempoChange::Step,
-    };
     let mut sorted = tempos.to_vec();
     sorted.sort_by_key(|a| (a.0, a.2));
-    let mut points = vec![step(0, DEFAULT_BPM)];
-    for (tick, bpm, _) in sorted {
-        let clamped = bpm.clamp(*BPM_RANGE.start(), *BPM_RANGE.end());
-        if clamped != bpm {
-            notices.add(
-                format!(
-                    "tempo outside {}–{} bpm: clamped",
-                    BPM_RANGE.start(),
-                    BPM_RANGE.end()
-                ),
-                &format!("score tick {tick}"),
-            );
-        }
-        let last = points.last_mut().expect("points start with one");
-        if last.tick == tick {
-            last.bpm = clamped;
-        } else if last.bpm != clamped {
-            points.push(step(tick, clamped));
-        }
-    }
-    points.dedup_by(|b, a| a.bpm == b.bpm);
-    points
+    tempo::steps(
+        DEFAULT_BPM,
+        sorted.into_iter().map(|(tick, bpm, _)| {
+            let clamped = bpm.clamp(*BPM_RANGE.start(), *BPM_RANGE.end());
+            if clamped != bpm {
+                notices.add(
+                    format!(
+                        "tempo outside {}–{} bpm: clamped",
+                        BPM_RANGE.start(),
+                        BPM_RANGE.end()
+                    ),
+                    &format!("score tick {tick}"),
+                );
+            }
+            (tick, clamped)
+        }),
+    )
 }
 
 /// `length` ticks as a time signature (numerator 1–64 over 1–32), preferring `den`.
