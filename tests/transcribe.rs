@@ -482,18 +482,20 @@ fn noise_and_held_tones_are_not_strokes() {
 #[test]
 fn cli_transcribe() {
     let dir = tempfile::tempdir().unwrap();
-    let exe = env!("CARGO_BIN_EXE_timpanist");
+    let transcribe = |wav: &Path, out: &Path| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_timpanist"))
+            .args([
+                "transcribe",
+                wav.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+            ])
+            .output()
+            .unwrap()
+    };
     let wav = root().join("kits/samples/Timpani_2L.wav");
     let out = dir.path().join("note.ron");
-    let run = std::process::Command::new(exe)
-        .args([
-            "transcribe",
-            wav.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let run = transcribe(&wav, &out);
     assert!(
         run.status.success(),
         "{}",
@@ -506,15 +508,7 @@ fn cli_transcribe() {
 
     // The C2 note: no drum of the standard kit reaches it, and the summary says so.
     let low = root().join("kits/samples/Timpani_1L.wav");
-    let run = std::process::Command::new(exe)
-        .args([
-            "transcribe",
-            low.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let run = transcribe(&low, &out);
     assert!(run.status.success());
     let said = String::from_utf8_lossy(&run.stdout);
     assert!(said.contains("1 notes moved by octaves"), "{said}");
@@ -522,15 +516,7 @@ fn cli_transcribe() {
     let bad = dir.path().join("broken.wav");
     std::fs::write(&bad, b"RIFF").unwrap();
     let never = dir.path().join("never.ron");
-    let run = std::process::Command::new(exe)
-        .args([
-            "transcribe",
-            bad.to_str().unwrap(),
-            "-o",
-            never.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
+    let run = transcribe(&bad, &never);
     assert!(!run.status.success());
     assert!(String::from_utf8_lossy(&run.stderr).contains("broken.wav"));
     assert!(!never.exists());

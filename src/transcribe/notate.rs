@@ -213,7 +213,7 @@ pub fn roll_runs(placed: &[Placed]) -> Vec<(usize, usize)> {
             j += 1;
         }
         let times: Vec<f64> = placed[i..=j].iter().map(|p| p.time_s).collect();
-        if j + 1 - i >= ROLL_MIN_STROKES && even(&times) {
+        if is_roll(&times) {
             match runs.last_mut() {
                 Some(last) if last.1 + 1 == i && one_stroke_missed(placed, *last, (i, j)) => {
                     last.1 = j;
