@@ -336,16 +336,7 @@ fn a_failure_midway_leaves_no_partial_pack() {
     let score = timpanist::score::demos::score("etude-modes").unwrap();
     let kit = timpanist::kit::Kit::bundled("standard").unwrap();
     let motion = Motion::new(250.0, [Vec::new(), Vec::new()], Vec::new());
-    let reference = Reference {
-        rate_hz: 250.0,
-        tips: [Vec::new(), Vec::new()],
-        poses: None,
-        beats: Vec::new(),
-        gaze: None,
-        grip: None,
-        hands: None,
-        lean: None,
-    };
+    let reference = Reference::following(250.0, [Vec::new(), Vec::new()]);
     let audio = timpanist::sound::Audio {
         rate_hz: 48_000,
         channels: 2,

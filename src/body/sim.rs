@@ -359,6 +359,20 @@ impl Environment for FreeSpace {
 }
 
 impl Reference {
+    /// Tip targets alone at `rate_hz`: no poses, beats, gaze, grip, hand targets or lean.
+    pub fn following(rate_hz: f64, tips: [Vec<DVec3>; 2]) -> Reference {
+        Reference {
+            rate_hz,
+            tips,
+            poses: None,
+            beats: Vec::new(),
+            gaze: None,
+            grip: None,
+            hands: None,
+            lean: None,
+        }
+    }
+
     /// The beat being played at `time_s`: the first whose impact is not yet past.
     pub fn beat_at(&self, time_s: f64) -> Option<usize> {
         self.beats
@@ -1031,14 +1045,8 @@ mod tests {
                 .collect()
         };
         let reference = Reference {
-            rate_hz: 250.0,
-            tips: [hold(Side::Left, false), hold(Side::Right, true)],
-            poses: None,
             beats: vec![(0.02, 3), (0.06, 4)],
-            gaze: None,
-            grip: None,
-            hands: None,
-            lean: None,
+            ..Reference::following(250.0, [hold(Side::Left, false), hold(Side::Right, true)])
         };
         let params = SimParams {
             frequency_hz: [2000.0; JOINT_COUNT],
@@ -1074,14 +1082,8 @@ mod tests {
                 .collect()
         };
         let reference = Reference {
-            rate_hz: 250.0,
-            tips: [tips(Side::Left, 0.0), tips(Side::Right, 2.0)],
-            poses: None,
             beats: vec![(1.9, 7)],
-            gaze: None,
-            grip: None,
-            hands: None,
-            lean: None,
+            ..Reference::following(250.0, [tips(Side::Left, 0.0), tips(Side::Right, 2.0)])
         };
         let run = |limit: f64| {
             let params = SimParams {
@@ -1169,16 +1171,7 @@ mod tests {
                     .collect()
             })
         };
-        let reference = |late| Reference {
-            rate_hz: 250.0,
-            tips: path(late),
-            poses: None,
-            beats: Vec::new(),
-            gaze: None,
-            grip: None,
-            hands: None,
-            lean: None,
-        };
+        let reference = |late| Reference::following(250.0, path(late));
         let params = SimParams::default();
         let (a, b) = (reference(0.0), reference(0.5));
         let ones = [1.0; JOINT_COUNT];

@@ -77,16 +77,7 @@ mod tests {
             ]
         };
         let motion = Motion::new(250.0, tips(0.8), vec![REST, bent, REST]);
-        let reference = Reference {
-            rate_hz: 250.0,
-            tips: tips(0.75),
-            poses: None,
-            beats: Vec::new(),
-            gaze: None,
-            grip: None,
-            hands: None,
-            lean: None,
-        };
+        let reference = Reference::following(250.0, tips(0.75));
         let bytes = to_c3d(&motion, &reference, &skeleton);
         let back = read(Path::new("motion.c3d"), &bytes, None).unwrap();
         assert_eq!(back.frames, 3);

@@ -258,14 +258,9 @@ fn unit_reference(db: &MotionDb, unit: &UnitEntry, tips: [Vec<DVec3>; 2]) -> Ref
         None => solved_joints(&tips, take.rate_hz),
     };
     Reference {
-        rate_hz: take.rate_hz,
-        tips,
         poses: Some(poses),
         beats: vec![((unit.impact - unit.start) as f64 / take.rate_hz, 0)],
-        gaze: None,
-        grip: None,
-        hands: None,
-        lean: None,
+        ..Reference::following(take.rate_hz, tips)
     }
 }
 
@@ -317,16 +312,7 @@ fn longest_gap(track: &[Option<DVec3>]) -> usize {
 fn solved_joints(tips: &[Vec<DVec3>; 2], rate_hz: f64) -> Vec<Pose> {
     let skeleton = capture_skeleton();
     let start = posture_reaching(&skeleton, [tips[0][0], tips[1][0]], &NO_LIMITS);
-    let reference = Reference {
-        rate_hz,
-        tips: tips.clone(),
-        poses: None,
-        beats: Vec::new(),
-        gaze: None,
-        grip: None,
-        hands: None,
-        lean: None,
-    };
+    let reference = Reference::following(rate_hz, tips.clone());
     let model = BodyModel::new(skeleton, 70.0);
     ik_targets(&model, &reference, &SimParams::default(), &start)
 }
