@@ -192,9 +192,9 @@ pub fn transcribe(
     for run in fast_runs(&times) {
         let span = (times[run.start], times[run.end - 1]);
         if let Some(run_hz) = notes::hear_run(samples, rate_hz, span, band) {
-            let roll = notate::is_roll(&times[run.clone()]);
-            for stroke in &mut strokes[run] {
-                stroke.principal_hz = if roll {
+            let roll = notate::roll_core(&times[run.clone()]).map(|(a, b)| a..=b);
+            for (k, stroke) in strokes[run].iter_mut().enumerate() {
+                stroke.principal_hz = if roll.as_ref().is_some_and(|r| r.contains(&k)) {
                     Some(run_hz)
                 } else {
                     notes::onto_run(stroke.principal_hz, run_hz)

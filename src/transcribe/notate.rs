@@ -18,6 +18,9 @@ const ROLL_MIN_STROKES: usize = 6;
 const ROLL_MAX_GAP_S: f64 = 0.13;
 /// …each within this share of a gap from an even grid.
 const ROLL_EVENNESS: f64 = 0.35;
+/// A close run that is not even as a whole may still hold a roll with this many strokes
+/// left out at either end.
+const ROLL_TRIM: usize = 2;
 
 /// One stroke as heard: when, which pitches (two for a chord), how much energy it added.
 #[derive(Clone, Debug, PartialEq)]
@@ -213,17 +216,31 @@ pub fn roll_runs(placed: &[Placed]) -> Vec<(usize, usize)> {
             j += 1;
         }
         let times: Vec<f64> = placed[i..=j].iter().map(|p| p.time_s).collect();
-        if is_roll(&times) {
+        if let Some((a, b)) = roll_core(&times).map(|(a, b)| (i + a, i + b)) {
             match runs.last_mut() {
-                Some(last) if last.1 + 1 == i && one_stroke_missed(placed, *last, (i, j)) => {
-                    last.1 = j;
+                Some(last) if last.1 + 1 == a && one_stroke_missed(placed, *last, (a, b)) => {
+                    last.1 = b;
                 }
-                _ => runs.push((i, j)),
+                _ => runs.push((a, b)),
             }
         }
         i = j + 1;
     }
     runs
+}
+
+/// The longest part of strokes at `times` (s, sorted; a run of close strokes) that is a
+/// roll ([`is_roll`]), leaving out at most [`ROLL_TRIM`] strokes at each end (a stray
+/// onset just before or after a roll — a loud note's beating, a stroke of the next beat
+/// — made the whole run uneven, and each stroke of the roll was written on its own):
+/// (first, last) index, inclusive; `None` when no such part is one.
+pub fn roll_core(times: &[f64]) -> Option<(usize, usize)> {
+    let n = times.len();
+    (0..=2 * ROLL_TRIM)
+        .flat_map(|dropped| (0..=dropped).map(move |front| (front, dropped - front)))
+        .filter(|&(front, back)| front <= ROLL_TRIM && back <= ROLL_TRIM && front + back < n)
+        .map(|(front, back)| (front, n - 1 - back))
+        .find(|&(a, b)| is_roll(&times[a..=b]))
 }
 
 /// Mean gap between the strokes of a run of at least two, s.
@@ -243,20 +260,27 @@ fn one_stroke_missed(placed: &[Placed], a: (usize, usize), b: (usize, usize)) ->
 /// Whether strokes at `times` (s, sorted) lie on an even grid: every one within
 /// [`ROLL_EVENNESS`] of a gap from the least-squares line through them.
 fn even(times: &[f64]) -> bool {
-    let n = times.len() as f64;
-    let mean_k = (n - 1.0) / 2.0;
-    let mean_t = times.iter().sum::<f64>() / n;
-    let (mut num, mut den) = (0.0, 0.0);
-    for (k, t) in times.iter().enumerate() {
-        num += (k as f64 - mean_k) * (t - mean_t);
-        den += (k as f64 - mean_k).powi(2);
-    }
-    let gap = num / den;
+    let (first, gap) = even_line(times);
     gap > 0.0
         && times
             .iter()
             .enumerate()
-            .all(|(k, t)| (mean_t + gap * (k as f64 - mean_k) - t).abs() <= ROLL_EVENNESS * gap)
+            .all(|(k, t)| (first + gap * k as f64 - t).abs() <= ROLL_EVENNESS * gap)
+}
+
+/// The least-squares line through `values` (at least two) against their index: its
+/// value at index 0 and its step.
+fn even_line(values: &[f64]) -> (f64, f64) {
+    let n = values.len() as f64;
+    let mean_k = (n - 1.0) / 2.0;
+    let mean = values.iter().sum::<f64>() / n;
+    let (mut num, mut den) = (0.0, 0.0);
+    for (k, v) in values.iter().enumerate() {
+        num += (k as f64 - mean_k) * (v - mean);
+        den += (k as f64 - mean_k).powi(2);
+    }
+    let step = num / den;
+    (mean - step * mean_k, step)
 }
 
 /// Whether strokes at `times` (s, sorted) are one roll by their timing, as [`roll_runs`]
@@ -268,13 +292,16 @@ pub fn is_roll(times: &[f64]) -> bool {
         && even(times)
 }
 
-/// A roll over `run`: strokes per quarter the divisor of `tpq` (1–32) nearest the run's
-/// rate, one stroke-step of length per stroke (a roll's strokes run up to, not at, its
-/// end; see [`crate::score::Beat::stroke_ticks`]).
-pub fn roll_of(run: &[Placed], tpq: u32) -> Roll {
-    let first = run[0].tick;
-    let last = run[run.len() - 1].tick;
-    let gap_ticks = (last - first) as f64 / (run.len() - 1) as f64;
+/// A roll over `run`: where it starts (tick) and its strokes per quarter, the divisor of
+/// `tpq` (1–32) nearest the run's rate, with one stroke-step of length per stroke (a
+/// roll's strokes run up to, not at, its end; see [`crate::score::Beat::stroke_ticks`]).
+/// The run's strokes are fitted by one even line of ticks, and the roll starts on the
+/// step of that line's start nearest it: one stroke's own onset can be 20 ms off in a
+/// reverberant recording (a hall's roll was written from an onset a third of a step late,
+/// and every one of its strokes missed the performance by as much).
+pub fn roll_of(run: &[Placed], tpq: u32) -> (u64, Roll) {
+    let ticks: Vec<f64> = run.iter().map(|p| p.tick as f64).collect();
+    let (first, gap_ticks) = even_line(&ticks);
     let per_quarter = (1..=32u32)
         .filter(|d| tpq.is_multiple_of(*d))
         .min_by(|&a, &b| {
@@ -282,12 +309,17 @@ pub fn roll_of(run: &[Placed], tpq: u32) -> Roll {
             err(a).total_cmp(&err(b))
         })
         .unwrap_or(8);
-    let step = u64::from(tpq / per_quarter);
-    let strokes = ((last - first) as f64 / step as f64).round() as u64 + 1;
-    Roll {
-        length_ticks: strokes * step,
-        strokes_per_quarter: per_quarter,
-    }
+    let step = f64::from(tpq / per_quarter);
+    let start = ((first / step).round() * step).max(0.0);
+    let last = first + gap_ticks * (run.len() - 1) as f64;
+    let strokes = ((last - start) / step).round().max(0.0) as u64 + 1;
+    (
+        start as u64,
+        Roll {
+            length_ticks: strokes * step as u64,
+            strokes_per_quarter: per_quarter,
+        },
+    )
 }
 
 /// The beats of the placed strokes: rolls where [`roll_runs`] finds them, a beat per drum
@@ -315,7 +347,9 @@ pub fn beats(placed: &[Placed], kit: &Kit, tpq: u32) -> (Vec<Beat>, usize) {
             && a == i
         {
             let mut b0 = beat(p.drums[0]);
-            b0.roll = Some(roll_of(&placed[a..=b], tpq));
+            let (tick, roll) = roll_of(&placed[a..=b], tpq);
+            b0.tick = tick;
+            b0.roll = Some(roll);
             beats.push(b0);
             run.next();
             i = b + 1;
@@ -393,7 +427,8 @@ mod tests {
             })
             .collect();
         assert_eq!(roll_runs(&placed), vec![(0, 9)]);
-        let roll = roll_of(&placed, 960);
+        let (tick, roll) = roll_of(&placed, 960);
+        assert_eq!(tick, 960);
         assert_eq!(roll.strokes_per_quarter, 16);
         assert_eq!(roll.length_ticks, 10 * 60);
         let (beats, rolls) = beats(&placed, &Kit::standard(), 960);
@@ -444,5 +479,31 @@ mod tests {
             .map(stroke)
             .collect();
         assert_eq!(roll_runs(&rest), vec![(0, 10), (11, 27)]);
+    }
+
+    /// Twelve strokes a tenth of a second apart (sixths of a quarter at 100 bpm) with a
+    /// stray onset 50 ms after the last (a loud low note's beating): the twelve are one
+    /// roll and the stray one a beat of its own. With the first onset a third of a step
+    /// late, as a hall can place it, the roll still starts on its step.
+    #[test]
+    fn a_roll_leaves_out_a_stray_onset_and_starts_on_its_line() {
+        let m = map(100.0);
+        let at = |t: f64| Placed {
+            time_s: t,
+            tick: quantise(&m, 960, t, None),
+            drums: vec![(1, Pitch(45))],
+            dynamic: Dynamic::P,
+        };
+        let mut placed: Vec<Placed> = (0..12).map(|k| at(0.6 + f64::from(k) * 0.1)).collect();
+        placed.push(at(0.6 + 1.1 + 0.05));
+        assert_eq!(roll_runs(&placed), vec![(0, 11)]);
+        let (beats, rolls) = beats(&placed, &Kit::standard(), 960);
+        assert_eq!((beats.len(), rolls), (2, 1));
+        assert!(beats[1].roll.is_none());
+        placed.pop();
+        placed[0] = at(0.6 + 0.1 / 3.0);
+        let (tick, roll) = roll_of(&placed, 960);
+        assert_eq!((tick, roll.strokes_per_quarter), (960, 6));
+        assert_eq!(roll.length_ticks, 12 * 160);
     }
 }

@@ -18,10 +18,13 @@ const FLUX_BAND_HZ: (f64, f64) = (30.0, 12_000.0);
 const LOG_GAMMA: f64 = 1000.0;
 /// The reference frame lies this many frames back (SuperFlux's μ).
 const LAG_FRAMES: usize = 2;
-/// Peak picking: the maximum over −30…+30 ms, the mean over −100…+70 ms.
+/// Peak picking: the maximum over −30…+30 ms, the mean over −60…+70 ms (over −100 ms,
+/// Böck's, the mean held a roll's first stroke — struck from silence, its flux 5–7 times
+/// a later stroke's — when the second came 67–83 ms after it, and the second was lost;
+/// a hall's echo 45 ms after a stroke still has the stroke in its mean).
 const PRE_MAX_S: f64 = 0.03;
 const POST_MAX_S: f64 = 0.03;
-const PRE_AVG_S: f64 = 0.1;
+const PRE_AVG_S: f64 = 0.06;
 const POST_AVG_S: f64 = 0.07;
 /// Two onsets are at least this far apart, s.
 pub const MIN_GAP_S: f64 = 0.03;
