@@ -145,11 +145,14 @@ fn check(
 /// half, heard by its (2,1) — an even roll of eighths of a quarter at 96 bpm meets the
 /// (1,1) in opposite phase stroke after stroke — was written on the D3 drum: 287 of 315).
 /// Damaged: 85 % of the strokes found, F ≥ 0.6 on every score, the right drum for 88 %
-/// (measured 2026-12-06: 300 of 319 found, F 0.840 on the roll exercise, and 274 of 300
-/// on the right drum; 295, 0.789 and 270 before the onsets' local mean looked back 60 ms
-/// instead of 100). Heard in a concert hall (`sound::room`, one microphone: recordings
-/// are made in rooms): 93 % found, F ≥ 0.75, the right drum for 78 % (measured: 311 of
-/// 319 found, F 0.962 on the roll exercise, 270 of 311 on the right drum — the hall
+/// (measured 2026-12-06: 314 of 319 found, F 0.970 on the roll exercise, and 307 of 314
+/// on the right drum; 300, 0.840 and 274 before the flux summed a logarithmic filterbank,
+/// whose top octaves no longer let the hiss drown soft strokes; 295, 0.789 and 270 before
+/// the onsets' local mean looked back 60 ms instead of 100). Heard in a concert hall
+/// (`sound::room`, one microphone: recordings are made in rooms): 93 % found, F ≥ 0.75,
+/// the right drum for 78 % (measured: 313 of 319 found, F 0.977 on the roll exercise and
+/// 0.952 on the secco study, 272 of 313 on the right drum; 311, 0.962 and 270 before the
+/// filterbank — the hall
 /// carries the strokes before into each stroke's pitch, and its two rolls are written on
 /// the wrong drums, E♭3 and E3 for D3 and A2. Before a roll started on the step of the
 /// even line through its strokes rather than at its first onset, which the hall put a
@@ -379,8 +382,10 @@ fn recorded_roll(
 /// recorded and upsampled to 44.1 and 48 kHz: nearly every stroke is heard within 15 ms,
 /// nearly every roll is written as one roll of at least 12 strokes (a stray stroke
 /// beside it allowed), and most at the note's pitch (C2, which no drum of the standard
-/// kit reaches, an octave up). Measured 2026-12-06 (32 / 44.1 / 48 kHz): 564 / 560 / 569
-/// of 576 strokes heard, 34 / 35 / 35 rolls, 30 / 30 / 31 at the pitch. Before the local
+/// kit reaches, an octave up). Measured 2026-12-06 (32 / 44.1 / 48 kHz): 563 / 558 / 565
+/// of 576 strokes heard, 33 / 34 / 34 rolls, 30 / 29 / 29 at the pitch (564 / 560 / 569,
+/// 34 / 35 / 35 and 30 / 30 / 31 before the flux summed a logarithmic filterbank rather
+/// than every bin, which hears soft strokes under hiss far better). Before the local
 /// mean of the onset strength looked back 100 ms (it held a roll's first stroke, struck
 /// from silence and many times stronger, when the second came 67–83 ms later) and a
 /// roll could leave out a stray onset at its ends: 559 / 550 / 562, 33 / 30 / 30,
