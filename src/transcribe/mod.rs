@@ -185,20 +185,23 @@ pub fn transcribe(
             }
         })
         .collect();
-    // A run that is one roll by its timing (written on one drum) takes the pitch heard
-    // over the whole run: each stroke alone is heard through a window of 60–120 ms,
-    // whose 8–16 Hz resolution misplaces a low drum's (1,1) by a semitone or more (a
-    // recorded D2 roll's first stroke reads C♯2) or hears a partial as the (1,1).
+    // A stroke of a fast run heard by one of the run's upper partials is put back on the
+    // run's drum; a roll (the strokes notation writes as one, by their timing) takes the
+    // pitch heard over the whole roll: each stroke alone is heard through a window of
+    // 60–120 ms, whose 8–16 Hz resolution misplaces a low drum's (1,1) by a semitone or
+    // more (a recorded D2 roll's first stroke reads C♯2) or hears a partial as the (1,1).
     for run in fast_runs(&times) {
         let span = (times[run.start], times[run.end - 1]);
         if let Some(run_hz) = notes::hear_run(samples, rate_hz, span, band) {
-            let roll = notate::roll_core(&times[run.clone()]).map(|(a, b)| a..=b);
-            for (k, stroke) in strokes[run].iter_mut().enumerate() {
-                stroke.principal_hz = if roll.as_ref().is_some_and(|r| r.contains(&k)) {
-                    Some(run_hz)
-                } else {
-                    notes::onto_run(stroke.principal_hz, run_hz)
-                };
+            for stroke in &mut strokes[run] {
+                stroke.principal_hz = notes::onto_run(stroke.principal_hz, run_hz);
+            }
+        }
+    }
+    for (a, b) in notate::roll_spans(&times, &|_| false) {
+        if let Some(roll_hz) = notes::hear_run(samples, rate_hz, (times[a], times[b]), band) {
+            for stroke in &mut strokes[a..=b] {
+                stroke.principal_hz = Some(roll_hz);
             }
         }
     }

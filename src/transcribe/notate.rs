@@ -198,27 +198,31 @@ pub fn place(
     (placed, notes)
 }
 
-/// Runs of strokes to write as rolls: (first, last) index, inclusive. Judged by timing
-/// alone — inside a roll each stroke adds little to a head already ringing, so its own
-/// pitch is unreliable — a roll is written on its first stroke's drum. Two runs one
+/// Runs of strokes to write as rolls: (first, last) index, inclusive ([`roll_spans`] of
+/// their times, a chord ending a run).
+pub fn roll_runs(placed: &[Placed]) -> Vec<(usize, usize)> {
+    let times: Vec<f64> = placed.iter().map(|p| p.time_s).collect();
+    roll_spans(&times, &|k| placed[k].drums.len() > 1)
+}
+
+/// Which strokes at `times` (s, sorted) are rolls: (first, last) index, inclusive, a
+/// stroke for which `chord` holds ending a run. Judged by timing alone — inside a roll
+/// each stroke adds little to a head already ringing, so its own pitch is unreliable —
+/// a roll is written on one drum, at the pitch heard over the whole roll. Two runs one
 /// missed stroke apart (at the pace of both) are one roll: a roll's soft strokes can
 /// fall under the onset detector, and each half would otherwise be written on the drum
 /// its own first stroke was heard on.
-pub fn roll_runs(placed: &[Placed]) -> Vec<(usize, usize)> {
+pub fn roll_spans(times: &[f64], chord: &dyn Fn(usize) -> bool) -> Vec<(usize, usize)> {
     let mut runs: Vec<(usize, usize)> = Vec::new();
     let mut i = 0;
-    while i < placed.len() {
+    while i < times.len() {
         let mut j = i;
-        while j + 1 < placed.len()
-            && placed[j].drums.len() == 1
-            && placed[j + 1].time_s - placed[j].time_s <= ROLL_MAX_GAP_S
-        {
+        while j + 1 < times.len() && !chord(j) && times[j + 1] - times[j] <= ROLL_MAX_GAP_S {
             j += 1;
         }
-        let times: Vec<f64> = placed[i..=j].iter().map(|p| p.time_s).collect();
-        if let Some((a, b)) = roll_core(&times).map(|(a, b)| (i + a, i + b)) {
+        if let Some((a, b)) = roll_core(&times[i..=j]).map(|(a, b)| (i + a, i + b)) {
             match runs.last_mut() {
-                Some(last) if last.1 + 1 == a && one_stroke_missed(placed, *last, (a, b)) => {
+                Some(last) if last.1 + 1 == a && one_stroke_missed(times, *last, (a, b)) => {
                     last.1 = b;
                 }
                 _ => runs.push((a, b)),
@@ -234,7 +238,7 @@ pub fn roll_runs(placed: &[Placed]) -> Vec<(usize, usize)> {
 /// onset just before or after a roll — a loud note's beating, a stroke of the next beat
 /// — made the whole run uneven, and each stroke of the roll was written on its own):
 /// (first, last) index, inclusive; `None` when no such part is one.
-pub fn roll_core(times: &[f64]) -> Option<(usize, usize)> {
+fn roll_core(times: &[f64]) -> Option<(usize, usize)> {
     let n = times.len();
     (0..=2 * ROLL_TRIM)
         .flat_map(|dropped| (0..=dropped).map(move |front| (front, dropped - front)))
@@ -243,17 +247,17 @@ pub fn roll_core(times: &[f64]) -> Option<(usize, usize)> {
         .find(|&(a, b)| is_roll(&times[a..=b]))
 }
 
-/// Mean gap between the strokes of a run of at least two, s.
-fn mean_gap(run: &[Placed]) -> f64 {
-    (run[run.len() - 1].time_s - run[0].time_s) / (run.len() - 1) as f64
+/// Mean gap between the strokes at `times` (at least two), s.
+fn mean_gap(times: &[f64]) -> f64 {
+    (times[times.len() - 1] - times[0]) / (times.len() - 1) as f64
 }
 
-/// Whether the runs `a` and `b` (next to each other) keep one pace, within
+/// Whether the runs `a` and `b` of `times` (next to each other) keep one pace, within
 /// [`ROLL_EVENNESS`] of a gap, with one stroke missing between them.
-fn one_stroke_missed(placed: &[Placed], a: (usize, usize), b: (usize, usize)) -> bool {
-    let (ga, gb) = (mean_gap(&placed[a.0..=a.1]), mean_gap(&placed[b.0..=b.1]));
+fn one_stroke_missed(times: &[f64], a: (usize, usize), b: (usize, usize)) -> bool {
+    let (ga, gb) = (mean_gap(&times[a.0..=a.1]), mean_gap(&times[b.0..=b.1]));
     let gap = 0.5 * (ga + gb);
-    let between = placed[b.0].time_s - placed[a.1].time_s;
+    let between = times[b.0] - times[a.1];
     (ga - gb).abs() <= ROLL_EVENNESS * gap && (between - 2.0 * gap).abs() <= ROLL_EVENNESS * gap
 }
 
@@ -286,7 +290,7 @@ fn even_line(values: &[f64]) -> (f64, f64) {
 /// Whether strokes at `times` (s, sorted) are one roll by their timing, as [`roll_runs`]
 /// judges it: at least [`ROLL_MIN_STROKES`], each at most [`ROLL_MAX_GAP_S`] after the
 /// previous, on an even grid.
-pub fn is_roll(times: &[f64]) -> bool {
+fn is_roll(times: &[f64]) -> bool {
     times.len() >= ROLL_MIN_STROKES
         && times.windows(2).all(|w| w[1] - w[0] <= ROLL_MAX_GAP_S)
         && even(times)
