@@ -152,16 +152,18 @@ fn check(
 /// half, heard by its (2,1) — an even roll of eighths of a quarter at 96 bpm meets the
 /// (1,1) in opposite phase stroke after stroke — was written on the D3 drum: 287 of 315).
 /// Damaged: 85 % of the strokes found, F ≥ 0.6 on every score, the right drum for 88 %
-/// (measured 2026-12-06: 314 of 319 found, F 0.970 on the roll exercise, and 307 of 314
-/// on the right drum; 300, 0.840 and 274 before the flux summed a logarithmic filterbank,
+/// (measured 2026-12-06: 315 of 319 found, F 0.977 on the roll exercise, and 308 of 315
+/// on the right drum; 314, 0.970 and 307 before a roll took in the uneven strokes at its
+/// start; 300, 0.840 and 274 before the flux summed a logarithmic filterbank,
 /// whose top octaves no longer let the hiss drown soft strokes; 295, 0.789 and 270 before
 /// the onsets' local mean looked back 60 ms instead of 100). Heard in a concert hall
 /// (`sound::room`, one microphone: recordings are made in rooms): 93 % found, F ≥ 0.75,
-/// the right drum for 78 % (measured: 313 of 319 found, F 0.977 on the roll exercise and
-/// 0.952 on the secco study, 272 of 313 on the right drum; 311, 0.962 and 270 before the
-/// filterbank — the hall
-/// carries the strokes before into each stroke's pitch, and its two rolls are written on
-/// the wrong drums, E♭3 and E3 for D3 and A2. Before a roll started on the step of the
+/// the right drum for 78 % (measured: 315 of 319 found, F 0.993 on the roll exercise and
+/// 0.952 on the secco study, 301 of 315 on the right drum — 272 of 313 before a roll's
+/// every stroke took the roll's pitch and a roll took in the uneven strokes at its start,
+/// its two rolls written a semitone and a fifth off; 311, 0.962 and 270 before the
+/// filterbank; the hall carries the strokes before into each stroke's pitch. Before a
+/// roll started on the step of the
 /// even line through its strokes rather than at its first onset, which the hall put a
 /// third of a step late, 298 found and F 0.763 there; before the 60 ms look-back, 306
 /// found, F 0.892, the A2 roll in pieces). A damping is no stroke: the secco

@@ -230,7 +230,34 @@ pub fn roll_spans(times: &[f64], chord: &dyn Fn(usize) -> bool) -> Vec<(usize, u
         }
         i = j + 1;
     }
+    for r in 0..runs.len() {
+        let floor = if r == 0 { 0 } else { runs[r - 1].1 + 1 };
+        runs[r].0 = extended_back(times, runs[r], floor, chord);
+    }
     runs
+}
+
+/// Where the roll `run` of `times` starts once the strokes before it that keep its pace
+/// are taken in (each one or two of its steps before the next, within [`ROLL_EVENNESS`]
+/// of a step: a soft roll's first strokes, heard unevenly in a hall and one of them
+/// missed, were too few to be a roll of their own), not reaching back past `floor` or a
+/// chord.
+fn extended_back(
+    times: &[f64],
+    run: (usize, usize),
+    floor: usize,
+    chord: &dyn Fn(usize) -> bool,
+) -> usize {
+    let (_, step) = even_line(&times[run.0..=run.1]);
+    let mut a = run.0;
+    while a > floor && !chord(a - 1) {
+        let steps = (times[a] - times[a - 1]) / step;
+        if !(0.5..2.5).contains(&steps) || (steps - steps.round()).abs() > ROLL_EVENNESS {
+            break;
+        }
+        a -= 1;
+    }
+    a
 }
 
 /// The longest part of strokes at `times` (s, sorted; a run of close strokes) that is a
@@ -275,16 +302,22 @@ fn even(times: &[f64]) -> bool {
 /// The least-squares line through `values` (at least two) against their index: its
 /// value at index 0 and its step.
 fn even_line(values: &[f64]) -> (f64, f64) {
-    let n = values.len() as f64;
-    let mean_k = (n - 1.0) / 2.0;
-    let mean = values.iter().sum::<f64>() / n;
+    let index: Vec<f64> = (0..values.len()).map(|k| k as f64).collect();
+    line_through(&index, values)
+}
+
+/// The least-squares line through the points (`xs`, `ys`) (at least two distinct `xs`):
+/// its value at x = 0 and its slope.
+fn line_through(xs: &[f64], ys: &[f64]) -> (f64, f64) {
+    let n = xs.len() as f64;
+    let (mean_x, mean_y) = (xs.iter().sum::<f64>() / n, ys.iter().sum::<f64>() / n);
     let (mut num, mut den) = (0.0, 0.0);
-    for (k, v) in values.iter().enumerate() {
-        num += (k as f64 - mean_k) * (v - mean);
-        den += (k as f64 - mean_k).powi(2);
+    for (x, y) in xs.iter().zip(ys) {
+        num += (x - mean_x) * (y - mean_y);
+        den += (x - mean_x).powi(2);
     }
-    let step = num / den;
-    (mean - step * mean_k, step)
+    let slope = num / den;
+    (mean_y - slope * mean_x, slope)
 }
 
 /// Whether strokes at `times` (s, sorted) are one roll by their timing, as [`roll_runs`]
@@ -305,7 +338,17 @@ fn is_roll(times: &[f64]) -> bool {
 /// and every one of its strokes missed the performance by as much).
 pub fn roll_of(run: &[Placed], tpq: u32) -> (u64, Roll) {
     let ticks: Vec<f64> = run.iter().map(|p| p.tick as f64).collect();
-    let (first, gap_ticks) = even_line(&ticks);
+    // Each stroke's step on the roll's grid, counting a stroke the onsets missed (a gap
+    // of two steps) as a step of its own.
+    let mut gaps: Vec<f64> = ticks.windows(2).map(|w| w[1] - w[0]).collect();
+    gaps.sort_by(f64::total_cmp);
+    let typical = gaps[gaps.len() / 2].max(1.0);
+    let mut steps = vec![0.0];
+    for w in ticks.windows(2) {
+        let last = steps[steps.len() - 1];
+        steps.push(last + ((w[1] - w[0]) / typical).round().max(1.0));
+    }
+    let (first, gap_ticks) = line_through(&steps, &ticks);
     let per_quarter = (1..=32u32)
         .filter(|d| tpq.is_multiple_of(*d))
         .min_by(|&a, &b| {
@@ -315,7 +358,7 @@ pub fn roll_of(run: &[Placed], tpq: u32) -> (u64, Roll) {
         .unwrap_or(8);
     let step = f64::from(tpq / per_quarter);
     let start = ((first / step).round() * step).max(0.0);
-    let last = first + gap_ticks * (run.len() - 1) as f64;
+    let last = first + gap_ticks * steps[steps.len() - 1];
     let strokes = ((last - start) / step).round().max(0.0) as u64 + 1;
     (
         start as u64,
@@ -382,6 +425,16 @@ mod tests {
         )
     }
 
+    /// A stroke at `t` s on `drum` (drum, pitch), its tick on the map `m` at 960 per quarter.
+    fn stroke_at(m: &TempoMap, t: f64, drum: (usize, Pitch), dynamic: Dynamic) -> Placed {
+        Placed {
+            time_s: t,
+            tick: quantise(m, 960, t, None),
+            drums: vec![drum],
+            dynamic,
+        }
+    }
+
     /// On the beat, an eighth, a triplet and a late stroke land on their grids; a stroke
     /// between grids keeps its exact tick.
     #[test]
@@ -420,15 +473,7 @@ mod tests {
     fn even_fast_runs_are_rolls() {
         let m = map(60.0);
         let placed: Vec<Placed> = (0..10)
-            .map(|k| {
-                let t = 1.0 + f64::from(k) * 0.0625;
-                Placed {
-                    time_s: t,
-                    tick: quantise(&m, 960, t, None),
-                    drums: vec![(1, Pitch(45))],
-                    dynamic: Dynamic::P,
-                }
-            })
+            .map(|k| stroke_at(&m, 1.0 + f64::from(k) * 0.0625, (1, Pitch(45)), Dynamic::P))
             .collect();
         assert_eq!(roll_runs(&placed), vec![(0, 9)]);
         let (tick, roll) = roll_of(&placed, 960);
@@ -492,12 +537,7 @@ mod tests {
     #[test]
     fn a_roll_leaves_out_a_stray_onset_and_starts_on_its_line() {
         let m = map(100.0);
-        let at = |t: f64| Placed {
-            time_s: t,
-            tick: quantise(&m, 960, t, None),
-            drums: vec![(1, Pitch(45))],
-            dynamic: Dynamic::P,
-        };
+        let at = |t: f64| stroke_at(&m, t, (1, Pitch(45)), Dynamic::P);
         let mut placed: Vec<Placed> = (0..12).map(|k| at(0.6 + f64::from(k) * 0.1)).collect();
         placed.push(at(0.6 + 1.1 + 0.05));
         assert_eq!(roll_runs(&placed), vec![(0, 11)]);
@@ -509,5 +549,28 @@ mod tests {
         let (tick, roll) = roll_of(&placed, 960);
         assert_eq!((tick, roll.strokes_per_quarter), (960, 6));
         assert_eq!(roll.length_ticks, 12 * 160);
+    }
+
+    /// A soft roll heard unevenly: three strokes, one missed, then eleven (eighths of a
+    /// quarter at 96 bpm). The three are too few to be a roll of their own, but they keep
+    /// its pace: one roll from the first stroke, on its grid, 15 steps long.
+    #[test]
+    fn a_roll_takes_in_the_strokes_before_it_that_keep_its_pace() {
+        let m = map(96.0);
+        let placed: Vec<Placed> = (0..15)
+            .filter(|&k| k != 3)
+            .map(|k| {
+                stroke_at(
+                    &m,
+                    1.25 + f64::from(k) * 0.078125,
+                    (0, Pitch(45)),
+                    Dynamic::Pp,
+                )
+            })
+            .collect();
+        assert_eq!(roll_runs(&placed), vec![(0, 13)]);
+        let (tick, roll) = roll_of(&placed, 960);
+        assert_eq!((tick, roll.strokes_per_quarter), (1920, 8));
+        assert_eq!(roll.length_ticks, 15 * 120);
     }
 }
