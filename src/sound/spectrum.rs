@@ -78,10 +78,11 @@ pub fn spectrum(samples: &[f32], rate_hz: u32) -> Vec<(f64, f64)> {
 /// The largest peak within [lo, hi] Hz, refined by parabolic interpolation of the log
 /// magnitude: (frequency Hz, amplitude). None if the band holds no bin.
 pub fn peak_in(spec: &[(f64, f64)], lo: f64, hi: f64) -> Option<(f64, f64)> {
-    let (k, &(_, a)) = spec
+    let within = bins_within(spec, lo, hi);
+    let (k, &(_, a)) = spec[within.clone()]
         .iter()
         .enumerate()
-        .filter(|(_, (f, _))| (lo..=hi).contains(f))
+        .map(|(i, p)| (within.start + i, p))
         .max_by(|x, y| x.1.1.total_cmp(&y.1.1))?;
     if k == 0 || k + 1 >= spec.len() || a <= 0.0 {
         return Some(spec[k]);
@@ -101,11 +102,20 @@ pub fn peak_in(spec: &[(f64, f64)], lo: f64, hi: f64) -> Option<(f64, f64)> {
     Some((spec[k].0 + shift * bin, (c - 0.25 * (l - r) * shift).exp()))
 }
 
+/// The bins of `spec` (rising in frequency) within [lo, hi] Hz, found by bisection: the
+/// transcriber asks for a few bins around each of thousands of partials per stroke, and
+/// scanning the whole spectrum for each took most of its time.
+pub fn bins_within(spec: &[(f64, f64)], lo: f64, hi: f64) -> std::ops::Range<usize> {
+    let start = spec.partition_point(|(f, _)| *f < lo);
+    let end = spec.partition_point(|(f, _)| *f <= hi);
+    start..end.max(start)
+}
+
 /// Local maxima above `floor` × the largest amplitude in [lo, hi] Hz, rising in frequency.
 pub fn peaks(spec: &[(f64, f64)], lo: f64, hi: f64, floor: f64) -> Vec<(f64, f64)> {
-    let band: Vec<usize> = (1..spec.len().saturating_sub(1))
-        .filter(|&k| (lo..=hi).contains(&spec[k].0))
-        .collect();
+    let within = bins_within(spec, lo, hi);
+    let band: Vec<usize> =
+        (within.start.max(1)..within.end.min(spec.len().saturating_sub(1))).collect();
     let top = band.iter().map(|&k| spec[k].1).fold(0.0, f64::max);
     band.into_iter()
         .filter(|&k| {
@@ -188,5 +198,22 @@ mod tests {
         let spec = spectrum(&s, rate);
         let f = principal_hz(&spec, 40.0, 400.0, &[1.0, 1.5, 1.98, 2.44, 2.94]).unwrap();
         assert!((f / 100.0 - 1.0).abs() < 1e-3, "{f}");
+    }
+
+    /// The bins within a band, by bisection: the same bins a scan keeps, edges included.
+    #[test]
+    fn bins_within_a_band() {
+        let spec: Vec<(f64, f64)> = (0..100).map(|k| (k as f64 * 2.5, 1.0)).collect();
+        assert_eq!(bins_within(&spec, 10.0, 20.0), 4..9);
+        assert_eq!(bins_within(&spec, 10.1, 19.9), 5..8);
+        assert_eq!(bins_within(&spec, 300.0, 400.0), 100..100);
+        assert_eq!(bins_within(&spec, 20.0, 10.0).len(), 0);
+        assert_eq!(bins_within(&[], 1.0, 2.0).len(), 0);
+        for (lo, hi) in [(0.0, 7.5), (33.3, 97.1), (-5.0, 1000.0)] {
+            let scanned: Vec<usize> = (0..spec.len())
+                .filter(|&k| (lo..=hi).contains(&spec[k].0))
+                .collect();
+            assert_eq!(bins_within(&spec, lo, hi).collect::<Vec<_>>(), scanned);
+        }
     }
 }

@@ -6,7 +6,7 @@
 //! stronger.
 
 use crate::sound::analysis::KETTLEDRUM_RATIOS;
-use crate::sound::spectrum::{peak_in, peaks, spectrum};
+use crate::sound::spectrum::{bins_within, peak_in, peaks, spectrum};
 
 /// The spectrum windows start this long after the onset (past the click), s.
 const AFTER_ONSET_S: f64 = 0.005;
@@ -131,7 +131,13 @@ fn principal_with(
 ) -> Option<f64> {
     let top = KETTLEDRUM_RATIOS[KETTLEDRUM_RATIOS.len() - 1];
     let near = |spec: &[(f64, f64)], f: f64| {
-        spec.iter()
+        let margin = 1.0 + 1e-9;
+        let (lo, hi) = (
+            f * (1.0 - PARTIAL_TOLERANCE) / margin,
+            f * (1.0 + PARTIAL_TOLERANCE) * margin,
+        );
+        spec[bins_within(spec, lo, hi)]
+            .iter()
             .filter(|(g, _)| (g / f - 1.0).abs() <= PARTIAL_TOLERANCE)
             .map(|p| p.1)
             .fold(0.0, f64::max)
