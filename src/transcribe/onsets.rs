@@ -1,7 +1,8 @@
 //! Where strokes begin in a recording. A log-magnitude spectral flux over a logarithmic
 //! filterbank against a maximum-filtered, lagged reference frame (SuperFlux, Böck &
-//! Widmer 2013) gives an onset strength every 5 ms; adaptive peak picking (Böck, Krebs & Schedl 2012: a local maximum
-//! above the local mean plus a threshold, at least 30 ms apart) finds the strokes; each is
+//! Widmer 2013) gives an onset strength every 5 ms; adaptive peak picking (Böck, Krebs &
+//! Schedl 2012: a local maximum above the local mean plus a threshold, at least 30 ms
+//! apart) finds the strokes; each is
 //! then placed to the half millisecond on the steepest rise of the high-passed signal's
 //! energy, where the stick's click starts.
 
@@ -165,7 +166,7 @@ pub fn strength(samples: &[f32], rate_hz: u32) -> Strength {
 /// filterbank. Summed bin by bin, the octaves above 3 kHz held three quarters of the
 /// flux's terms, and a recording's hiss fluctuated in each of them: soft roll strokes
 /// under white noise 50 dB below the peak were lost (the demos' roll exercise, damaged:
-/// 50 of 68 found; 64 with the bands).
+/// 50 of 68 found; 64 with the bands, 65 once a roll also took in its uneven start).
 fn log_bands(lo: usize, hi: usize, bin_hz: f64) -> Vec<std::ops::Range<usize>> {
     let mut bands = Vec::new();
     let mut start = lo;
