@@ -191,11 +191,20 @@ fn targets() -> Vec<Target> {
         true,
         Box::new(move |b| CaptureProfile::parse(&String::from_utf8_lossy(b), path).is_ok()),
     );
+    // Recordings: a small WAV, and the D2 note as FLAC, AIFF, MP3 and Ogg Vorbis
+    // (tests/fixtures/recordings; all but the Ogg, which is read whole or not at all, cut
+    // to their first packets so mutations reach the decoders, not only the headers).
     add(
-        "wav",
-        vec![small_wav()],
+        "recording",
+        vec![
+            small_wav(),
+            recording_head("d2-note.flac", 16_000),
+            recording_head("d2-note.aiff", 4000),
+            recording_head("d2-note.mp3", 1500),
+            recording_head("d2-note.ogg", usize::MAX),
+        ],
         false,
-        Box::new(move |b| timpanist::sound::analysis::read_mono_bytes(path, b).is_ok()),
+        Box::new(move |b| timpanist::sound::recording::read_mono_bytes(path, b).is_ok()),
     );
     // A motion-database take, its zlib stream unpacked: inputs are the 24-byte header
     // and the raw varint channels, packed again before decoding, so the mutations reach
@@ -260,6 +269,13 @@ fn named_timpani(text: &str) -> String {
         );
     }
     text.to_string()
+}
+
+/// The first `bytes` of a recording fixture (readable: its decoders stop at the cut).
+fn recording_head(name: &str, bytes: usize) -> Vec<u8> {
+    let mut b = read(&format!("tests/fixtures/recordings/{name}"));
+    b.truncate(bytes);
+    b
 }
 
 /// A 20 ms stereo 16-bit WAV of a decaying 147 Hz tone.

@@ -258,7 +258,7 @@ fn recorded_phrase(semitones: i32, ringing: bool) -> (Vec<f32>, u32, Vec<(f64, f
     let mut next_at = 0.0;
     for name in ["1L", "2R", "3L", "1R", "3R", "2L"] {
         let (original, r) =
-            timpanist::sound::analysis::read_mono(&dir.join(format!("Timpani_{name}.wav")))
+            timpanist::sound::recording::read_mono(&dir.join(format!("Timpani_{name}.wav")))
                 .unwrap();
         rate = r;
         let s: Vec<f32> = (0..((original.len() - 1) as f64 / speed) as usize)
@@ -358,7 +358,7 @@ fn recorded_roll(
     seed: u64,
 ) -> (Vec<f32>, Vec<f64>, Pitch) {
     let path = root().join(format!("kits/samples/Timpani_{name}.wav"));
-    let (note, r) = timpanist::sound::analysis::read_mono(&path).unwrap();
+    let (note, r) = timpanist::sound::recording::read_mono(&path).unwrap();
     let note = if r == rate_hz {
         note
     } else {

@@ -52,7 +52,13 @@ impl EditorApp {
                         "Import MusicXML...",
                         ("MusicXML", &["musicxml", "xml", "mxl"]),
                     ),
-                    ("Import audio (transcribe)...", ("WAV", &["wav", "wave"])),
+                    (
+                        "Import audio (transcribe)...",
+                        (
+                            "recording (WAV, AIFF, FLAC, MP3, Ogg)",
+                            &crate::sound::recording::EXTENSIONS,
+                        ),
+                    ),
                 ];
                 for (label, filter) in imports {
                     if ui.button(label).clicked() {

@@ -405,12 +405,10 @@ impl EditorApp {
             },
             AfterConfirm::OpenDialog => self.ask_and_act(Request {
                 purpose: Purpose::Open,
-                title: "Open a score, MIDI, MusicXML or WAV file",
+                title: "Open a score, MIDI, MusicXML or recording",
                 filter: (
-                    "score, MIDI, MusicXML or WAV",
-                    &[
-                        "ron", "mid", "midi", "musicxml", "xml", "mxl", "wav", "wave",
-                    ],
+                    "score, MIDI, MusicXML or recording",
+                    &crate::io::open::OPENABLE_EXTENSIONS,
                 ),
                 save: false,
                 file_name: None,

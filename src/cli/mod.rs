@@ -92,10 +92,11 @@ pub enum Command {
         #[arg(long)]
         title: Option<String>,
     },
-    /// Transcribe a timpani recording (WAV) into a score: strokes, drums and pitches,
+    /// Transcribe a timpani recording (WAV, AIFF, FLAC, MP3, Ogg Vorbis) into a score: strokes, drums and pitches,
     /// dynamics, a tempo map and rolls.
     Transcribe {
-        /// The recording (.wav: PCM 8-32 bit or float, any rate, channels mixed to mono).
+        /// The recording (.wav in any encoding, .aiff, .flac, .mp3 or .ogg; any rate;
+        /// channels mixed to mono).
         input: PathBuf,
         /// The score to write (.ron).
         #[arg(short, long)]
@@ -261,7 +262,8 @@ pub enum SoundCommand {
     /// Measure struck notes (WAV): onset, (1,1) pitch, octave-band shares 63 Hz-4 kHz and
     /// spectral centroid over the first second, the (1,1)'s T60 and pitch glide.
     Analyse {
-        /// WAV files, one note each (the first onset is measured).
+        /// Recordings (WAV, AIFF, FLAC, MP3 or Ogg Vorbis), one note each (the first
+        /// onset is measured).
         #[arg(required = true)]
         files: Vec<PathBuf>,
         /// Measure the note starting near these times instead (s, comma-separated; e.g.
@@ -295,7 +297,7 @@ pub enum SoundCommand {
     /// Fit the modal sound to recorded notes: band radiation corrections and decays,
     /// the listed partials' decays (README "Sound calibration").
     Fit {
-        /// Recorded notes (WAV), one struck timpani note each [default: the embedded
+        /// Recorded notes (WAV, AIFF, FLAC, MP3 or Ogg Vorbis), one struck timpani note each [default: the embedded
         /// FluidR3 timpani notes].
         files: Vec<PathBuf>,
         /// The calibration file to write.

@@ -57,7 +57,7 @@ pub fn fit(files: &[PathBuf], output: &Path) -> anyhow::Result<()> {
         files
             .iter()
             .map(|path| {
-                let (samples, rate_hz) = analysis::read_mono(path)?;
+                let (samples, rate_hz) = crate::sound::recording::read_mono(path)?;
                 if let Some(why) = analysis::not_a_note(&samples, rate_hz) {
                     anyhow::bail!("{}: {why}", path.display());
                 }
@@ -106,7 +106,7 @@ pub fn fit(files: &[PathBuf], output: &Path) -> anyhow::Result<()> {
 pub fn analyse(files: &[PathBuf], at: &[f64], plot: Option<&Path>) -> anyhow::Result<()> {
     let mut panels = Vec::new();
     for path in files {
-        let (all, rate) = analysis::read_mono(path)?;
+        let (all, rate) = crate::sound::recording::read_mono(path)?;
         let duration = all.len() as f64 / f64::from(rate);
         let starts: Vec<Option<f64>> = if at.is_empty() {
             vec![None]

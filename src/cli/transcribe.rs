@@ -1,4 +1,4 @@
-//! `timpanist transcribe`: a timpani recording (WAV) as a score ([`crate::transcribe`]).
+//! `timpanist transcribe`: a timpani recording (WAV, AIFF, FLAC, MP3, Ogg Vorbis) as a score ([`crate::transcribe`]).
 
 use super::midi::{Imported, import_kit, save_imported};
 use crate::transcribe::{self, Levels, Options};

@@ -1,6 +1,6 @@
 //! Opening any file that holds a score, the way users open files: a score (`.ron`) is
 //! loaded, a MIDI file (`.mid`), a MusicXML file (`.musicxml`, `.xml`, `.mxl`) or a
-//! recording (`.wav`, transcribed) is imported onto the bundled standard kit as a new,
+//! recording (`.wav`, `.aiff`, `.flac`, `.mp3`, `.ogg`: transcribed) is imported onto the bundled standard kit as a new,
 //! unsaved score. Used by the editor's
 //! Open, drag and drop, and by `timpanist FILE`; headless, so it is testable without a
 //! window.
@@ -10,6 +10,7 @@ use super::musicxml::{self, MusicXmlError};
 use crate::base::ron_file::FileError;
 use crate::kit::Kit;
 use crate::score::LoadedScore;
+use crate::sound::recording;
 use crate::transcribe::{self, TranscribeError};
 use std::path::{Path, PathBuf};
 
@@ -35,10 +36,16 @@ pub fn kind_of(path: &Path) -> FileKind {
         Some("ron") => FileKind::Score,
         Some("mid" | "midi" | "smf") => FileKind::Midi,
         Some("musicxml" | "xml" | "mxl") => FileKind::MusicXml,
-        Some("wav" | "wave") => FileKind::Audio,
+        Some(ext) if recording::EXTENSIONS.contains(&ext) => FileKind::Audio,
         _ => FileKind::Other,
     }
 }
+
+/// Every extension the editor opens: scores, MIDI, MusicXML and recordings.
+pub const OPENABLE_EXTENSIONS: [&str; 15] = [
+    "ron", "mid", "midi", "musicxml", "xml", "mxl", "wav", "wave", "aif", "aiff", "aifc", "flac",
+    "mp3", "ogg", "oga",
+];
 
 /// What `timpanist FILE` does with a file.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -50,7 +57,7 @@ pub enum OpenAction {
 }
 
 /// The action for a file given on the command line: refused, naming the file, when it
-/// does not exist or is not a score, MIDI, MusicXML or WAV file.
+/// does not exist or is not a score, MIDI, MusicXML or recording file.
 pub fn action_for(path: &Path) -> Result<OpenAction, OpenError> {
     let kind = kind_of(path);
     if kind == FileKind::Other {
@@ -91,7 +98,7 @@ pub enum OpenError {
     #[error(transparent)]
     Audio(#[from] TranscribeError),
     #[error(
-        "{}: not a score (.ron), MIDI (.mid), MusicXML (.musicxml, .xml, .mxl) or WAV (.wav) file",
+        "{}: not a score (.ron), MIDI (.mid), MusicXML (.musicxml, .xml, .mxl) or recording (.wav, .aiff, .flac, .mp3, .ogg) file",
         .0.display()
     )]
     NotAScore(PathBuf),
@@ -101,7 +108,7 @@ pub enum OpenError {
     NoKit,
 }
 
-/// Read a score file or import a MIDI, MusicXML or WAV file, by extension.
+/// Read a score file or import a MIDI, MusicXML or recording file, by extension.
 pub fn read(path: &Path) -> Result<Opened, OpenError> {
     match kind_of(path) {
         FileKind::Score => {
@@ -198,6 +205,13 @@ mod tests {
         assert_eq!(kind_of(Path::new("x.MXL")), FileKind::MusicXml);
         assert_eq!(kind_of(Path::new("x.musicxml")), FileKind::MusicXml);
         assert_eq!(kind_of(Path::new("x.WAV")), FileKind::Audio);
+        assert_eq!(kind_of(Path::new("take.flac")), FileKind::Audio);
+        assert_eq!(kind_of(Path::new("take.Mp3")), FileKind::Audio);
+        assert_eq!(kind_of(Path::new("take.m4a")), FileKind::Other);
+        for ext in OPENABLE_EXTENSIONS {
+            let kind = kind_of(Path::new(&format!("x.{ext}")));
+            assert_ne!(kind, FileKind::Other, "{ext}");
+        }
         assert_eq!(kind_of(Path::new("x.txt")), FileKind::Other);
         assert_eq!(kind_of(Path::new("noext")), FileKind::Other);
     }

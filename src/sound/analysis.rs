@@ -7,7 +7,6 @@
 //! measures recordings and our own renders.
 
 use super::spectrum::{fft, hann, peak_in, principal_hz, spectrum};
-use std::path::Path;
 
 /// Nominal octave-band centres, Hz (band edges at centre/√2 and centre·√2).
 pub const OCTAVE_CENTRES_HZ: [f64; 7] = [63.0, 125.0, 250.0, 500.0, 1000.0, 2000.0, 4000.0];
@@ -28,9 +27,6 @@ pub const MIN_NOTE_S: f64 = 0.2;
 /// Shorter than this after the onset, a note is measured over what there is, with a
 /// warning, s.
 pub const SHORT_NOTE_S: f64 = 0.5;
-/// A stereo (or wider) file whose channels summed keep less than this share of their mean
-/// energy is read from its loudest channel instead: spaced microphones out of phase cancel.
-const MIN_MIX_SHARE: f64 = 0.5;
 
 /// Kettledrum ratios (1,1)…(5,1) used to recognise the (1,1) (guide §5, Fletcher & Rossing).
 pub const KETTLEDRUM_RATIOS: [f64; 5] = [1.0, 1.5, 1.98, 2.44, 2.94];
@@ -377,98 +373,6 @@ pub fn recorded_reference(tuning_hz: f64, window_s: f64) -> Option<(String, Vec<
     ))
 }
 
-/// Why a WAV could not be read for analysis.
-#[derive(Debug, thiserror::Error)]
-#[error("{}: {message}", path.display())]
-pub struct ReadError {
-    pub path: std::path::PathBuf,
-    pub message: String,
-}
-
-/// A WAV file's channels averaged to mono (PCM 8–32 bit or float; see [`downmix`]), with
-/// its rate.
-pub fn read_mono(path: &Path) -> Result<(Vec<f32>, u32), ReadError> {
-    let bytes = crate::base::limits::read_at_most(
-        path,
-        crate::base::limits::MAX_CAPTURE_FILE_BYTES,
-        "WAV file",
-    )
-    .map_err(|e| ReadError {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    })?;
-    read_mono_bytes(path, &bytes)
-}
-
-/// [`read_mono`] of a WAV file held in memory (`path` names it in errors).
-pub fn read_mono_bytes(path: &Path, bytes: &[u8]) -> Result<(Vec<f32>, u32), ReadError> {
-    let bad = |message: String| ReadError {
-        path: path.to_path_buf(),
-        message,
-    };
-    if bytes.starts_with(b"RF64") || bytes.starts_with(b"BW64") {
-        return Err(bad(
-            "an RF64/BW64 WAV (the format for files over 4 GB) is not read: save the note \
-             as a plain WAV"
-                .into(),
-        ));
-    }
-    let unreadable = |e: hound::Error| {
-        let message = e.to_string();
-        bad(if message.contains("enough bytes") {
-            format!("{message} (the file is empty or cut short)")
-        } else {
-            message
-        })
-    };
-    let mut reader = hound::WavReader::new(std::io::Cursor::new(bytes)).map_err(unreadable)?;
-    let spec = reader.spec();
-    let ch = usize::from(spec.channels.max(1));
-    let raw: Vec<f32> = match spec.sample_format {
-        hound::SampleFormat::Float => reader
-            .samples::<f32>()
-            .collect::<Result<_, _>>()
-            .map_err(unreadable)?,
-        hound::SampleFormat::Int => {
-            let scale = 1.0 / (1u64 << (spec.bits_per_sample.clamp(8, 32) - 1)) as f32;
-            reader
-                .samples::<i32>()
-                .map(|s| s.map(|v| v as f32 * scale))
-                .collect::<Result<_, _>>()
-                .map_err(unreadable)?
-        }
-    };
-    if raw.is_empty() {
-        return Err(bad("the file holds no samples".into()));
-    }
-    Ok((downmix(&raw, ch), spec.sample_rate))
-}
-
-/// Interleaved frames of `ch` channels to mono: their mean, or the loudest channel when the
-/// mean keeps less than [`MIN_MIX_SHARE`] of the channels' mean energy (a spaced pair
-/// whose microphones hear the head out of phase would cancel its low partials).
-fn downmix(raw: &[f32], ch: usize) -> Vec<f32> {
-    let mean: Vec<f32> = raw
-        .chunks_exact(ch)
-        .map(|f| f.iter().sum::<f32>() / ch as f32)
-        .collect();
-    if ch < 2 {
-        return mean;
-    }
-    let energy = |xs: &mut dyn Iterator<Item = f32>| xs.map(|x| f64::from(x).powi(2)).sum::<f64>();
-    let per_channel: Vec<f64> = (0..ch)
-        .map(|c| energy(&mut raw.iter().skip(c).step_by(ch).copied()))
-        .collect();
-    let channels_mean = per_channel.iter().sum::<f64>() / ch as f64;
-    if energy(&mut mean.iter().copied()) >= MIN_MIX_SHARE * channels_mean {
-        return mean;
-    }
-    let loudest = (0..ch)
-        .max_by(|&a, &b| per_channel[a].total_cmp(&per_channel[b]))
-        .unwrap_or(0);
-    raw.iter().skip(loudest).step_by(ch).copied().collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -532,20 +436,5 @@ mod tests {
         let span = ((0.05, 0.9), 0.1);
         assert_eq!(band_t60(&tone, rate, 250.0, span, MIN_DECAY_DB), None);
         assert_eq!(partial_t60(&tone, rate, 200.0, span, MIN_DECAY_DB), None);
-    }
-
-    /// Two channels hearing the head out of phase are read from the louder, not cancelled;
-    /// two in phase are averaged.
-    #[test]
-    fn a_stereo_pair_out_of_phase_is_not_cancelled() {
-        let note: Vec<f32> = (0..4800)
-            .map(|i| (TAU * 100.0 * i as f64 / 48_000.0).sin() as f32)
-            .collect();
-        let interleave =
-            |l: f32, r: f32| -> Vec<f32> { note.iter().flat_map(|&x| [l * x, r * x]).collect() };
-        assert_eq!(downmix(&interleave(1.0, -0.9), 2), note);
-        let mean: Vec<f32> = note.iter().map(|&x| (x + 0.5 * x) / 2.0).collect();
-        assert_eq!(downmix(&interleave(1.0, 0.5), 2), mean);
-        assert_eq!(downmix(&note, 1), note);
     }
 }

@@ -12,6 +12,7 @@ pub mod hands;
 pub mod modal;
 pub mod partials;
 pub mod radiation;
+pub mod recording;
 pub mod room;
 pub mod sample;
 pub mod signal;

@@ -15,9 +15,10 @@ use crate::base::limits::MAX_SCORE_S;
 use crate::base::pitch::Pitch;
 use crate::kit::Kit;
 use crate::score::{Dynamic, MeterChange, Score, TempoMap};
-use crate::sound::analysis::{self, ReadError};
+use crate::sound::analysis;
 use crate::sound::calibration::Calibration;
 use crate::sound::fit;
+use crate::sound::recording::{self, ReadError};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -112,7 +113,7 @@ pub fn transcribe_file(
     kit: &Kit,
     options: &Options,
 ) -> Result<(Score, Report), TranscribeError> {
-    let (samples, rate) = analysis::read_mono(path)?;
+    let (samples, rate) = recording::read_mono(path)?;
     let mut options = options.clone();
     if options.title.is_none() {
         options.title = path

@@ -1,0 +1,201 @@
+//! Reading a recording to mono samples, whatever program wrote it: WAV in any encoding
+//! (8–32-bit integer, 32- and 64-bit float, A-law, μ-law, IMA and Microsoft ADPCM, the
+//! extensible header), AIFF and AIFF-C, FLAC, MP3 and Ogg Vorbis, decoded by Symphonia;
+//! the format is recognised from the bytes (the extension only hints). Several channels
+//! are averaged to one, or the loudest is kept where averaging would cancel (see
+//! [`downmix`]). Used by `sound analyse`, `sound fit` and the transcriber.
+
+use std::io::Cursor;
+use std::path::{Path, PathBuf};
+use symphonia::core::codecs::CodecParameters;
+use symphonia::core::errors::Error as DecodeError;
+use symphonia::core::formats::TrackType;
+use symphonia::core::formats::probe::Hint;
+use symphonia::core::io::{MediaSourceStream, ReadOnlySource};
+
+/// A stereo (or wider) file whose channels summed keep less than this share of their mean
+/// energy is read from its loudest channel instead: spaced microphones out of phase cancel.
+const MIN_MIX_SHARE: f64 = 0.5;
+
+/// The formats read, as a user would name them (for messages).
+pub const FORMATS: &str = "WAV, AIFF, FLAC, MP3 or Ogg Vorbis";
+
+/// The file extensions of the formats read (lower case).
+pub const EXTENSIONS: [&str; 9] = [
+    "wav", "wave", "aif", "aiff", "aifc", "flac", "mp3", "ogg", "oga",
+];
+
+/// Why a recording could not be read.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {message}", path.display())]
+pub struct ReadError {
+    pub path: PathBuf,
+    pub message: String,
+}
+
+/// A recording's channels averaged to mono (samples in −1…1), with its rate, Hz.
+pub fn read_mono(path: &Path) -> Result<(Vec<f32>, u32), ReadError> {
+    let bytes = crate::base::limits::read_at_most(
+        path,
+        crate::base::limits::MAX_CAPTURE_FILE_BYTES,
+        "recording",
+    )
+    .map_err(|e| ReadError {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    read_mono_bytes(path, &bytes)
+}
+
+/// [`read_mono`] of a recording held in memory (`path` names it in errors; its extension,
+/// if any, is a hint to the format, which is recognised from the bytes).
+pub fn read_mono_bytes(path: &Path, bytes: &[u8]) -> Result<(Vec<f32>, u32), ReadError> {
+    let bad = |message: String| ReadError {
+        path: path.to_path_buf(),
+        message,
+    };
+    if bytes.is_empty() {
+        return Err(bad("the file is empty".into()));
+    }
+    if bytes.starts_with(b"RF64") || bytes.starts_with(b"BW64") {
+        return Err(bad(
+            "an RF64/BW64 WAV (the format for files over 4 GB) is not read: save the note \
+             as a plain WAV"
+                .into(),
+        ));
+    }
+    let mut hint = Hint::new();
+    if let Some(ext) = path.extension().and_then(|e| e.to_str()) {
+        hint.with_extension(ext);
+    }
+    // Read as a stream, front to back, never seeking: a file cut short (a recorder stopped
+    // mid-write) then gives what was written instead of failing a length check.
+    let source = ReadOnlySource::new(Cursor::new(bytes));
+    let stream = MediaSourceStream::new(Box::new(source), Default::default());
+    let mut reader = symphonia::default::get_probe()
+        .probe(&hint, stream, Default::default(), Default::default())
+        .map_err(|e| {
+            bad(match e {
+                DecodeError::Unsupported(_) => {
+                    format!("not a recording timpanist can read (it reads {FORMATS})")
+                }
+                DecodeError::IoError(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => {
+                    "the file ends before its first sound (is it cut short?)".into()
+                }
+                e => format!("not a readable {FORMATS} file ({e})"),
+            })
+        })?;
+    let track = reader
+        .default_track(TrackType::Audio)
+        .ok_or_else(|| bad("the file holds no audio track".into()))?;
+    let track_id = track.id;
+    let Some(CodecParameters::Audio(params)) = track.codec_params.clone() else {
+        return Err(bad("the file holds no audio track".into()));
+    };
+    let rate = params
+        .sample_rate
+        .filter(|&r| r > 0)
+        .ok_or_else(|| bad("the file does not say its sample rate".into()))?;
+    let mut decoder = symphonia::default::get_codecs()
+        .make_audio_decoder(&params, &Default::default())
+        .map_err(|e| bad(format!("its audio encoding is not read ({e})")))?;
+    let max_frames = (crate::base::limits::MAX_SCORE_S * f64::from(rate)) as usize;
+    let mut raw: Vec<f32> = Vec::new();
+    let mut packet_samples: Vec<f32> = Vec::new();
+    let mut channels = 0usize;
+    let seconds = |frames: usize| frames as f64 / f64::from(rate);
+    loop {
+        let packet = match reader.next_packet() {
+            Ok(Some(packet)) => packet,
+            Ok(None) => break,
+            // A file cut short (a recorder stopped mid-write): what was written is read.
+            Err(DecodeError::IoError(e))
+                if e.kind() == std::io::ErrorKind::UnexpectedEof && !raw.is_empty() =>
+            {
+                break;
+            }
+            Err(e) => {
+                let at = seconds(raw.len() / channels.max(1));
+                return Err(bad(format!("unreadable at {at:.3} s: {e}")));
+            }
+        };
+        if packet.track_id != track_id {
+            continue;
+        }
+        let decoded = decoder.decode(&packet).map_err(|e| {
+            let at = seconds(raw.len() / channels.max(1));
+            bad(format!("unreadable at {at:.3} s: {e}"))
+        })?;
+        let ch = decoded.spec().channels().count().max(1);
+        if channels != 0 && ch != channels {
+            return Err(bad(format!(
+                "its channel count changes from {channels} to {ch} at {:.3} s",
+                seconds(raw.len() / channels)
+            )));
+        }
+        channels = ch;
+        decoded.copy_to_vec_interleaved(&mut packet_samples);
+        raw.extend_from_slice(&packet_samples);
+        if raw.len() / channels > max_frames {
+            return Err(bad(format!(
+                "longer than {:.0} minutes, the longest recording read",
+                crate::base::limits::MAX_SCORE_S / 60.0
+            )));
+        }
+    }
+    if raw.is_empty() {
+        return Err(bad("the file holds no samples".into()));
+    }
+    if raw.iter().any(|s| !s.is_finite()) {
+        return Err(bad(
+            "it holds samples that are not numbers (NaN or infinite)".into(),
+        ));
+    }
+    Ok((downmix(&raw, channels), rate))
+}
+
+/// Interleaved frames of `ch` channels to mono: their mean, or the loudest channel when the
+/// mean keeps less than [`MIN_MIX_SHARE`] of the channels' mean energy (a spaced pair
+/// whose microphones hear the head out of phase would cancel its low partials).
+fn downmix(raw: &[f32], ch: usize) -> Vec<f32> {
+    let mean: Vec<f32> = raw
+        .chunks_exact(ch)
+        .map(|f| f.iter().sum::<f32>() / ch as f32)
+        .collect();
+    if ch < 2 {
+        return mean;
+    }
+    let energy = |xs: &mut dyn Iterator<Item = f32>| xs.map(|x| f64::from(x).powi(2)).sum::<f64>();
+    let per_channel: Vec<f64> = (0..ch)
+        .map(|c| energy(&mut raw.iter().skip(c).step_by(ch).copied()))
+        .collect();
+    let channels_mean = per_channel.iter().sum::<f64>() / ch as f64;
+    if energy(&mut mean.iter().copied()) >= MIN_MIX_SHARE * channels_mean {
+        return mean;
+    }
+    let loudest = (0..ch)
+        .max_by(|&a, &b| per_channel[a].total_cmp(&per_channel[b]))
+        .unwrap_or(0);
+    raw.iter().skip(loudest).step_by(ch).copied().collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::TAU;
+
+    /// Two channels hearing the head out of phase are read from the louder, not cancelled;
+    /// two in phase are averaged.
+    #[test]
+    fn a_stereo_pair_out_of_phase_is_not_cancelled() {
+        let note: Vec<f32> = (0..4800)
+            .map(|i| (TAU * 100.0 * i as f64 / 48_000.0).sin() as f32)
+            .collect();
+        let interleave =
+            |l: f32, r: f32| -> Vec<f32> { note.iter().flat_map(|&x| [l * x, r * x]).collect() };
+        assert_eq!(downmix(&interleave(1.0, -0.9), 2), note);
+        let mean: Vec<f32> = note.iter().map(|&x| (x + 0.5 * x) / 2.0).collect();
+        assert_eq!(downmix(&interleave(1.0, 0.5), 2), mean);
+        assert_eq!(downmix(&note, 1), note);
+    }
+}
