@@ -140,6 +140,11 @@ fn an_mp3_is_transcribed_as_its_wav() {
     assert_eq!(from_mp3.score.beats[0].tick, from_wav.score.beats[0].tick);
     assert_eq!(from_mp3.score.beats[0].drum, from_wav.score.beats[0].drum);
     assert_eq!(from_mp3.kit, from_wav.kit, "the same drums tuned alike");
+    // One stroke shows no beat: one tempo, the transcriber's default.
+    for loaded in [&from_wav, &from_mp3] {
+        assert_eq!(loaded.score.tempo.len(), 1, "{:?}", loaded.score.tempo);
+        assert_eq!(loaded.score.tempo[0].bpm, 100.0);
+    }
 }
 
 #[test]

@@ -184,7 +184,8 @@ pub fn snap(beats: &mut [f64], strokes_s: &[f64]) {
 /// A tempo map in which beat `k` of `beats` (s, rising, each a quarter note) falls at
 /// tick `first_tick + k·tpq`, score time 0 at tick 0: the fewest constant-tempo steps that
 /// keep every beat within [`TEMPO_TOLERANCE_S`]. The span before the first beat is one
-/// step of `first_tick` ticks.
+/// step of `first_tick` ticks, unless the first step's tempo keeps the first beat within
+/// the tolerance too. Without two beats, the prior's tempo.
 pub fn tempo_map(beats: &[f64], tpq: u32, first_tick: u64) -> Vec<TempoPoint> {
     let q = f64::from(tpq);
     let mut points = Vec::new();
@@ -208,8 +209,24 @@ pub fn tempo_map(beats: &[f64], tpq: u32, first_tick: u64) -> Vec<TempoPoint> {
     if points.is_empty() {
         points.push(step(0, PRIOR_BPM));
     }
+    // The lead-in takes the first step's tempo when that keeps the first beat within the
+    // tolerance (a stroke 5 ms into a file is not a tempo of its own).
+    if first_tick > 0
+        && let [_, first, ..] = points.as_slice()
+    {
+        let at_first_tempo_s = 60.0 * first_tick as f64 / q / first.bpm;
+        if (at_first_tempo_s - beats[0]).abs() <= TEMPO_TOLERANCE_S {
+            points.remove(0);
+            points[0].tick = 0;
+        }
+    }
     points.dedup_by(|b, a| (a.bpm - b.bpm).abs() < 1e-9);
     points
+}
+
+/// The beat period of the prior's tempo, s.
+pub fn prior_period_s() -> f64 {
+    60.0 / PRIOR_BPM
 }
 
 fn step(tick: u64, bpm: f64) -> TempoPoint {
@@ -327,5 +344,27 @@ mod tests {
             );
         }
         assert!(points.len() < beats.len(), "{} points", points.len());
+    }
+
+    /// A lead-in a few milliseconds long (the first stroke just after the file starts)
+    /// takes the tempo after it, not a tempo of its own; a lead-in that the tempo after it
+    /// would misplace keeps its own; no beats give the prior's tempo.
+    #[test]
+    fn a_short_lead_in_takes_the_first_tempo() {
+        let beats: Vec<f64> = (0..8).map(|k| 0.0055 + f64::from(k) * 0.5).collect();
+        let points = tempo_map(&beats, 960, 11);
+        assert_eq!(points.len(), 1, "{points:?}");
+        assert_eq!(points[0].tick, 0);
+        assert!((points[0].bpm - 120.0).abs() < 1e-9, "{points:?}");
+        let map = TempoMap::new(&points, 960);
+        assert!((map.seconds_at(11.0) - beats[0]).abs() <= TEMPO_TOLERANCE_S);
+        // A first beat at 0.3 s written one beat in: 200 bpm before it, 120 after.
+        let late: Vec<f64> = beats.iter().map(|b| b - 0.0055 + 0.3).collect();
+        let points = tempo_map(&late, 960, 960);
+        assert_eq!(points.len(), 2, "{points:?}");
+        assert!((points[0].bpm - 200.0).abs() < 1e-9, "{points:?}");
+        let prior = tempo_map(&[], 960, 0);
+        assert_eq!(prior.len(), 1);
+        assert!((prior[0].bpm - PRIOR_BPM).abs() < 1e-12);
     }
 }

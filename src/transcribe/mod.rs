@@ -210,12 +210,18 @@ pub fn transcribe(
     let mut score = Score::new(options.title.as_deref().unwrap_or("Transcription"));
     score.kit = options.kit_ref.clone();
     let tpq = score.ticks_per_quarter;
-    let period = beats::period_s(&strength).unwrap_or(0.6);
-    let (first, last) = (times[0], *times.last().expect("not empty"));
-    let mut beat_times = beats::track(&strength, period, first, last);
-    beats::snap(&mut beat_times, &times);
-    let first_tick = lead_in_ticks(beat_times[0], period, tpq);
-    score.tempo = beats::tempo_map(&beat_times, tpq, first_tick);
+    // One or two strokes show no beat (the autocorrelation of a stroke's decay would name
+    // a tempo of its own): they are written at the prior's tempo.
+    score.tempo = if times.len() < MIN_BEAT_STROKES {
+        beats::tempo_map(&[], tpq, 0)
+    } else {
+        let period = beats::period_s(&strength).unwrap_or_else(beats::prior_period_s);
+        let (first, last) = (times[0], *times.last().expect("not empty"));
+        let mut beat_times = beats::track(&strength, period, first, last);
+        beats::snap(&mut beat_times, &times);
+        let first_tick = lead_in_ticks(beat_times[0], period, tpq);
+        beats::tempo_map(&beat_times, tpq, first_tick)
+    };
     score.meter = vec![MeterChange {
         bar: 1,
         numerator: 4,
@@ -278,6 +284,9 @@ fn pitch_band(kit: &Kit) -> (f64, f64) {
     let hi = kit.drums.iter().map(|d| d.highest.hz()).fold(0.0, f64::max);
     (lo / 1.5, hi * 1.5)
 }
+
+/// The fewest strokes whose onsets can show a beat.
+const MIN_BEAT_STROKES: usize = 3;
 
 /// Ticks from score time 0 to the first beat at `first_s`: whole beats of about
 /// `period_s`, or the exact fraction when the first beat comes within half a beat.
