@@ -292,6 +292,27 @@ fn quit_with_unsaved_changes_asks() {
     assert!(h.state().is_dirty());
 }
 
+/// A 32 kHz WAV of the shipped recorded notes `names` (e.g. "2L"), each cut or padded with
+/// silence to `samples_each`.
+fn write_recorded_notes(wav: &Path, names: &[&str], samples_each: usize) {
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: 32_000,
+        bits_per_sample: 16,
+        sample_format: hound::SampleFormat::Int,
+    };
+    let mut w = hound::WavWriter::create(wav, spec).unwrap();
+    for name in names {
+        let path = root().join(format!("kits/samples/Timpani_{name}.wav"));
+        let mut r = hound::WavReader::open(path).unwrap();
+        let note: Vec<i16> = r.samples::<i16>().map(Result::unwrap).collect();
+        for i in 0..samples_each {
+            w.write_sample(note.get(i).copied().unwrap_or(0)).unwrap();
+        }
+    }
+    w.finalize().unwrap();
+}
+
 /// Dropped files: a MIDI file imports as a new unsaved score, a recording is transcribed
 /// into one, a broken score shows an error in the window, another kind of file is refused
 /// with a message.
@@ -325,22 +346,7 @@ fn dropped_files() {
 
     // A recording is transcribed: three recorded notes 0.8 s apart, three strokes.
     let wav = dir.path().join("three notes.wav");
-    let spec = hound::WavSpec {
-        channels: 1,
-        sample_rate: 32_000,
-        bits_per_sample: 16,
-        sample_format: hound::SampleFormat::Int,
-    };
-    let mut w = hound::WavWriter::create(&wav, spec).unwrap();
-    for name in ["2L", "3R", "2R"] {
-        let path = root().join(format!("kits/samples/Timpani_{name}.wav"));
-        let mut r = hound::WavReader::open(path).unwrap();
-        let note: Vec<i16> = r.samples::<i16>().map(Result::unwrap).collect();
-        for i in 0..25_600 {
-            w.write_sample(note.get(i).copied().unwrap_or(0)).unwrap();
-        }
-    }
-    w.finalize().unwrap();
+    write_recorded_notes(&wav, &["2L", "3R", "2R"], 25_600);
     h.state_mut().handle_dropped(&wav);
     h.state_mut().wait_for_composition();
     settle(&mut h);
@@ -348,6 +354,55 @@ fn dropped_files() {
     assert!(app.error().is_none(), "{:?}", app.error());
     assert_eq!(app.loaded().unwrap().score.beats.len(), 3);
     assert!(app.path().is_none(), "a transcription is not saved yet");
+}
+
+/// A recording is transcribed on a thread while a dialog says so: the window keeps
+/// drawing, its shortcuts wait, a second file is refused until it is read, and Cancel
+/// keeps the score on screen. Read to the end, the transcription opens; an MP3 too.
+#[test]
+fn a_recording_opens_behind_a_dialog_that_can_cancel() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut h = harness(Some(demo()), dir.path());
+    // Twenty seconds of recorded notes, a second apart: long enough to be caught reading.
+    let wav = dir.path().join("twenty notes.wav");
+    write_recorded_notes(&wav, &["3R"; 20], 32_000);
+
+    h.state_mut().handle_dropped(&wav);
+    // A new window shows from its second frame (the first measures it).
+    h.step();
+    h.step();
+    h.get_by_label("Transcribing a recording");
+    h.get_by_label_contains("twenty notes.wav");
+    h.state_mut().handle_dropped(&demo());
+    let refused = h.state().error().unwrap().to_string();
+    assert!(refused.contains("wait until"), "{refused}");
+    h.get_by_label("Cancel").click();
+    h.step();
+    h.step();
+    assert!(h.query_by_label("Transcribing a recording").is_none());
+    assert_eq!(
+        h.state().loaded().unwrap().score.beats.len(),
+        16,
+        "the demo stays"
+    );
+    assert!(
+        h.state()
+            .status()
+            .contains("cancelled reading twenty notes.wav")
+    );
+
+    h.state_mut().handle_dropped(&wav);
+    h.step();
+    settle(&mut h);
+    let app = h.state();
+    assert_eq!(app.loaded().unwrap().score.beats.len(), 20);
+    assert!(app.path().is_none(), "a transcription is not saved yet");
+    assert!(h.query_by_label("Transcribing a recording").is_none());
+
+    h.state_mut()
+        .handle_dropped(&root().join("tests/fixtures/recordings/d2-note.mp3"));
+    settle(&mut h);
+    assert_eq!(h.state().loaded().unwrap().score.beats.len(), 1);
 }
 
 /// Space plays from the playhead on the silent clock and pauses again; F1 shows help.

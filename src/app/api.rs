@@ -116,8 +116,10 @@ impl EditorApp {
         self.pipeline.compositions_made()
     }
 
-    /// Wait for the composition in progress (for tests and batch use).
+    /// Wait for a recording being opened, then for the composition in progress (for
+    /// tests and batch use).
     pub fn wait_for_composition(&mut self) -> Option<&Composition> {
+        self.wait_for_opening();
         self.pipeline.wait_for_composition()
     }
 

@@ -23,6 +23,7 @@ mod history;
 mod inspector;
 mod jobs;
 mod keys;
+mod opening;
 mod osc_out;
 mod output;
 pub mod picking;
@@ -167,6 +168,8 @@ pub struct EditorApp {
     after_save: Option<AfterConfirm>,
     /// The user agreed to quit: close once the writing jobs are done.
     quitting: bool,
+    /// A recording being read (transcribed) for a new document, while its dialog shows.
+    opening: Option<opening::Opening>,
     pending: Vec<Command>,
     ctx: Option<egui::Context>,
     /// The window title last sent, so it is only sent when it changes.
@@ -256,6 +259,7 @@ impl EditorApp {
             confirm: None,
             after_save: None,
             quitting: false,
+            opening: None,
             pending: Vec::new(),
             ctx: None,
             shown_title: String::new(),
@@ -306,7 +310,11 @@ impl EditorApp {
         }
         // Shortcuts wait while a modal asks something (its own keys, Escape and Enter, are
         // its own).
-        if self.confirm.is_none() && self.restore_offer.is_none() && !self.dialogs.is_open() {
+        if self.confirm.is_none()
+            && self.restore_offer.is_none()
+            && self.opening.is_none()
+            && !self.dialogs.is_open()
+        {
             for a in keys::take_actions(ctx) {
                 self.pending.push(Command::Do(a));
             }
@@ -375,6 +383,7 @@ impl eframe::App for EditorApp {
         self.drain();
         self.confirm_dialog(&ctx);
         self.restore_dialog(&ctx);
+        self.opening_dialog(&ctx);
         self.file_dialog(&ctx);
         keys::help_window(&ctx, &mut self.views.show_help);
         self.preferences_window(&ctx);

@@ -67,6 +67,9 @@ impl EditorApp {
         for finished in self.jobs.poll() {
             self.job_finished(finished);
         }
+        if let Some(outcome) = self.opening.as_ref().and_then(|o| o.poll()) {
+            self.take_opened(outcome);
+        }
     }
 
     /// Show a rendering the pipeline took: its body in the view, its summary in the status
@@ -109,13 +112,78 @@ impl EditorApp {
         }
     }
 
-    /// Open a score (`.ron`) or import a MIDI (`.mid`) or MusicXML file; errors go to the
-    /// window.
-    /// Unsaved changes are dropped (the UI asks first).
+    /// Open a score (`.ron`) or import a MIDI (`.mid`), MusicXML or recording file;
+    /// errors go to the window. A recording is transcribed on a thread while a dialog
+    /// shows ([`super::opening`]); the rest open at once. Unsaved changes are dropped (the
+    /// UI asks first).
     pub fn open_path(&mut self, path: &Path) {
+        if let Some(busy) = &self.opening {
+            self.messages.error = Some(format!(
+                "{}: wait until {} is read, or cancel it",
+                path.display(),
+                busy.path().display()
+            ));
+            return;
+        }
+        if kind_of(path) == FileKind::Audio {
+            let wake = self
+                .ctx
+                .clone()
+                .map(|ctx| Box::new(move || ctx.request_repaint()) as Box<dyn Fn() + Send>);
+            self.opening = Some(super::opening::Opening::start(path, wake));
+            return;
+        }
         match files::read(path) {
             Ok(opened) => self.open_document(opened),
             Err(e) => self.messages.error = Some(e.to_string()),
+        }
+    }
+
+    /// Take the recording read on its thread, if it is read: as the document, or its
+    /// error in the window.
+    fn take_opened(&mut self, outcome: super::opening::Outcome) {
+        self.opening = None;
+        match outcome {
+            Ok(opened) => self.open_document(opened),
+            Err(e) => self.messages.error = Some(e),
+        }
+    }
+
+    /// Block until a recording being read is read and open it (tests and batch use).
+    pub(super) fn wait_for_opening(&mut self) {
+        if let Some(opening) = self.opening.take() {
+            self.take_opened(opening.wait());
+        }
+    }
+
+    /// The dialog shown while a recording is read: its name, the time so far, Cancel
+    /// (the document on screen stays; the thread's result is dropped).
+    pub(super) fn opening_dialog(&mut self, ctx: &egui::Context) {
+        let Some(opening) = &self.opening else {
+            return;
+        };
+        let name = opening.path().file_name().map_or_else(
+            || opening.path().display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        let seconds = opening.elapsed().as_secs_f64();
+        let mut cancel = false;
+        egui::Modal::new(egui::Id::unique("opening-recording")).show(ctx, |ui| {
+            ui.heading("Transcribing a recording");
+            ui.horizontal(|ui| {
+                ui.spinner();
+                ui.label(format!("{name}: {seconds:.0} s"));
+            });
+            ui.label("Finding the strokes, their drums, pitches and dynamics, and the beat.");
+            if ui.button("Cancel").clicked() || ui.input(|i| i.key_pressed(egui::Key::Escape)) {
+                cancel = true;
+            }
+        });
+        if cancel {
+            self.messages.status = format!("cancelled reading {name}");
+            self.opening = None;
+        } else {
+            ctx.request_repaint_after(std::time::Duration::from_millis(250));
         }
     }
 
@@ -136,7 +204,7 @@ impl EditorApp {
         match kind_of(path) {
             FileKind::Other => {
                 self.messages.error = Some(format!(
-                    "{}: drop a score (.ron), a MIDI file (.mid), a MusicXML file (.musicxml, .xml, .mxl) or a recording (.wav)",
+                    "{}: drop a score (.ron), a MIDI file (.mid), a MusicXML file (.musicxml, .xml, .mxl) or a recording (.wav, .aiff, .flac, .mp3, .ogg)",
                     path.display()
                 ))
             }

@@ -132,6 +132,9 @@ impl TempoLane {
         lane.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Canvas, true, "Tempo lane"));
         let mut hovered_point = None;
         let pointer = ui.input(|i| i.pointer.hover_pos());
+        // A label is drawn only clear of the last one drawn (points a few ticks apart
+        // would print their tempos over each other); the point hovered always has one.
+        let mut label_free_from = f32::NEG_INFINITY;
         for (i, p) in points.iter().enumerate() {
             let c = Pos2::new(x_of(p.tick), y_of(p.bpm));
             if !rect.expand(6.0).contains(c) {
@@ -147,13 +150,16 @@ impl TempoLane {
                 hovered_point = Some(i);
             }
             clip.circle(c, 4.5, colour, Stroke::new(1.0, Color32::BLACK));
-            clip.text(
-                c + Vec2::new(6.0, -7.0),
-                egui::Align2::LEFT_BOTTOM,
-                format!("{:.0}", p.bpm),
-                egui::FontId::monospace(9.0),
-                colour,
-            );
+            if c.x >= label_free_from || hovered_point == Some(i) {
+                let label = clip.text(
+                    c + Vec2::new(6.0, -7.0),
+                    egui::Align2::LEFT_BOTTOM,
+                    format!("{:.0}", p.bpm),
+                    egui::FontId::monospace(9.0),
+                    colour,
+                );
+                label_free_from = label_free_from.max(label.right() + 2.0);
+            }
             if resp.drag_started() {
                 self.dragging = Some(i);
                 self.range = Some((lo, hi));
