@@ -325,6 +325,51 @@ fn recorded_notes_joined_into_a_phrase() {
     }
 }
 
+/// Strokes far apart show no beat in their onset strength: three recorded notes 3 s,
+/// 2.4 s and 2 s apart are written on whole beats nearest 100 bpm (100, 100 and 90 bpm),
+/// with one tempo after the lead-in; one note alone at 100 bpm with one tempo.
+#[test]
+fn sparse_strokes_are_written_on_whole_beats() {
+    let kit = Kit::standard();
+    let (note, rate) =
+        timpanist::sound::recording::read_mono(&root().join("kits/samples/Timpani_2R.wav"))
+            .unwrap();
+    for (gap_s, beats_apart) in [(3.0, 5u64), (2.4, 4), (2.0, 3)] {
+        let gap = (gap_s * f64::from(rate)) as usize;
+        let mut phrase = vec![0.0f32; rate as usize + 3 * gap];
+        for k in 0..3 {
+            let at = rate as usize + k * gap;
+            let n = note.len().min(gap);
+            for (o, s) in phrase[at..at + n].iter_mut().zip(&note[..n]) {
+                *o += s;
+            }
+        }
+        let (score, _) = transcribe(&phrase, rate, &kit, "sparse", &Options::default()).unwrap();
+        let ticks: Vec<u64> = score.beats.iter().map(|b| b.tick).collect();
+        let tpq = u64::from(score.ticks_per_quarter);
+        assert_eq!(ticks.len(), 3, "{gap_s} s: {ticks:?}");
+        assert!(
+            ticks.windows(2).all(|w| w[1] - w[0] == beats_apart * tpq),
+            "{gap_s} s: {ticks:?}"
+        );
+        let after_lead_in: Vec<f64> = (score.tempo.iter())
+            .filter(|p| p.tick >= ticks[0])
+            .map(|p| p.bpm)
+            .collect();
+        assert_eq!(after_lead_in.len(), 1, "{gap_s} s: {:?}", score.tempo);
+        let want_bpm = 60.0 * beats_apart as f64 / gap_s;
+        assert!(
+            (after_lead_in[0] / want_bpm - 1.0).abs() < 0.01,
+            "{:?}",
+            score.tempo
+        );
+    }
+    let (score, _) = transcribe(&note, rate, &kit, "one note", &Options::default()).unwrap();
+    assert_eq!(score.beats.len(), 1);
+    assert_eq!(score.tempo.len(), 1, "{:?}", score.tempo);
+    assert_eq!(score.tempo[0].bpm, 100.0);
+}
+
 /// `x` at `from` Hz played at `to` Hz (`to` > `from`): band-limited interpolation, a
 /// Hann-windowed sinc of 24 samples either side (as a recording made at 44.1 or 48 kHz).
 fn upsampled(x: &[f32], from: u32, to: u32) -> Vec<f32> {

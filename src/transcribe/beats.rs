@@ -25,7 +25,7 @@ const LOCAL_TIGHTNESS: f64 = 150.0;
 const LOCAL_BEATS: usize = 4;
 /// A beat this close to a stroke moves onto it, s.
 const SNAP_S: f64 = 0.025;
-/// Largest error a constant-tempo step may leave at a beat, s.
+/// Largest error a constant-tempo step may leave at a beat that carries a stroke, s.
 pub const TEMPO_TOLERANCE_S: f64 = 0.004;
 
 /// The beat period, s: the lag in [`BPM_SPAN`] where the prior-weighted autocorrelation of
@@ -183,28 +183,40 @@ pub fn snap(beats: &mut [f64], strokes_s: &[f64]) {
 
 /// A tempo map in which beat `k` of `beats` (s, rising, each a quarter note) falls at
 /// tick `first_tick + k·tpq`, score time 0 at tick 0: the fewest constant-tempo steps that
-/// keep every beat within [`TEMPO_TOLERANCE_S`]. The span before the first beat is one
+/// keep every beat on a stroke (`on_stroke[k]`) within [`TEMPO_TOLERANCE_S`], each step
+/// starting on such a beat (or the first). The beats between them count the beats but do
+/// not bend the tempo: where a beat falls in a silence only shapes how the silence is
+/// written, and the tracker's beats there follow the decays' noise (three strokes 3 s
+/// apart gave twelve tempo steps). The span before the first beat is one
 /// step of `first_tick` ticks, unless the first step's tempo keeps the first beat within
 /// the tolerance too. Without two beats, the prior's tempo.
-pub fn tempo_map(beats: &[f64], tpq: u32, first_tick: u64) -> Vec<TempoPoint> {
+pub fn tempo_map(beats: &[f64], on_stroke: &[bool], tpq: u32, first_tick: u64) -> Vec<TempoPoint> {
     let q = f64::from(tpq);
     let mut points = Vec::new();
-    let mut start = 0;
     if first_tick > 0 {
         let bpm = 60.0 * first_tick as f64 / q / beats[0].max(1e-3);
         points.push(step(0, bpm));
     }
-    while start + 1 < beats.len() {
-        let mut end = start + 1;
-        while end + 1 < beats.len() && fits(&beats[start..=end + 1]) {
-            end += 1;
+    let mut anchors: Vec<usize> = (0..beats.len()).filter(|&k| on_stroke[k]).collect();
+    if !beats.is_empty() && anchors.first() != Some(&0) {
+        anchors.insert(0, 0);
+    }
+    if anchors.len() < 2 {
+        anchors = (0..beats.len()).collect();
+    }
+    let mut a = 0;
+    while a + 1 < anchors.len() {
+        let mut b = a + 1;
+        while b + 1 < anchors.len() && fits(beats, &anchors[a..=b + 1]) {
+            b += 1;
         }
-        let beat_s = (beats[end] - beats[start]) / (end - start) as f64;
+        let (from, to) = (anchors[a], anchors[b]);
+        let beat_s = (beats[to] - beats[from]) / (to - from) as f64;
         points.push(step(
-            first_tick + start as u64 * u64::from(tpq),
+            first_tick + from as u64 * u64::from(tpq),
             60.0 / beat_s,
         ));
-        start = end;
+        a = b;
     }
     if points.is_empty() {
         points.push(step(0, PRIOR_BPM));
@@ -237,15 +249,28 @@ fn step(tick: u64, bpm: f64) -> TempoPoint {
     }
 }
 
-/// Whether one constant tempo through the first and last beat keeps every beat between
-/// within the tolerance.
-fn fits(beats: &[f64]) -> bool {
-    let n = beats.len() - 1;
-    let slope = (beats[n] - beats[0]) / n as f64;
-    beats
-        .iter()
-        .enumerate()
-        .all(|(k, b)| (beats[0] + slope * k as f64 - b).abs() <= TEMPO_TOLERANCE_S)
+/// Whether one constant tempo through the first and last of the beats `anchors` (indices
+/// into `beats`, rising) keeps every one between within [`TEMPO_TOLERANCE_S`].
+fn fits(beats: &[f64], anchors: &[usize]) -> bool {
+    let (first, last) = (anchors[0], anchors[anchors.len() - 1]);
+    let slope = (beats[last] - beats[first]) / (last - first) as f64;
+    anchors.iter().all(|&k| {
+        let line = beats[first] + slope * (k - first) as f64;
+        (line - beats[k]).abs() <= TEMPO_TOLERANCE_S
+    })
+}
+
+/// The beat period of strokes spaced `interval_s` apart on average when that is slower
+/// than the slowest beat considered (sparse playing, whose onset strength shows no beat
+/// in its autocorrelation): the interval divided by the whole number of beats that
+/// brings it nearest the prior's tempo.
+pub fn sparse_period_s(interval_s: f64) -> Option<f64> {
+    let slowest_s = 60.0 / BPM_SPAN.0;
+    if interval_s.is_nan() || interval_s <= slowest_s {
+        return None;
+    }
+    let beats = (interval_s / prior_period_s()).round().max(1.0);
+    Some(interval_s / beats)
 }
 
 #[cfg(test)]
@@ -308,7 +333,7 @@ mod tests {
                 "beat at {b:.3} s is off the quarter grid: {beats:?}"
             );
         }
-        let points = tempo_map(&beats, 960, 960);
+        let points = tempo_map(&beats, &vec![true; beats.len()], 960, 960);
         assert!(points.len() <= 2, "{points:?}");
     }
 
@@ -334,7 +359,7 @@ mod tests {
         }
         let first = beats[0];
         let first_tick = (first / p).round() as u64 * 960;
-        let points = tempo_map(&beats, 960, first_tick);
+        let points = tempo_map(&beats, &vec![true; beats.len()], 960, first_tick);
         let map = TempoMap::new(&points, 960);
         for (k, b) in beats.iter().enumerate() {
             let at = map.seconds_at((first_tick + k as u64 * 960) as f64);
@@ -352,7 +377,7 @@ mod tests {
     #[test]
     fn a_short_lead_in_takes_the_first_tempo() {
         let beats: Vec<f64> = (0..8).map(|k| 0.0055 + f64::from(k) * 0.5).collect();
-        let points = tempo_map(&beats, 960, 11);
+        let points = tempo_map(&beats, &[true; 8], 960, 11);
         assert_eq!(points.len(), 1, "{points:?}");
         assert_eq!(points[0].tick, 0);
         assert!((points[0].bpm - 120.0).abs() < 1e-9, "{points:?}");
@@ -360,11 +385,43 @@ mod tests {
         assert!((map.seconds_at(11.0) - beats[0]).abs() <= TEMPO_TOLERANCE_S);
         // A first beat at 0.3 s written one beat in: 200 bpm before it, 120 after.
         let late: Vec<f64> = beats.iter().map(|b| b - 0.0055 + 0.3).collect();
-        let points = tempo_map(&late, 960, 960);
+        let points = tempo_map(&late, &[true; 8], 960, 960);
         assert_eq!(points.len(), 2, "{points:?}");
         assert!((points[0].bpm - 200.0).abs() < 1e-9, "{points:?}");
-        let prior = tempo_map(&[], 960, 0);
+        let prior = tempo_map(&[], &[], 960, 0);
         assert_eq!(prior.len(), 1);
         assert!((prior[0].bpm - PRIOR_BPM).abs() < 1e-12);
+    }
+
+    /// Three strokes 3 s apart: a beat of their own (five beats each, 100 bpm) and one
+    /// tempo, however the tracker's beats in the silences between them wander; were those
+    /// beats strokes, the tempo would follow them.
+    #[test]
+    fn sparse_strokes_keep_one_tempo() {
+        assert_eq!(
+            sparse_period_s(1.2),
+            None,
+            "a beat of 50 bpm is heard as it is"
+        );
+        let period = sparse_period_s(3.0).unwrap();
+        assert!((period - 0.6).abs() < 1e-12, "{period}");
+        assert!((sparse_period_s(2.0).unwrap() - 2.0 / 3.0).abs() < 1e-12);
+        let wander = [0.0, 0.03, -0.025, 0.04, -0.035];
+        let beats: Vec<f64> = (0..11)
+            .map(|k| {
+                1.0 + 0.6 * f64::from(k)
+                    + if k % 5 == 0 {
+                        0.0
+                    } else {
+                        wander[k as usize % 5]
+                    }
+            })
+            .collect();
+        let on_stroke: Vec<bool> = (0..11).map(|k| k % 5 == 0).collect();
+        let points = tempo_map(&beats, &on_stroke, 960, 0);
+        assert_eq!(points.len(), 1, "{points:?}");
+        assert!((points[0].bpm - 100.0).abs() < 1e-9, "{points:?}");
+        // Heard, the same wandering beats are followed.
+        assert!(tempo_map(&beats, &[true; 11], 960, 0).len() > 1);
     }
 }

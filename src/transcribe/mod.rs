@@ -213,14 +213,20 @@ pub fn transcribe(
     // One or two strokes show no beat (the autocorrelation of a stroke's decay would name
     // a tempo of its own): they are written at the prior's tempo.
     score.tempo = if times.len() < MIN_BEAT_STROKES {
-        beats::tempo_map(&[], tpq, 0)
+        beats::tempo_map(&[], &[], tpq, 0)
     } else {
-        let period = beats::period_s(&strength).unwrap_or_else(beats::prior_period_s);
+        let period = beats::sparse_period_s(median_interval_s(&times))
+            .or_else(|| beats::period_s(&strength))
+            .unwrap_or_else(beats::prior_period_s);
         let (first, last) = (times[0], *times.last().expect("not empty"));
         let mut beat_times = beats::track(&strength, period, first, last);
         beats::snap(&mut beat_times, &times);
+        // `snap` puts a beat on a stroke exactly.
+        let on_stroke: Vec<bool> = (beat_times.iter())
+            .map(|b| times.binary_search_by(|t| t.total_cmp(b)).is_ok())
+            .collect();
         let first_tick = lead_in_ticks(beat_times[0], period, tpq);
-        beats::tempo_map(&beat_times, tpq, first_tick)
+        beats::tempo_map(&beat_times, &on_stroke, tpq, first_tick)
     };
     score.meter = vec![MeterChange {
         bar: 1,
@@ -283,6 +289,16 @@ fn pitch_band(kit: &Kit) -> (f64, f64) {
         .fold(f64::MAX, f64::min);
     let hi = kit.drums.iter().map(|d| d.highest.hz()).fold(0.0, f64::max);
     (lo / 1.5, hi * 1.5)
+}
+
+/// The median time between consecutive strokes (`times`, s, sorted), s; 0 for one.
+fn median_interval_s(times: &[f64]) -> f64 {
+    let mut gaps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
+    if gaps.is_empty() {
+        return 0.0;
+    }
+    gaps.sort_by(f64::total_cmp);
+    gaps[gaps.len() / 2]
 }
 
 /// The fewest strokes whose onsets can show a beat.
