@@ -260,6 +260,65 @@ fn fits(beats: &[f64], anchors: &[usize]) -> bool {
     })
 }
 
+/// Ratios to a beat period that confuse duple and triple time: a beat heard a third too
+/// slow writes quarters as triplets, a third too fast writes them as dotted notes.
+const TRIPLE_RATIOS: [f64; 2] = [2.0 / 3.0, 1.5];
+/// An interval within this share of a beat (at most [`GRID_TOLERANCE_S`]) of a whole or
+/// half number of beats counts as written plainly.
+const GRID_SHARE: f64 = 0.08;
+const GRID_TOLERANCE_S: f64 = 0.04;
+/// A related period replaces the autocorrelation's when it writes this many more
+/// intervals plainly (whole beats 1, half beats ½), and at least this share of all of
+/// them: a piece whose tempo changes is written plainly by no one period, and its
+/// autocorrelation's stands (a study at 80, 120 and 90 bpm was written at 120
+/// throughout, its opening at 80 in dotted quarters).
+const PLAINER_BY: f64 = 1.0;
+const PLAIN_SHARE: f64 = 0.7;
+
+/// How plainly the intervals between `times` (s, sorted) are written at a beat of
+/// `period_s`: each interval of a whole number of beats counts 1, of a half number ½;
+/// with the number of intervals counted (a chord's is not).
+fn plainness(times: &[f64], period_s: f64) -> (f64, usize) {
+    let tolerance = (GRID_SHARE * period_s).min(GRID_TOLERANCE_S) / period_s;
+    let off = |x: f64| (x - x.round()).abs();
+    (times.windows(2))
+        .map(|w| (w[1] - w[0]) / period_s)
+        .filter(|&beats| beats > 2.0 * tolerance)
+        .fold((0.0, 0), |(score, n), beats| {
+            let plain = if off(beats) <= tolerance {
+                1.0
+            } else if off(2.0 * beats) <= 2.0 * tolerance {
+                0.5
+            } else {
+                0.0
+            };
+            (score + plain, n + 1)
+        })
+}
+
+/// The beat period that writes the strokes at `times` most plainly: `period_s` (the
+/// autocorrelation's), or the period a third faster or slower (within the periods
+/// considered) when that writes clearly more intervals, and most of them, as whole or
+/// half beats. The
+/// autocorrelation cannot tell 48 from 72 bpm in five strokes of an improvisation at 72
+/// (0, 1, 1½, 3 and 4 beats, which 48 bpm writes as triplets), nor 114 from 76 bpm in a
+/// study of half notes and quarters at 76 (written in dotted notes at 114).
+pub fn plainest_period_s(period_s: f64, times: &[f64]) -> f64 {
+    let (fastest, slowest) = (60.0 / BPM_SPAN.1, 60.0 / BPM_SPAN.0);
+    let mut best = (plainness(times, period_s).0, period_s);
+    for ratio in TRIPLE_RATIOS {
+        let p = period_s * ratio;
+        let (score, n) = plainness(times, p);
+        if (fastest..=slowest).contains(&p)
+            && score >= best.0 + PLAINER_BY
+            && score >= PLAIN_SHARE * n as f64
+        {
+            best = (score, p);
+        }
+    }
+    best.1
+}
+
 /// The beat period of strokes spaced `interval_s` apart on average when that is slower
 /// than the slowest beat considered (sparse playing, whose onset strength shows no beat
 /// in its autocorrelation): the interval divided by the whole number of beats that
@@ -391,6 +450,34 @@ mod tests {
         let prior = tempo_map(&[], &[], 960, 0);
         assert_eq!(prior.len(), 1);
         assert!((prior[0].bpm - PRIOR_BPM).abs() < 1e-12);
+    }
+
+    /// A beat a third off is taken back when the strokes read plainly at the right one:
+    /// five strokes at 0, 1, 1½, 3 and 4 beats of 72 bpm heard at 48 bpm; half notes and
+    /// quarters at 76 bpm heard at 114. Sixteenths stay at their beat, and so does a
+    /// piece at 80, 120 and 90 bpm, which no one period writes plainly.
+    #[test]
+    fn a_beat_a_third_off_is_taken_back() {
+        let at = |bpm: f64, beats: &[f64]| -> Vec<f64> {
+            beats.iter().map(|b| 0.5 + b * 60.0 / bpm).collect()
+        };
+        let close = |p: f64, bpm: f64| (60.0 / p - bpm).abs() < 1e-6;
+        let improvisation = at(72.0, &[0.0, 1.0, 1.5, 3.0, 4.0]);
+        assert!(close(plainest_period_s(60.0 / 48.0, &improvisation), 72.0));
+        let study = at(
+            76.0,
+            &[0.0, 2.0, 4.0, 6.0, 8.0, 9.0, 10.0, 11.0, 12.0, 14.0],
+        );
+        assert!(close(plainest_period_s(60.0 / 114.0, &study), 76.0));
+        assert!(close(plainest_period_s(60.0 / 76.0, &study), 76.0));
+        let sixteenths: Vec<f64> = (0..64).map(|k| 0.5 + f64::from(k) * 0.15).collect();
+        assert!(close(plainest_period_s(0.6, &sixteenths), 100.0));
+        let mut changing = at(80.0, &(0..13).map(f64::from).collect::<Vec<_>>());
+        for beat_s in [0.5, 60.0 / 90.0] {
+            let last = *changing.last().unwrap();
+            changing.extend((1..=8).map(|k| last + f64::from(k) * beat_s));
+        }
+        assert!(close(plainest_period_s(0.75, &changing), 80.0));
     }
 
     /// Three strokes 3 s apart: a beat of their own (five beats each, 100 bpm) and one

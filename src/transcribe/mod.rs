@@ -218,6 +218,7 @@ pub fn transcribe(
         let period = beats::sparse_period_s(median_interval_s(&times))
             .or_else(|| beats::period_s(&strength))
             .unwrap_or_else(beats::prior_period_s);
+        let period = beats::plainest_period_s(period, &times);
         let (first, last) = (times[0], *times.last().expect("not empty"));
         let mut beat_times = beats::track(&strength, period, first, last);
         beats::snap(&mut beat_times, &times);
