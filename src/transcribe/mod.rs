@@ -219,8 +219,7 @@ pub fn transcribe(
             .or_else(|| beats::period_s(&strength))
             .unwrap_or_else(beats::prior_period_s);
         let period = beats::plainest_period_s(period, &times);
-        let (first, last) = (times[0], *times.last().expect("not empty"));
-        let mut beat_times = beats::track(&strength, period, first, last);
+        let mut beat_times = beats::track(&strength, period, &times);
         beats::snap(&mut beat_times, &times);
         // `snap` puts a beat on a stroke exactly.
         let on_stroke: Vec<bool> = (beat_times.iter())
