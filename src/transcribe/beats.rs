@@ -1,13 +1,16 @@
 //! The beat of a recording and a tempo map that follows it. The beat period comes from the
 //! autocorrelation of the onset strength, weighted towards 100 bpm (a log-Gaussian prior
-//! one octave wide); beats are then tracked by dynamic programming (Ellis 2007: each beat
-//! rewards onset strength and pays for departing from the period), so tempo changes are
-//! followed. A second pass holds each beat more firmly to the *local* period (the median
-//! beat interval of the first pass around it): inside a roll, where every 32nd is as
-//! strong an onset as the beat, the first pass may take a roll stroke next to the beat
-//! (a one-beat tempo swing of ±12 %), while a gradual accelerando still moves the local
-//! period with it. Beats within 25 ms of a stroke move onto it. The tempo map is the fewest
-//! steps of constant tempo that keep every beat within 4 ms.
+//! one octave wide) — or, for strokes further apart than the slowest beat, from their
+//! interval ([`sparse_period_s`]) — and is then taken a third faster or slower when that
+//! writes the strokes plainly ([`plainest_period_s`]). Beats are tracked by dynamic
+//! programming (Ellis 2007: each beat rewards onset strength and pays for departing from
+//! the period), so tempo changes are followed. A second pass holds each beat more firmly
+//! to the *local* period (the median beat interval of the first pass around it, or the
+//! pace of evenly spaced strokes near it): inside a roll, where every 32nd is as strong an
+//! onset as the beat, the first pass may take a roll stroke next to the beat (a one-beat
+//! tempo swing of ±12 %), while a gradual accelerando still moves the local period with
+//! it. Beats within 25 ms of a stroke move onto it. The tempo map is the fewest steps of
+//! constant tempo that keep every beat on a stroke within 4 ms.
 
 use super::onsets::Strength;
 use crate::score::{TempoChange, TempoPoint};
@@ -51,9 +54,9 @@ pub fn period_s(strength: &Strength) -> Option<f64> {
         .map(|(lag, _)| lag as f64 * strength.hop_s)
 }
 
-/// Beat times, s, tracked through the onset strength with period `period_s`, from the
-/// first beat to the last, extended by whole periods to cover `[first_s, last_s]` (the
-/// first and last strokes).
+/// Beat times, s, tracked through the onset strength with period `period_s` (the local
+/// period following the pace of evenly spaced strokes, [`follow_strokes`]), extended by
+/// whole periods to cover the first to the last of `strokes_s` (s, sorted).
 pub fn track(strength: &Strength, period_s: f64, strokes_s: &[f64]) -> Vec<f64> {
     let (first_s, last_s) = match (strokes_s.first(), strokes_s.last()) {
         (Some(&a), Some(&b)) => (a, b),
@@ -232,9 +235,9 @@ pub fn snap(beats: &mut [f64], strokes_s: &[f64]) {
 /// starting on such a beat (or the first). The beats between them count the beats but do
 /// not bend the tempo: where a beat falls in a silence only shapes how the silence is
 /// written, and the tracker's beats there follow the decays' noise (three strokes 3 s
-/// apart gave twelve tempo steps). The span before the first beat is one
-/// step of `first_tick` ticks, unless the first step's tempo keeps the first beat within
-/// the tolerance too. Without two beats, the prior's tempo.
+/// apart gave twelve tempo steps). The span before the first beat is one step of
+/// `first_tick` ticks, unless the first step's tempo keeps the first beat within the
+/// tolerance too. Without two beats, the prior's tempo.
 pub fn tempo_map(beats: &[f64], on_stroke: &[bool], tpq: u32, first_tick: u64) -> Vec<TempoPoint> {
     let q = f64::from(tpq);
     let mut points = Vec::new();
@@ -344,10 +347,10 @@ fn plainness(times: &[f64], period_s: f64) -> (f64, usize) {
 /// The beat period that writes the strokes at `times` most plainly: `period_s` (the
 /// autocorrelation's), or the period a third faster or slower (within the periods
 /// considered) when that writes clearly more intervals, and most of them, as whole or
-/// half beats. The
-/// autocorrelation cannot tell 48 from 72 bpm in five strokes of an improvisation at 72
-/// (0, 1, 1½, 3 and 4 beats, which 48 bpm writes as triplets), nor 114 from 76 bpm in a
-/// study of half notes and quarters at 76 (written in dotted notes at 114).
+/// half beats. The autocorrelation cannot tell 48 from 72 bpm in five strokes of an
+/// improvisation at 72 (0, 1, 1½, 3 and 4 beats, which 48 bpm writes as triplets), nor
+/// 114 from 76 bpm in a study of half notes and quarters at 76 (written in dotted notes
+/// at 114).
 pub fn plainest_period_s(period_s: f64, times: &[f64]) -> f64 {
     let (fastest, slowest) = (60.0 / BPM_SPAN.1, 60.0 / BPM_SPAN.0);
     let mut best = (plainness(times, period_s).0, period_s);
@@ -364,7 +367,7 @@ pub fn plainest_period_s(period_s: f64, times: &[f64]) -> f64 {
     best.1
 }
 
-/// The beat period of strokes spaced `interval_s` apart on average when that is slower
+/// The beat period of strokes whose median interval is `interval_s`, when that is slower
 /// than the slowest beat considered (sparse playing, whose onset strength shows no beat
 /// in its autocorrelation): the interval divided by the whole number of beats that
 /// brings it nearest the prior's tempo.
