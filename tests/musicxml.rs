@@ -80,6 +80,62 @@ fn run(xml: &str) -> (Score, ImportReport) {
     (score, report)
 }
 
+/// Every timpani part in music21's own corpus (sixteen Bach movements in music21 9), when
+/// python3 has music21: each imports with every note at music21's offset and pitch, repeats
+/// expanded as music21 expands them (`tests/scripts/music21_corpus_timpani.py` lists them as
+/// music21 reads them); skipped with a message without music21.
+#[test]
+fn music21_corpus_timpani_parts() {
+    let script =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scripts/music21_corpus_timpani.py");
+    let Ok(o) = Command::new("python3").arg(&script).output() else {
+        println!("skipped: no python3");
+        return;
+    };
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    if !o.status.success()
+        && String::from_utf8_lossy(&o.stderr).contains("No module named 'music21'")
+    {
+        println!("skipped: python3 with music21 is not installed (pip install music21)");
+        return;
+    }
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let kit = Kit::standard();
+    let mut parts = 0;
+    for line in stdout.lines() {
+        let v: serde_json::Value = serde_json::from_str(line).unwrap();
+        let path = PathBuf::from(v["path"].as_str().unwrap());
+        let mut want: Vec<(i64, u8)> = (v["notes"].as_array().unwrap().iter())
+            .map(|n| {
+                let offset = n[0].as_f64().unwrap();
+                (
+                    (offset * 960.0).round() as i64,
+                    n[1].as_u64().unwrap() as u8,
+                )
+            })
+            .collect();
+        let (score, _) =
+            import_file(&path, &kit, &ImportOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+        let tpq = i64::from(score.ticks_per_quarter);
+        let mut got: Vec<(i64, u8)> = (score.beats.iter())
+            .map(|b| (b.tick as i64 * 960 / tpq, b.sounding_pitch(&kit).0))
+            .collect();
+        want.sort_unstable();
+        got.sort_unstable();
+        assert_eq!(got, want, "{}", path.display());
+        println!(
+            "{}: {} notes as music21 reads them",
+            path.display(),
+            got.len()
+        );
+        parts += 1;
+    }
+    assert!(
+        parts >= 10,
+        "only {parts} timpani parts in music21's corpus"
+    );
+}
+
 /// (tick, sounding pitch) of every beat.
 fn timeline(score: &Score) -> Vec<(u64, Pitch)> {
     let kit = Kit::standard();
