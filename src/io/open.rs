@@ -42,10 +42,25 @@ pub fn kind_of(path: &Path) -> FileKind {
 }
 
 /// Every extension the editor opens: scores, MIDI, MusicXML and recordings.
-pub const OPENABLE_EXTENSIONS: [&str; 15] = [
-    "ron", "mid", "midi", "musicxml", "xml", "mxl", "wav", "wave", "aif", "aiff", "aifc", "flac",
-    "mp3", "ogg", "oga",
-];
+pub const OPENABLE_EXTENSIONS: [&str; 15] = joined(
+    ["ron", "mid", "midi", "musicxml", "xml", "mxl"],
+    recording::EXTENSIONS,
+);
+
+/// `a` then `b`, at compile time (`N` = `A` + `B`, or it does not compile).
+const fn joined<const A: usize, const B: usize, const N: usize>(
+    a: [&'static str; A],
+    b: [&'static str; B],
+) -> [&'static str; N] {
+    assert!(A + B == N);
+    let mut out = [""; N];
+    let mut i = 0;
+    while i < N {
+        out[i] = if i < A { a[i] } else { b[i - A] };
+        i += 1;
+    }
+    out
+}
 
 /// What `timpanist FILE` does with a file.
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -92,24 +92,32 @@ fn follow_strokes(local: &mut [f64], strokes_s: &[f64], hop_s: f64) {
     if strokes_s.len() < 3 {
         return;
     }
+    // Frames between the same two strokes see the same strokes around them.
+    let paces: Vec<Option<f64>> = (0..=strokes_s.len())
+        .map(|k| even_pace_s(strokes_s, k))
+        .collect();
     for (n, period) in local.iter_mut().enumerate() {
         let t = n as f64 * hop_s;
-        let k = strokes_s.partition_point(|&s| s < t);
-        let span = k.saturating_sub(PACE_STROKES)..(k + PACE_STROKES).min(strokes_s.len());
-        let mut gaps: Vec<f64> = strokes_s[span].windows(2).map(|w| w[1] - w[0]).collect();
-        if gaps.len() < 2 {
+        let Some(pace_s) = paces[strokes_s.partition_point(|&s| s < t)] else {
             continue;
-        }
-        gaps.sort_by(f64::total_cmp);
-        if gaps[gaps.len() - 1] > EVEN_PACE * gaps[0] {
-            continue;
-        }
-        let pace = gaps[gaps.len() / 2] / hop_s;
-        let ratio = pace / *period;
-        if (PACE_RATIO.0..=PACE_RATIO.1).contains(&ratio) {
+        };
+        let pace = pace_s / hop_s;
+        if (PACE_RATIO.0..=PACE_RATIO.1).contains(&(pace / *period)) {
             *period = pace;
         }
     }
+}
+
+/// The median interval of the strokes around the one at index `k` of `strokes_s` (s,
+/// sorted; [`PACE_STROKES`] on each side), s, if they are evenly spaced ([`EVEN_PACE`]).
+fn even_pace_s(strokes_s: &[f64], k: usize) -> Option<f64> {
+    let span = k.saturating_sub(PACE_STROKES)..(k + PACE_STROKES).min(strokes_s.len());
+    let mut gaps: Vec<f64> = strokes_s[span].windows(2).map(|w| w[1] - w[0]).collect();
+    if gaps.len() < 2 {
+        return None;
+    }
+    gaps.sort_by(f64::total_cmp);
+    (gaps[gaps.len() - 1] <= EVEN_PACE * gaps[0]).then(|| gaps[gaps.len() / 2])
 }
 
 /// For each frame, the median interval (frames) of the beats `frames` around it

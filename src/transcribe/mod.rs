@@ -13,6 +13,7 @@ pub mod onsets;
 
 use crate::base::limits::MAX_SCORE_S;
 use crate::base::pitch::Pitch;
+use crate::base::stats::median;
 use crate::kit::Kit;
 use crate::score::{Dynamic, MeterChange, Score, TempoMap};
 use crate::sound::analysis;
@@ -215,7 +216,8 @@ pub fn transcribe(
     score.tempo = if times.len() < MIN_BEAT_STROKES {
         beats::tempo_map(&[], &[], tpq, 0)
     } else {
-        let period = beats::sparse_period_s(median_interval_s(&times))
+        let median_interval_s = median(times.windows(2).map(|w| w[1] - w[0])).unwrap_or(0.0);
+        let period = beats::sparse_period_s(median_interval_s)
             .or_else(|| beats::period_s(&strength))
             .unwrap_or_else(beats::prior_period_s);
         let period = beats::plainest_period_s(period, &times);
@@ -289,16 +291,6 @@ fn pitch_band(kit: &Kit) -> (f64, f64) {
         .fold(f64::MAX, f64::min);
     let hi = kit.drums.iter().map(|d| d.highest.hz()).fold(0.0, f64::max);
     (lo / 1.5, hi * 1.5)
-}
-
-/// The median time between consecutive strokes (`times`, s, sorted), s; 0 for one.
-fn median_interval_s(times: &[f64]) -> f64 {
-    let mut gaps: Vec<f64> = times.windows(2).map(|w| w[1] - w[0]).collect();
-    if gaps.is_empty() {
-        return 0.0;
-    }
-    gaps.sort_by(f64::total_cmp);
-    gaps[gaps.len() / 2]
 }
 
 /// The fewest strokes whose onsets can show a beat.
