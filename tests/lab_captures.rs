@@ -61,6 +61,8 @@ fn options_for(truth: &Truth, align: Alignment) -> IngestOptions {
             UpAxis::Z
         },
         tip_offset_m: None,
+        // As a user lists a stick's loose markers: from the tip (as the corpus writes them).
+        markers_from_tip: true,
         align,
         mode: Some(
             truth
@@ -102,6 +104,22 @@ struct Outcome {
     plane_max_m: f64,
 }
 
+/// Where the tip of a stick of loose markers (`label`: `A+B+…`, at `places` in the
+/// stick frame, whose origin is the tip) lies in the frame `mocap::marker_body` builds
+/// for them: the stick frame carried onto the body's layout (Kabsch).
+fn tip_in_marker_body(take: &Take, label: &str, places: &[[f64; 3]]) -> DVec3 {
+    use timpanist::mocap::marker_body::{best_rotation, from_markers};
+    let tracks: Vec<&timpanist::mocap::Track> =
+        label.split('+').map(|l| take.track(l).unwrap()).collect();
+    let layout = from_markers(&tracks).unwrap().layout;
+    let places: Vec<DVec3> = places.iter().map(|p| DVec3::from(*p)).collect();
+    let mean = |v: &[DVec3]| v.iter().sum::<DVec3>() / v.len() as f64;
+    let (stick_mean, body_mean) = (mean(&places), mean(&layout));
+    let centred = |v: &[DVec3], m: DVec3| v.iter().map(|p| *p - m).collect::<Vec<_>>();
+    let turn = best_rotation(&centred(&places, stick_mean), &centred(&layout, body_mean));
+    body_mean - turn * stick_mean
+}
+
 /// Import `capture` into a fresh database with `--align auto` and compare.
 fn run(capture: &GeneratedCapture, dir: &Path, kit: &Kit, habits: &HabitBook) -> Outcome {
     let truth = &capture.truth;
@@ -137,6 +155,10 @@ fn run(capture: &GeneratedCapture, dir: &Path, kit: &Kit, habits: &HabitBook) ->
             .count();
         if let (Some(truth_offset), Some(estimate)) = (t.tip_offset_body_m, hand.tip_estimate) {
             tip_error = Some((estimate.offset_m - DVec3::from(truth_offset)).length());
+        }
+        if let (Some(places), Some(estimate)) = (&t.stick_markers_m, hand.tip_estimate) {
+            let truth = tip_in_marker_body(&take, &t.label, places);
+            tip_error = Some((estimate.offset_m - truth).length());
         }
     }
     // Alignment: where the fitted transform puts the drum the take was played on.
@@ -208,11 +230,33 @@ fn lab_captures_come_back() {
         .map(|c| run(c, &dir, &kit, &habits))
         .collect();
     std::fs::remove_dir_all(&dir).ok();
+    report_and_check(&outcomes);
+}
+
+/// Print the table of `outcomes` and check each (see [`lab_captures_come_back`]).
+fn report_and_check(outcomes: &[Outcome]) {
+    print_table(outcomes);
+    for o in outcomes {
+        let recall = o.matched as f64 / o.strokes as f64;
+        let false_found = (o.found - o.matched.min(o.found)) as f64 / o.found.max(1) as f64;
+        assert!(recall >= 0.9, "{o:?}");
+        assert!(false_found < 0.05, "{o:?}");
+        assert!(o.plane_max_m < 0.02, "{o:?}");
+        assert!(o.place_error_m < 0.2, "{o:?}");
+        assert!(o.yaw_error_deg.abs() < 35.0, "{o:?}");
+        if let Some(e) = o.tip_error_m {
+            assert!(e < 0.1, "{o:?}");
+        }
+    }
+}
+
+/// The table of `outcomes`, on stderr.
+fn print_table(outcomes: &[Outcome]) {
     eprintln!(
         "{:<46} {:>7} {:>6} {:>8} {:>9} {:>9} {:>9} {:>9}",
         "capture", "strokes", "found", "matched", "tip mm", "yaw °", "place cm", "plane mm"
     );
-    for o in &outcomes {
+    for o in outcomes {
         eprintln!(
             "{:<46} {:>7} {:>6} {:>8} {:>9} {:>9.1} {:>9.1} {:>9.1}",
             o.name,
@@ -226,18 +270,106 @@ fn lab_captures_come_back() {
             o.plane_max_m * 1e3
         );
     }
+}
+
+/// Sticks tracked by loose markers on the shaft, no tip marker and no rigid body — three
+/// around and along it (Vicon CSV, and again as C3D), two (TRC, Y up, 120 Hz) — come
+/// back as the other layouts do, their tips estimated on the markers' axis within 5 cm
+/// (`mocap::marker_body`; the priors place it along the axis when the stick meets the
+/// head at one angle).
+#[test]
+fn sticks_of_loose_markers_come_back() {
+    let db = shipped_db();
+    let kit = Kit::standard();
+    let habits = align::habits_of(&db, &kit);
+    let dir = std::env::temp_dir().join(format!("timpanist-lab-shaft-{}", std::process::id()));
+    let takes = db.index.takes.len();
+    let styled = |layout: Layout, places: Vec<[f64; 3]>, seed: u64| LabStyle {
+        stick_markers_m: places,
+        seed,
+        ..LabStyle::typical(layout)
+    };
+    let shaft = |along: &[f64]| LabStyle::on_the_shaft(along);
+    let three = labcorpus::generate(
+        &db,
+        17 % takes,
+        &styled(Layout::Vicon, shaft(&[0.06, 0.16, 0.26]), 70),
+    )
+    .unwrap()
+    .with_suffix("-three-markers");
+    let marker_take = write_and_read(&three, &dir).1;
+    let mut c3d = three.clone();
+    let name = three.truth.files[0].replace(".csv", ".c3d");
+    c3d.files = vec![(
+        name.clone(),
+        timpanist::io::c3d_write::write_c3d(&marker_take),
+    )];
+    c3d.truth.files = vec![name];
+    let captures = [
+        three,
+        c3d,
+        labcorpus::generate(
+            &db,
+            29 % takes,
+            &styled(Layout::Trc, shaft(&[0.05, 0.25]), 71),
+        )
+        .unwrap()
+        .with_suffix("-two-markers"),
+    ];
+    let outcomes: Vec<Outcome> = captures
+        .iter()
+        .map(|c| run(c, &dir, &kit, &habits))
+        .collect();
+    std::fs::remove_dir_all(&dir).ok();
+    report_and_check(&outcomes);
     for o in &outcomes {
-        let recall = o.matched as f64 / o.strokes as f64;
-        let false_found = (o.found - o.matched.min(o.found)) as f64 / o.found.max(1) as f64;
-        assert!(recall >= 0.9, "{o:?}");
-        assert!(false_found < 0.05, "{o:?}");
-        assert!(o.plane_max_m < 0.02, "{o:?}");
-        assert!(o.place_error_m < 0.2, "{o:?}");
-        assert!(o.yaw_error_deg.abs() < 35.0, "{o:?}");
-        if let Some(e) = o.tip_error_m {
-            assert!(e < 0.1, "{o:?}");
-        }
+        let tip = o
+            .tip_error_m
+            .unwrap_or_else(|| panic!("no tip estimate: {o:?}"));
+        assert!(tip < 0.05, "{o:?}");
     }
+}
+
+/// A file whose stick is three loose markers (`StickR1`…`3`, beside arm markers) imports
+/// without `--tips`: the three are taken as one stick, its tip estimated, every stroke
+/// found.
+#[test]
+fn cli_takes_a_hands_stick_markers_as_one_stick() {
+    let db = shipped_db();
+    let dir = std::env::temp_dir().join(format!("timpanist-lab-loose-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let style = LabStyle {
+        stick_markers_m: LabStyle::on_the_shaft(&[0.06, 0.16, 0.26]),
+        ..LabStyle::typical(Layout::Vicon)
+    };
+    let capture = labcorpus::generate(&db, 17 % db.index.takes.len(), &style).unwrap();
+    let (name, bytes) = &capture.files[0];
+    std::fs::write(dir.join(name), bytes).unwrap();
+    let output = std::process::Command::new(env!("CARGO_BIN_EXE_timpanist"))
+        .args(["mocap", "import", "--align", "auto"])
+        .arg(dir.join(name))
+        .arg("-o")
+        .arg(dir.join("db"))
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&output.stdout).to_string();
+    let stderr = String::from_utf8_lossy(&output.stderr).to_string();
+    std::fs::remove_dir_all(&dir).ok();
+    assert!(output.status.success(), "{stdout}\n{stderr}");
+    let track = &capture.truth.tracks[0];
+    assert_eq!(track.label, "Player:StickR1+Player:StickR2+Player:StickR3");
+    let line = stdout
+        .lines()
+        .find(|l| l.contains(&format!("stick \"{}\"", track.label)))
+        .unwrap_or_else(|| panic!("{stdout}"));
+    let impacts: usize = line
+        .split(": ")
+        .nth(1)
+        .and_then(|s| s.split(' ').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("{line}"));
+    assert_eq!(impacts, track.impacts.len(), "{stdout}");
+    assert!(stdout.contains("tip estimated at"), "{stdout}");
 }
 
 /// A hand-given transform is applied as given: the stored tips are the lab tips turned
@@ -415,4 +547,47 @@ fn cli_points_lab_coordinates_to_align() {
         "{kept}"
     );
     assert!(!aligned.contains("on no drum"), "{aligned}");
+}
+
+/// Three loose shaft markers (6, 16 and 26 cm from the tip, listed from it) on twelve
+/// takes of every mode, both grips and hands, Vicon and TRC alternately: at least ten
+/// come back with every stroke found and matched (90 %), the facing within 10° and the
+/// tip within 8 cm. (2026-12-06: eleven do, the tip 15–79 mm off; a French legato take's
+/// tip is estimated 19 cm off and its facing 32°: the stick meets the head at one angle,
+/// so the capture leaves the tip's place along the stick to the priors and the
+/// shipped performer's stroke shape, and its lift is steep enough for the fit to slide.)
+#[test]
+fn loose_shaft_markers_over_twelve_takes() {
+    let db = shipped_db();
+    let kit = Kit::standard();
+    let habits = align::habits_of(&db, &kit);
+    let dir = std::env::temp_dir().join(format!("timpanist-lab-twelve-{}", std::process::id()));
+    let takes = db.index.takes.len();
+    let outcomes: Vec<Outcome> = (0..12u64)
+        .map(|k| {
+            let style = LabStyle {
+                stick_markers_m: LabStyle::on_the_shaft(&[0.06, 0.16, 0.26]),
+                seed: 2026 + k,
+                ..LabStyle::typical(if k % 2 == 0 {
+                    Layout::Vicon
+                } else {
+                    Layout::Trc
+                })
+            };
+            let c = labcorpus::generate(&db, (17 + 13 * k as usize) % takes, &style).unwrap();
+            run(&c, &dir, &kit, &habits)
+        })
+        .collect();
+    std::fs::remove_dir_all(&dir).ok();
+    print_table(&outcomes);
+    let good = outcomes
+        .iter()
+        .filter(|o| {
+            o.matched as f64 >= 0.9 * o.strokes as f64
+                && o.found <= o.strokes + 1
+                && o.yaw_error_deg.abs() < 10.0
+                && o.tip_error_m.is_some_and(|e| e < 0.08)
+        })
+        .count();
+    assert!(good >= 10, "{good} of 12 came back");
 }

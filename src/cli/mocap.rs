@@ -243,6 +243,8 @@ pub fn import(args: ImportArgs) -> anyhow::Result<()> {
             tips: source.tips.clone(),
             up: source.up,
             tip_offset_m: source.tip_offset_m,
+            // Markers the user listed (`--tips A+B+…`) run from the tip.
+            markers_from_tip: !matches!(args.tips, TipsArg::Unnamed),
             align: align.clone(),
             mode: args.mode,
             location: args.location,
@@ -414,9 +416,17 @@ fn paired_source(
             tracks.push(t);
         }
     }
+    // Each marker of a stick of loose markers (`A+B`) is prefixed too.
+    let prefixed = |prefix: &str, label: String| {
+        label
+            .split('+')
+            .map(|one| format!("{prefix}:{one}"))
+            .collect::<Vec<_>>()
+            .join("+")
+    };
     l.tips = [
-        l.tips[0].take().map(|t| format!("left:{t}")),
-        r.tips[1].clone().map(|t| format!("right:{t}")),
+        l.tips[0].take().map(|t| prefixed("left", t)),
+        r.tips[1].clone().map(|t| prefixed("right", t)),
     ];
     l.take = Take {
         source: left.to_path_buf(),
@@ -476,8 +486,8 @@ fn resolve_tips(
                 let sticks: Vec<&str> = mine.iter().copied().filter(|l| names_a_stick(l)).collect();
                 if let [one] = mine[..] {
                     place(side, one.to_string());
-                } else if let [one] = sticks[..] {
-                    place(side, one.to_string());
+                } else if let Some(label) = one_stick(take, &sticks) {
+                    place(side, label);
                 }
             }
             if let (Some(side), [one]) = (fixed, &labels[..]) {
@@ -522,6 +532,34 @@ fn warn_if_off_the_kit(path: &Path, report: &IngestReport) {
             );
         }
     }
+}
+
+/// The stick among one hand's stick-named tracks: the only one; else the only rigid
+/// body; else the only tip marker; else, when all are plain markers, all of them as
+/// one stick of loose markers (`A+B+…`, `mocap::marker_body`).
+fn one_stick(take: &Take, sticks: &[&str]) -> Option<String> {
+    let only = |keep: &dyn Fn(&str) -> bool| match sticks
+        .iter()
+        .filter(|l| keep(l))
+        .collect::<Vec<_>>()[..]
+    {
+        [one] => Some(one.to_string()),
+        _ => None,
+    };
+    let rigid = |label: &str| {
+        take.track(label)
+            .is_some_and(|t| t.rotations.iter().any(Option::is_some))
+    };
+    let tip = |label: &str| {
+        let lower = label.to_ascii_lowercase();
+        lower.contains("tip") || lower.contains("bead")
+    };
+    only(&|_| true)
+        .or_else(|| only(&rigid))
+        .or_else(|| only(&tip))
+        .or_else(|| {
+            (sticks.len() >= 2 && !sticks.iter().any(|l| rigid(l))).then(|| sticks.join("+"))
+        })
 }
 
 /// Whether a track label names a stick or its tip (not an arm marker).
@@ -639,8 +677,9 @@ pub fn columns(file: &Path, profile: Option<&str>) -> anyhow::Result<()> {
 }
 
 /// Write the lab-style test corpus into `dir`: one capture per layout from takes of the
-/// shipped database (several modes and both hands), the Vicon one again as C3D, and one
-/// from the real TrajOptDrums stroke, with `truth.ron`.
+/// shipped database (several modes and both hands), the Vicon one again as C3D, a Vicon
+/// one whose stick is three loose shaft markers, and one from the real TrajOptDrums
+/// stroke, with `truth.ron`.
 pub fn corpus(dir: &Path, seed: u64) -> anyhow::Result<()> {
     use crate::mocap::labcorpus::{self, LabStyle, Layout};
     let db = crate::mocap::shipped::built_in()?;
@@ -663,6 +702,13 @@ pub fn corpus(dir: &Path, seed: u64) -> anyhow::Result<()> {
         c3d.truth.files = vec![c3d_name];
         captures.push(c3d);
     }
+    // A stick tracked by three loose markers on its shaft, no tip marker, no rigid body.
+    let style = LabStyle {
+        seed: seed + 11,
+        stick_markers_m: LabStyle::on_the_shaft(&[0.06, 0.16, 0.26]),
+        ..LabStyle::typical(Layout::Vicon)
+    };
+    captures.push(labcorpus::generate(&db, 17 % takes, &style)?.with_suffix("-shaft-markers"));
     let style = LabStyle {
         seed,
         ..LabStyle::typical(Layout::Trc)

@@ -10,9 +10,10 @@
 
 use super::align::{self, HabitBook, HandFit, HandStrokes, Target, Transform};
 use super::db::{MotionDb, TakeData, TakeEntry, UnitEntry};
+use super::marker_body;
 use super::segment::{Impact, RejectionCounts, SegmentParams, UnitSpan, fill_gaps, segment};
 use super::take::{ImportError, Take, Track};
-use super::tip_estimate::{self, TipEstimate, TipEstimateError};
+use super::tip_estimate::{self, TipEstimate, TipEstimateError, TipPrior};
 use crate::base::stats::median;
 use crate::kit::{Kit, Side};
 use crate::score::{Dynamic, Grip, ImpactLocation, PlayingMode};
@@ -37,6 +38,10 @@ pub struct IngestOptions {
     /// For rigid-body tracks: the tip in the body's own frame, m; `None` estimates it
     /// (`mocap::tip_estimate`).
     pub tip_offset_m: Option<DVec3>,
+    /// For a stick of loose markers (`A+B+…`): they are listed from the tip toward the
+    /// grip, so the tip lies past the first (the user named them so); `false`: past the
+    /// end that comes down faster (`mocap::marker_body`).
+    pub markers_from_tip: bool,
     /// How the take is placed in the performer frame.
     pub align: Alignment,
     /// Labels; `None` reads them from the file path (see [`labels_from_path`]).
@@ -224,7 +229,7 @@ pub fn ingest(
         .collect();
     // Every label is checked before any work, so a misspelt one is what the user hears of.
     for (_, label) in &wanted {
-        find_track(path, take, label)?;
+        find_tracks(path, take, label)?;
     }
     let mut sticks = Vec::new();
     for (side, label) in wanted {
@@ -457,7 +462,8 @@ pub fn front_drum(kit: &Kit, hand: Side) -> usize {
 }
 
 /// One stick's tip, Z up, in the capture's place: the marker itself, or the rigid body's
-/// origin carried to its tip (given or estimated).
+/// origin carried to its tip (given or estimated); a label `A+B+…` joins loose markers
+/// into the body they form (`mocap::marker_body`), whose tip is estimated.
 fn stick(
     path: &Path,
     take: &Take,
@@ -467,25 +473,56 @@ fn stick(
     head_height_m: Option<f64>,
     notices: &mut Vec<String>,
 ) -> Result<Stick, ImportError> {
-    let track = find_track(path, take, label)?;
-    let positions: Vec<Option<DVec3>> = track
-        .positions
+    let tracks = find_tracks(path, take, label)?;
+    let (found_label, positions, rotations, known, tip_offset_m) = match &tracks[..] {
+        [track] => (
+            track.label.clone(),
+            track.positions.clone(),
+            track.rotations.clone(),
+            TipPrior::Cluster,
+            options.tip_offset_m,
+        ),
+        markers => {
+            let joined = markers
+                .iter()
+                .map(|t| t.label.as_str())
+                .collect::<Vec<_>>()
+                .join("+");
+            let body = marker_body::from_markers(markers).map_err(|e| {
+                ImportError::format(path, format!("stick \"{joined}\""), e.to_string())
+            })?;
+            if options.tip_offset_m.is_some() {
+                notices.push(format!(
+                    "stick \"{joined}\": --tip-offset is the tip in a rigid body's own frame; this stick is loose markers, whose frame is built here, so its tip is estimated"
+                ));
+            }
+            if body.misfit_frames > 0 {
+                notices.push(format!(
+                    "stick \"{joined}\": {} frames left out where its markers did not keep their places on the stick (a swapped or ghost marker)",
+                    body.misfit_frames
+                ));
+            }
+            let known = body.tip_prior(options.markers_from_tip);
+            (joined, body.positions, body.rotations, known, None)
+        }
+    };
+    let positions: Vec<Option<DVec3>> = positions
         .iter()
         .map(|p| p.map(|p| to_performer(p, options.up)))
         .collect();
-    let rotations: Vec<Option<DQuat>> = track
-        .rotations
+    let rotations: Vec<Option<DQuat>> = rotations
         .iter()
         .map(|q| q.map(|q| rotation_to_performer(q, options.up)))
         .collect();
     let has_rotations = rotations.iter().any(Option::is_some);
-    let (offset, estimate) = match (options.tip_offset_m, has_rotations) {
+    let (offset, estimate) = match (tip_offset_m, has_rotations) {
         (Some(d), true) => (Some(d), None),
         (None, true) => match tip_estimate::estimate(
             &positions,
             &rotations,
             take.rate_hz,
             head_height_m.unwrap_or(0.76),
+            known,
         ) {
             Ok(e) => (Some(e.offset_m), Some(e)),
             // A stick that hardly plays (the idle hand of a take) has no tip to find:
@@ -516,7 +553,7 @@ fn stick(
         .collect();
     Ok(Stick {
         hand,
-        label: track.label.clone(),
+        label: found_label,
         tip,
         origin: if offset.is_some() {
             positions
@@ -525,6 +562,19 @@ fn stick(
         },
         estimate,
     })
+}
+
+/// The tracks a stick's label names: one track, or the markers of `A+B+…` (one stick
+/// of loose markers); an error names a missing one and lists the labels the file has.
+fn find_tracks<'a>(
+    path: &Path,
+    take: &'a Take,
+    label: &str,
+) -> Result<Vec<&'a Track>, ImportError> {
+    label
+        .split('+')
+        .map(|one| find_track(path, take, one.trim()))
+        .collect()
 }
 
 /// The track labelled `label`, or an error listing the labels the file has.
@@ -662,8 +712,9 @@ fn pick<T: std::fmt::Debug + Copy>(
     })
 }
 
-/// Which hand a track label names, when it says: "left"/"right" in it, or an L/R at
-/// either end of a letter run ("StickL", "LSTK", "Stick_R").
+/// Which hand a track label names, when it says: "left"/"right" in it, a word that is
+/// just L or R ("R_STICK_TIP", "RStick2", "Stick_L", "TipR"), or an L/R at either end
+/// of its letters ("StickL", "LSTK").
 pub fn hand_from_label(label: &str) -> Option<Side> {
     let lower = label.to_ascii_lowercase();
     if lower.contains("left") {
@@ -673,18 +724,56 @@ pub fn hand_from_label(label: &str) -> Option<Side> {
         return Some(Side::Right);
     }
     let name = label.rsplit(':').next().unwrap_or(label);
-    let letters: String = name.chars().filter(char::is_ascii_alphabetic).collect();
-    let (first, last) = (letters.chars().next()?, letters.chars().last()?);
     let side = |c: char| match c {
-        'L' => Some(Side::Left),
-        'R' => Some(Side::Right),
+        'L' | 'l' => Some(Side::Left),
+        'R' | 'r' => Some(Side::Right),
         _ => None,
     };
-    match (side(last), side(first)) {
+    let single: Vec<Side> = words(name)
+        .iter()
+        .filter_map(|w| match w.as_bytes() {
+            [c] => side(char::from(*c)),
+            _ => None,
+        })
+        .collect();
+    if let [one] = single[..] {
+        return Some(one);
+    }
+    let letters: String = name.chars().filter(char::is_ascii_alphabetic).collect();
+    let (first, last) = (letters.chars().next()?, letters.chars().last()?);
+    let upper = |c: char| side(c).filter(|_| c.is_ascii_uppercase());
+    match (upper(last), upper(first)) {
         (Some(s), _) => Some(s),
         (None, Some(s)) if letters.len() <= 5 => Some(s),
         _ => None,
     }
+}
+
+/// The words of a label: runs of letters split at anything else and at case changes
+/// ("R_STICK_tip2" → R, STICK, tip; "RStickTip" → R, Stick, Tip).
+fn words(label: &str) -> Vec<String> {
+    let chars: Vec<char> = label.chars().collect();
+    let mut words = Vec::new();
+    let mut word = String::new();
+    for (i, &c) in chars.iter().enumerate() {
+        if !c.is_ascii_alphabetic() {
+            words.extend((!word.is_empty()).then(|| std::mem::take(&mut word)));
+            continue;
+        }
+        let prev = i.checked_sub(1).map(|p| chars[p]);
+        let next = chars.get(i + 1);
+        let starts = c.is_ascii_uppercase()
+            && prev.is_some_and(|p| {
+                p.is_ascii_lowercase()
+                    || (p.is_ascii_uppercase() && next.is_some_and(char::is_ascii_lowercase))
+            });
+        if starts && !word.is_empty() {
+            words.push(std::mem::take(&mut word));
+        }
+        word.push(c);
+    }
+    words.extend((!word.is_empty()).then_some(word));
+    words
 }
 
 /// A capture position in the performer frame.
@@ -708,6 +797,31 @@ pub fn rotation_to_performer(q: DQuat, up: UpAxis) -> DQuat {
 mod tests {
     use super::*;
     use crate::mocap::db::{self, Index};
+
+    /// A label's hand, in the ways labs write it; none where it does not say.
+    #[test]
+    fn hands_from_track_labels() {
+        let cases = [
+            ("StickL", Some(Side::Left)),
+            ("Player:TipR", Some(Side::Right)),
+            ("LSTK", Some(Side::Left)),
+            ("RSTK2", Some(Side::Right)),
+            ("R_STICK_TIP", Some(Side::Right)),
+            ("l_mallet_top", Some(Side::Left)),
+            ("RStickTop", Some(Side::Right)),
+            ("Stick_L_2", Some(Side::Left)),
+            ("LeftMallet", Some(Side::Left)),
+            ("mallet right", Some(Side::Right)),
+            ("CLAV", None),
+            ("StickTop", None),
+            ("Marker1", None),
+        ];
+        for (label, hand) in cases {
+            assert_eq!(hand_from_label(label), hand, "{label}");
+        }
+        assert_eq!(words("R_STICK_tip2"), ["R", "STICK", "tip"]);
+        assert_eq!(words("RStickTip"), ["R", "Stick", "Tip"]);
+    }
 
     /// Words of a path become labels; missing ones stay unset.
     #[test]
@@ -778,6 +892,7 @@ mod tests {
             tips: [Some("TipL".into()), Some("TipR".into())],
             up: UpAxis::Y,
             tip_offset_m: None,
+            markers_from_tip: false,
             align: Alignment::None,
             mode: None,
             location: None,

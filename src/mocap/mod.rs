@@ -7,6 +7,7 @@ pub mod db;
 pub mod import;
 pub mod ingest;
 pub mod labcorpus;
+pub mod marker_body;
 pub mod segment;
 pub mod shipped;
 pub mod stats;

@@ -39,6 +39,7 @@
 
 use super::segment::{Impact, SegmentParams, find_impacts};
 use crate::base::stats::median;
+use crate::body::limits::symmetric_eigen;
 use glam::{DMat3, DMat4, DQuat, DVec3, DVec4};
 
 /// The estimated tip offset and how well the capture determines it.
@@ -75,8 +76,25 @@ pub enum TipEstimateError {
     TooFewImpacts(usize),
 }
 
-/// Prior distance from the body origin to the tip, m.
-const PRIOR_LENGTH_M: f64 = 0.30;
+/// What is known beforehand of where the tip lies in the body's frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TipPrior {
+    /// A rigid body of unknown layout (a marker cluster near the grip): the tip
+    /// [`PRIOR_LENGTH_M`] from its origin, in the stroke plane, at the end that comes
+    /// down faster (module doc, step 3).
+    Cluster,
+    /// Markers along the stick (`mocap::marker_body`): the tip on the body's x axis, at
+    /// one of the two places `ends_m` (one past each end of the markers, m): whichever
+    /// comes down faster.
+    OnAxis { ends_m: [f64; 2] },
+}
+
+/// Standard deviation of the prior across the stick, for markers along it, m.
+const ACROSS_STICK_SD_M: f64 = 0.015;
+
+/// Prior distance from the body origin to the tip, m (also used by `mocap::marker_body`
+/// for markers close together on the shaft).
+pub const PRIOR_LENGTH_M: f64 = 0.30;
 /// Standard deviation of every prior, m.
 const PRIOR_SD_M: f64 = 0.05;
 /// Assumed scatter of one impact's tip height about the plane, m.
@@ -99,6 +117,7 @@ pub fn estimate(
     rotations: &[Option<DQuat>],
     rate_hz: f64,
     head_height_m: f64,
+    known: TipPrior,
 ) -> Result<TipEstimate, TipEstimateError> {
     if rotations.iter().all(Option::is_none) {
         return Err(TipEstimateError::NoRotations);
@@ -108,11 +127,23 @@ pub fn estimate(
         .zip(rotations.iter().chain(std::iter::repeat(&None)))
         .map(|(p, q)| Some((*p.as_ref()?, *q.as_ref()?)))
         .collect();
-    let impacts = impact_frames(&poses, rate_hz);
+    let (impacts, prior) = match known {
+        TipPrior::Cluster => {
+            let impacts = impact_frames(&poses, rate_hz);
+            let prior = cluster_prior(&poses, &impacts, rate_hz, head_height_m);
+            (impacts, prior)
+        }
+        // The tip is known to lie on the axis near one end: that point's own impacts.
+        TipPrior::OnAxis { ends_m } => {
+            let tip = faster_end(&poses, DVec3::X * ends_m[0], DVec3::X * ends_m[1], rate_hz);
+            let impacts = impacts_near_tip(&poses, tip, rate_hz);
+            let sd = DVec3::new(PRIOR_SD_M, ACROSS_STICK_SD_M, ACROSS_STICK_SD_M);
+            (impacts.iter().map(|i| i.frame).collect(), (tip, sd))
+        }
+    };
     if impacts.len() < 4 {
         return Err(TipEstimateError::TooFewImpacts(impacts.len()));
     }
-    let prior = prior_offset(&poses, &impacts, rate_hz, head_height_m);
     let noise = rotation_noise_var(&poses);
     Ok(fit(&poses, &impacts, prior, noise, head_height_m))
 }
@@ -125,15 +156,26 @@ fn point(pose: Pose, d: DVec3) -> DVec3 {
 /// The impacts of the body point `d`: segmentation of its height without the plane test
 /// (a point off the tip meets the head at heights that vary with the stick's angle).
 fn impacts_of_point(poses: &[Option<Pose>], d: DVec3, rate_hz: f64) -> Vec<Impact> {
-    let z: Vec<f64> = poses
-        .iter()
-        .map(|s| s.map_or(f64::NAN, |s| point(s, d).z))
-        .collect();
     let params = SegmentParams {
         plane_tolerance_m: None,
         ..SegmentParams::default()
     };
-    find_impacts(&z, rate_hz, &params).0
+    find_impacts(&heights(poses, d), rate_hz, &params).0
+}
+
+/// The impacts of a body point near the tip, with segmentation's plane test: a point a
+/// few centimetres along the stick from the tip meets the head at nearly one height, and
+/// a turn in mid-air (a bounce, a marker's wobble) is far above it.
+fn impacts_near_tip(poses: &[Option<Pose>], d: DVec3, rate_hz: f64) -> Vec<Impact> {
+    find_impacts(&heights(poses, d), rate_hz, &SegmentParams::default()).0
+}
+
+/// The height of body point `d` per frame (NaN where unseen), m.
+fn heights(poses: &[Option<Pose>], d: DVec3) -> Vec<f64> {
+    poses
+        .iter()
+        .map(|s| s.map_or(f64::NAN, |s| point(s, d).z))
+        .collect()
 }
 
 /// The impact frames every point of the stick agrees on: impacts are found on the origin
@@ -178,17 +220,30 @@ fn impact_frames(poses: &[Option<Pose>], rate_hz: f64) -> Vec<usize> {
     frames
 }
 
-/// The prior tip (module doc, step 3): `a·ĝ ± b·ĥ` with `ĝ` the stick's vertical at
-/// impact, `ĥ` the horizontal direction in the stroke plane, its sign the end that comes
-/// down faster (the far end from the grip the stick turns about),
-/// `a` putting the tip on a head `head_height_m` above the floor and `b` making the
-/// distance [`PRIOR_LENGTH_M`].
-fn prior_offset(
+/// Of two body points, the one that comes down faster to its impacts (the tip end of
+/// the stick, farther from the grip it turns about).
+fn faster_end(poses: &[Option<Pose>], a: DVec3, b: DVec3, rate_hz: f64) -> DVec3 {
+    let speed = |d: DVec3| {
+        median_or_zero(
+            impacts_of_point(poses, d, rate_hz)
+                .iter()
+                .map(|i| i.approach_mps),
+        )
+    };
+    if speed(a) >= speed(b) { a } else { b }
+}
+
+/// The prior tip of a rigid body (module doc, step 3) and its standard deviation per
+/// body axis (m): `a·ĝ ± b·ĥ` with `ĝ` the stick's vertical at impact, `ĥ` the
+/// horizontal direction in the stroke plane, `a` putting the tip on a head
+/// `head_height_m` above the floor and `b` making the distance [`PRIOR_LENGTH_M`], the
+/// sign that of the end that comes down faster.
+fn cluster_prior(
     poses: &[Option<Pose>],
     impacts: &[usize],
     rate_hz: f64,
     head_height_m: f64,
-) -> DVec3 {
+) -> (DVec3, DVec3) {
     let at: Vec<Pose> = impacts.iter().filter_map(|&i| poses[i]).collect();
     let g = at
         .iter()
@@ -201,20 +256,10 @@ fn prior_offset(
     let origin_height = median_or_zero(at.iter().map(|p| p.0.z));
     let a = (head_height_m - origin_height).min(0.0);
     let b = (PRIOR_LENGTH_M * PRIOR_LENGTH_M - a * a).max(0.01).sqrt();
-    // The tip is the end that comes down fastest (farthest from the grip it turns about).
-    let speed = |d: DVec3| {
-        median_or_zero(
-            impacts_of_point(poses, d, rate_hz)
-                .iter()
-                .map(|i| i.approach_mps),
-        )
-    };
-    let (ahead, behind) = (g * a + forward * b, g * a - forward * b);
-    if speed(ahead) >= speed(behind) {
-        ahead
-    } else {
-        behind
-    }
+    (
+        faster_end(poses, g * a + forward * b, g * a - forward * b, rate_hz),
+        DVec3::splat(PRIOR_SD_M),
+    )
 }
 
 /// The body axis the stick mostly turns about: the principal direction of its angular
@@ -300,43 +345,6 @@ fn turn_between(a: Pose, b: Pose) -> DVec3 {
     axis * angle
 }
 
-/// Eigenvalues and unit eigenvectors of a symmetric 3×3 matrix (cyclic Jacobi
-/// rotations, `A ← JᵀAJ`, `V ← VJ`, until the off-diagonal vanishes).
-fn symmetric_eigen(m: DMat3) -> ([f64; 3], [DVec3; 3]) {
-    // a[i][j]: row i, column j (the matrix is symmetric, so the layout does not matter).
-    let mut a = m.to_cols_array_2d();
-    let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    for _ in 0..20 {
-        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
-            if a[p][q].abs() < 1e-300 {
-                continue;
-            }
-            let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-            let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-            let c = 1.0 / (t * t + 1.0).sqrt();
-            let s = t * c;
-            for row in &mut a {
-                let (kp, kq) = (row[p], row[q]);
-                row[p] = c * kp - s * kq;
-                row[q] = s * kp + c * kq;
-            }
-            let (row_p, row_q) = (a[p], a[q]);
-            a[p] = std::array::from_fn(|k| c * row_p[k] - s * row_q[k]);
-            a[q] = std::array::from_fn(|k| s * row_p[k] + c * row_q[k]);
-            for row in &mut v {
-                let (kp, kq) = (row[p], row[q]);
-                row[p] = c * kp - s * kq;
-                row[q] = s * kp + c * kq;
-            }
-        }
-    }
-    let column = |i: usize| DVec3::new(v[0][i], v[1][i], v[2][i]);
-    (
-        [a[0][0], a[1][1], a[2][2]],
-        [column(0), column(1), column(2)],
-    )
-}
-
 /// The lowest height of point `d` within [`NEAR_FRAMES`] of each impact, with its frame.
 fn lowest_near(poses: &[Option<Pose>], impacts: &[usize], d: DVec3) -> Vec<(usize, f64)> {
     impacts
@@ -353,11 +361,11 @@ fn lowest_near(poses: &[Option<Pose>], impacts: &[usize], d: DVec3) -> Vec<(usiz
 fn fit(
     poses: &[Option<Pose>],
     impacts: &[usize],
-    prior: DVec3,
+    prior: (DVec3, DVec3),
     noise_var: f64,
     head_height_m: f64,
 ) -> TipEstimate {
-    let mut d = prior;
+    let mut d = prior.0;
     let mut rows: Vec<(DVec3, f64)> = Vec::new();
     let mut keep: Vec<bool> = Vec::new();
     let mut solution = (d, head_height_m, DMat4::IDENTITY);
@@ -408,18 +416,18 @@ fn fit(
 }
 
 /// Solve `g·d − h = −z` over the kept rows (each with [`IMPACT_SD_M`]) together with the
-/// priors `d ≈ prior`, `h ≈ head_height_m` (each [`PRIOR_SD_M`]). Returns `d`, `h` and
-/// the posterior covariance.
+/// priors `d ≈ prior.0` (standard deviations `prior.1`), `h ≈ head_height_m`
+/// ([`PRIOR_SD_M`]). Returns `d`, `h` and the posterior covariance.
 fn solve(
     rows: &[(DVec3, f64)],
     keep: &[bool],
-    prior: DVec3,
+    prior: (DVec3, DVec3),
     head_height_m: f64,
 ) -> (DVec3, f64, DMat4) {
     let data_weight = 1.0 / (IMPACT_SD_M * IMPACT_SD_M);
-    let prior_weight = 1.0 / (PRIOR_SD_M * PRIOR_SD_M);
-    let mut precision = DMat4::from_diagonal(DVec4::splat(prior_weight));
-    let mut rhs = prior.extend(head_height_m) * prior_weight;
+    let prior_weight = prior.1.extend(PRIOR_SD_M).powf(-2.0);
+    let mut precision = DMat4::from_diagonal(prior_weight);
+    let mut rhs = prior.0.extend(head_height_m) * prior_weight;
     for (&(g, z), _) in rows.iter().zip(keep).filter(|(_, k)| **k) {
         let a = DVec4::new(g.x, g.y, g.z, -1.0);
         precision += DMat4::from_cols(a * a.x, a * a.y, a * a.z, a * a.w) * data_weight;
@@ -502,7 +510,7 @@ mod tests {
     #[test]
     fn finds_the_tip_of_a_rigid_stick() {
         let (p, q, truth) = rigid_stick(200.0, 0.001);
-        let e = estimate(&p, &q, 200.0, 0.76).unwrap();
+        let e = estimate(&p, &q, 200.0, 0.76, TipPrior::Cluster).unwrap();
         let error = (e.offset_m - truth).length();
         eprintln!("tip estimate off by {:.1} mm: {e:?}", error * 1e3);
         assert!(e.impacts >= 12, "{e:?}");
@@ -515,32 +523,17 @@ mod tests {
         assert!((e.plane_height_m - 0.76).abs() < 0.005, "{e:?}");
     }
 
-    /// The Jacobi solver diagonalises a symmetric matrix: A·v = λ·v for each pair.
-    #[test]
-    fn symmetric_eigen_pairs() {
-        let m = DMat3::from_cols(
-            DVec3::new(4.0, 1.0, -2.0),
-            DVec3::new(1.0, 3.0, 0.5),
-            DVec3::new(-2.0, 0.5, 1.0),
-        );
-        let (values, vectors) = symmetric_eigen(m);
-        for (l, v) in values.iter().zip(vectors) {
-            assert!((v.length() - 1.0).abs() < 1e-9);
-            assert!((m * v - v * *l).length() < 1e-9, "{l} {v}");
-        }
-    }
-
     /// Markers without orientation, or no impacts, give a clear error.
     #[test]
     fn refuses_what_it_cannot_use() {
         let still = vec![Some(DVec3::new(0.0, 0.0, 1.0)); 400];
         assert_eq!(
-            estimate(&still, &[], 200.0, 0.76),
+            estimate(&still, &[], 200.0, 0.76, TipPrior::Cluster),
             Err(TipEstimateError::NoRotations)
         );
         let q = vec![Some(DQuat::IDENTITY); 400];
         assert!(matches!(
-            estimate(&still, &q, 200.0, 0.76),
+            estimate(&still, &q, 200.0, 0.76, TipPrior::Cluster),
             Err(TipEstimateError::TooFewImpacts(0))
         ));
     }

@@ -74,6 +74,8 @@ pub(super) fn lab_tracks(
                 hand: s.side,
                 impacts: s.impacts.clone(),
                 tip_offset_body_m: offset,
+                stick_markers_m: (!style.layout.rigid_body() && !style.stick_markers_m.is_empty())
+                    .then(|| style.stick_markers_m.clone()),
                 gaps: Vec::new(),
             }
         })
@@ -126,8 +128,26 @@ pub(super) fn push_markers(
     let to_lab = |v: &[DVec3]| -> Vec<Option<DVec3>> {
         v.iter().map(|p| Some(lab.to_lab(*p, style.up))).collect()
     };
-    let label = format!("{prefix}Tip{letter}");
-    tracks.push(marker_track(label.clone(), to_lab(&s.tip)));
+    let label = if style.stick_markers_m.is_empty() {
+        let label = format!("{prefix}Tip{letter}");
+        tracks.push(marker_track(label.clone(), to_lab(&s.tip)));
+        label
+    } else {
+        let mut labels = Vec::new();
+        for (k, place) in style.stick_markers_m.iter().enumerate() {
+            let on_stick = DVec3::from(*place);
+            let positions: Vec<DVec3> = s
+                .tip
+                .iter()
+                .zip(&s.stick)
+                .map(|(t, q)| *t + *q * on_stick)
+                .collect();
+            let label = format!("{prefix}Stick{letter}{}", k + 1);
+            tracks.push(marker_track(label.clone(), to_lab(&positions)));
+            labels.push(label);
+        }
+        labels.join("+")
+    };
     for (name, positions) in &s.markers {
         tracks.push(marker_track(
             format!("{prefix}{name}{letter}"),
@@ -268,9 +288,15 @@ pub(super) fn capture(take: &PerformerTake, style: &LabStyle, rng: Rng) -> Gener
         tracks = with_cluster_markers(tracks);
     }
     for t in &mut truth_tracks {
-        if let Some(track) = tracks.iter().find(|k| k.label == t.label) {
-            t.gaps = track.gaps.clone();
-        }
+        // A stick of loose markers (`A+B+…`) has the gaps of each of them.
+        let mut gaps: Vec<[usize; 2]> = t
+            .label
+            .split('+')
+            .filter_map(|label| tracks.iter().find(|k| k.label == label))
+            .flat_map(|track| track.gaps.iter().copied())
+            .collect();
+        gaps.sort_unstable();
+        t.gaps = gaps;
     }
     let dropped = dropped_frames(frames, style.dropped_fraction, &mut rng.fork(u64::MAX));
     let rows = (0..frames)

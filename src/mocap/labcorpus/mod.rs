@@ -145,6 +145,10 @@ use std::f64::consts::FRAC_PI_2;
 use std::fmt::Write as _;
 use std::path::Path;
 
+/// How far a shaft marker's centre stands off the stick's axis, m (a 9.5 mm marker on a
+/// 12 mm shaft, with its base).
+pub const SHAFT_MARKER_RADIUS_M: f64 = 0.012;
+
 /// The truth file's format version.
 pub const TRUTH_FORMAT_VERSION: u32 = 1;
 
@@ -240,6 +244,11 @@ pub struct LabStyle {
     pub origin_from_tip_m: f64,
     /// The marker cluster's rotation in the stick frame (rigid body = stick · cluster).
     pub cluster: DQuat,
+    /// Marker layouts: loose markers on each stick (`Stick{L,R}1`, `2`, …) written
+    /// instead of a tip marker, at these places in the stick frame (m; +z along the stick
+    /// from the tip toward the grip; [`LabStyle::on_the_shaft`] puts them on the shaft);
+    /// empty: a tip marker.
+    pub stick_markers_m: Vec<[f64; 3]>,
     pub sticks: Sticks,
     /// An extra first line, if any (the vendor layout's own title is replaced by it).
     pub title: Option<String>,
@@ -286,6 +295,7 @@ impl LabStyle {
             translation_m: DVec3::new(1.84, -0.62, 0.05),
             origin_from_tip_m: 0.27,
             cluster: DQuat::from_rotation_x(FRAC_PI_2) * DQuat::from_rotation_z(20f64.to_radians()),
+            stick_markers_m: Vec::new(),
             sticks: Sticks::Playing,
             title: None,
             gap_fraction: 0.02,
@@ -295,6 +305,21 @@ impl LabStyle {
             rotation_noise_rad: 0.3f64.to_radians(),
             seed: 2026,
         }
+    }
+
+    /// Markers on the shaft at these distances from the tip (m), each
+    /// [`SHAFT_MARKER_RADIUS_M`] off the axis at 120° from the last, for
+    /// [`LabStyle::stick_markers_m`].
+    pub fn on_the_shaft(along_m: &[f64]) -> Vec<[f64; 3]> {
+        along_m
+            .iter()
+            .enumerate()
+            .map(|(k, d)| {
+                let angle = k as f64 * std::f64::consts::TAU / 3.0;
+                let r = SHAFT_MARKER_RADIUS_M;
+                [r * angle.cos(), r * angle.sin(), *d]
+            })
+            .collect()
     }
 
     /// The same style without noise, gaps or dropped rows.
@@ -458,6 +483,10 @@ pub struct TrackTruth {
     /// For a rigid body: the tip in the body frame, m (`tip = origin + R·offset`);
     /// `None` for a tip marker.
     pub tip_offset_body_m: Option<[f64; 3]>,
+    /// For a stick of loose markers (the label joins them with `+`): their places in the
+    /// stick frame, m (+z along the stick from the tip toward the grip).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stick_markers_m: Option<Vec<[f64; 3]>>,
     /// Runs of missing frames: [first frame (0-based), length].
     pub gaps: Vec<[usize; 2]>,
 }
