@@ -33,6 +33,12 @@
 //!    and impacts over 3 MAD from the fit dropped. Each component's standard error is
 //!    reported; one near 5 cm means the priors, not the capture, placed it.
 //!
+//! **Markers along the stick** (`TipPrior::OnAxis`, from `mocap::marker_body`): the tip
+//! lies on the body's x axis near one end of the markers, so the impacts are that
+//! point's own (with segmentation's plane test: a point a few centimetres off the tip
+//! meets the head at nearly one height), and only its place along the axis is fitted,
+//! from the x component of `g` (the stick's tilt): a line of markers tells no roll.
+//!
 //! An error in an unobservable direction moves every impact by nearly the same vector,
 //! which the alignment to the drum (`mocap::align`) absorbs; it bends the path between
 //! impacts a little. When the tip offset is known, give it.
@@ -145,7 +151,9 @@ pub fn estimate(
         return Err(TipEstimateError::TooFewImpacts(impacts.len()));
     }
     let noise = rotation_noise_var(&poses);
-    Ok(fit(&poses, &impacts, prior, noise, head_height_m))
+    // On the axis, only the stick's tilt counts: a line of markers tells no roll.
+    let on_axis = matches!(known, TipPrior::OnAxis { .. });
+    Ok(fit(&poses, &impacts, prior, noise, head_height_m, on_axis))
 }
 
 /// The world point of body point `d`.
@@ -357,13 +365,15 @@ fn lowest_near(poses: &[Option<Pose>], impacts: &[usize], d: DVec3) -> Vec<(usiz
         .collect()
 }
 
-/// The posterior mean of `d` and `h` (module doc, step 4).
+/// The posterior mean of `d` and `h` (module doc, step 4); `on_axis`: `d` on the body's x
+/// axis, only the x component of `g` (the stick's tilt) used.
 fn fit(
     poses: &[Option<Pose>],
     impacts: &[usize],
     prior: (DVec3, DVec3),
     noise_var: f64,
     head_height_m: f64,
+    on_axis: bool,
 ) -> TipEstimate {
     let mut d = prior.0;
     let mut rows: Vec<(DVec3, f64)> = Vec::new();
@@ -373,6 +383,7 @@ fn fit(
         let raw: Vec<(DVec3, f64)> = lowest_near(poses, impacts, d)
             .into_iter()
             .filter_map(|(f, _)| poses[f].map(|p| (p.1.conjugate() * DVec3::Z, p.0.z)))
+            .map(|(g, z)| (if on_axis { DVec3::X * g.x } else { g }, z))
             .collect();
         let usual = usual_angles(&raw);
         keep = usual.clone();
