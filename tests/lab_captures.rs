@@ -609,3 +609,40 @@ fn loose_shaft_markers_over_twelve_takes() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Naming a marker twice, or joining one that is not on the stick, is refused with the
+/// stick named and why; nothing is added to the database.
+#[test]
+fn loose_marker_mistakes_are_refused() {
+    let db = shipped_db();
+    let style = LabStyle {
+        stick_markers_m: LabStyle::on_the_shaft(&[0.06, 0.16, 0.26]),
+        ..LabStyle::typical(Layout::Vicon)
+    };
+    let capture = labcorpus::generate(&db, 17 % db.index.takes.len(), &style).unwrap();
+    let dir = std::env::temp_dir().join(format!("timpanist-lab-mistake-{}", std::process::id()));
+    let (path, take) = write_and_read(&capture, &dir);
+    std::fs::remove_dir_all(&dir).ok();
+    for (label, why) in [
+        (
+            "StickR1+StickR1",
+            "names the track \"Player:StickR1\" twice",
+        ),
+        ("StickR1+ShoulderR", "do not move as one stick"),
+    ] {
+        let mut options = options_for(&capture.truth, Alignment::None);
+        options.tips = [None, Some(label.into())];
+        let mut out = MotionDb::empty("test");
+        let error = ingest::ingest(&mut out, &path, &take, &options)
+            .map(|_| ())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("stick \"Player:StickR1+")
+                || error.contains(&format!("stick \"{label}\"")),
+            "{error}"
+        );
+        assert!(error.contains(why), "{error}");
+        assert!(out.index.units.is_empty());
+    }
+}

@@ -621,7 +621,12 @@ fn print_report(source: &Source, report: &IngestReport, align: &Alignment) {
         );
         if h.tip_estimate.is_some_and(|e| e.rests_on_priors()) {
             println!(
-                "    the capture hardly tells where the tip is (the stick meets the head at nearly one angle): the estimate below leans on the priors (head 0.76 m above the floor, tip 0.30 m from the body origin); give --tip-offset if you know it"
+                "    the capture hardly tells where the tip is (the stick meets the head at nearly one angle): the estimate below leans on the priors ({})",
+                if h.loose_markers {
+                    "head 0.76 m above the floor, tip on the markers' axis 5 cm past them, or 0.30 m from their centre when they sit close together"
+                } else {
+                    "head 0.76 m above the floor, tip 0.30 m from the body origin; give --tip-offset if you know it"
+                }
             );
         }
         if let Some(e) = &h.tip_estimate {

@@ -139,6 +139,10 @@ pub struct HandReport {
     pub filled_frames: usize,
     /// The tip offset estimated for a rigid body given none.
     pub tip_estimate: Option<TipEstimate>,
+    /// Whether the stick is loose markers made into a body (`mocap::marker_body`), whose
+    /// tip is placed beforehand past the markers on their axis rather than 0.30 m from a
+    /// rigid body's origin.
+    pub loose_markers: bool,
     /// Where the impacts landed after alignment.
     pub fit: Option<HandFit>,
     /// The mean tip position at the impacts, as stored (after alignment), m.
@@ -295,6 +299,7 @@ pub fn ingest(
             missing_frames: seg.missing_frames,
             filled_frames: seg.filled_frames,
             tip_estimate: s.estimate,
+            loose_markers: s.label.contains('+'),
             fit: fits.iter().find(|f| f.hand == s.hand).copied(),
             impact_centroid_m: {
                 let at: Vec<DVec3> = seg.impacts.iter().filter_map(|&i| filled[i]).collect();
@@ -565,16 +570,27 @@ fn stick(
 }
 
 /// The tracks a stick's label names: one track, or the markers of `A+B+…` (one stick
-/// of loose markers); an error names a missing one and lists the labels the file has.
+/// of loose markers); an error names a missing one (listing the labels the file has) or
+/// one named twice.
 fn find_tracks<'a>(
     path: &Path,
     take: &'a Take,
     label: &str,
 ) -> Result<Vec<&'a Track>, ImportError> {
-    label
+    let tracks = label
         .split('+')
         .map(|one| find_track(path, take, one.trim()))
-        .collect()
+        .collect::<Result<Vec<_>, _>>()?;
+    for (i, t) in tracks.iter().enumerate() {
+        if tracks[..i].iter().any(|u| std::ptr::eq(*u, *t)) {
+            return Err(ImportError::format(
+                path,
+                format!("stick \"{label}\""),
+                format!("names the track \"{}\" twice", t.label),
+            ));
+        }
+    }
+    Ok(tracks)
 }
 
 /// The track labelled `label`, or an error listing the labels the file has.

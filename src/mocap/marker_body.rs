@@ -112,6 +112,10 @@ pub enum MarkerBodyError {
     NeverTogether(usize),
     #[error("its markers stand within {0:.1} mm of one another: they show no direction")]
     OnePoint(f64),
+    #[error(
+        "its markers do not move as one stick: in {misfit} of the {seen} frames where enough of them are seen they do not keep their places (is one of them not on the stick?)"
+    )]
+    NotRigid { misfit: usize, seen: usize },
 }
 
 /// The rigid body `tracks`' markers form (module doc).
@@ -182,6 +186,13 @@ pub fn from_markers(tracks: &[&Track]) -> Result<MarkerBody, MarkerBodyError> {
             Err(Misfit::Yes) => body.misfit_frames += 1,
             Err(Misfit::TooFewSeen) => {}
         }
+    }
+    let seen = body.misfit_frames + body.positions.iter().flatten().count();
+    if 2 * body.misfit_frames > seen {
+        return Err(MarkerBodyError::NotRigid {
+            misfit: body.misfit_frames,
+            seen,
+        });
     }
     Ok(body)
 }
@@ -558,6 +569,20 @@ mod tests {
         assert!(matches!(
             from_markers(&refs),
             Err(MarkerBodyError::OnePoint(_))
+        ));
+    }
+
+    /// A marker that is not on the stick (an arm marker joined by mistake) is refused.
+    #[test]
+    fn refuses_markers_that_do_not_move_together() {
+        let mut tracks = markers(&[DVec3::ZERO, DVec3::X * 0.2], 400, 0.0005, 5);
+        for (f, p) in tracks[1].positions.iter_mut().enumerate() {
+            *p = Some(DVec3::new(0.3, 0.2 * (f as f64 * 0.03).sin(), 1.4));
+        }
+        let refs: Vec<&Track> = tracks.iter().collect();
+        assert!(matches!(
+            from_markers(&refs),
+            Err(MarkerBodyError::NotRigid { .. })
         ));
     }
 
