@@ -730,7 +730,8 @@ fn pick<T: std::fmt::Debug + Copy>(
 
 /// Which hand a track label names, when it says: "left"/"right" in it, a word that is
 /// just L or R ("R_STICK_TIP", "RStick2", "Stick_L", "TipR"), or an L/R at either end
-/// of its letters ("StickL", "LSTK").
+/// of its letters ("StickL", "LSTK") — in its last `:`-separated part, else in the parts
+/// before it ("StickR:Marker1", a rigid body's marker in Motive).
 pub fn hand_from_label(label: &str) -> Option<Side> {
     let lower = label.to_ascii_lowercase();
     if lower.contains("left") {
@@ -739,7 +740,11 @@ pub fn hand_from_label(label: &str) -> Option<Side> {
     if lower.contains("right") {
         return Some(Side::Right);
     }
-    let name = label.rsplit(':').next().unwrap_or(label);
+    label.rsplit(':').find_map(hand_from_name)
+}
+
+/// [`hand_from_label`] for one part of a label, with no "left" or "right" in it.
+fn hand_from_name(name: &str) -> Option<Side> {
     let side = |c: char| match c {
         'L' | 'l' => Some(Side::Left),
         'R' | 'r' => Some(Side::Right),
@@ -831,6 +836,9 @@ mod tests {
             ("CLAV", None),
             ("StickTop", None),
             ("Marker1", None),
+            ("StickR:Marker1", Some(Side::Right)),
+            ("Player:TipL", Some(Side::Left)),
+            ("Player:CLAV", None),
         ];
         for (label, hand) in cases {
             assert_eq!(hand_from_label(label), hand, "{label}");
