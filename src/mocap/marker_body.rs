@@ -19,7 +19,11 @@
 //!    the shape, or a line whose markers' spacing is off by more than
 //!    [`SPACING_TOLERANCE`], is fitted again without its worst marker while enough
 //!    remain, else left missing (a marker swapped with its neighbour, or a reflection
-//!    taken for it); short gaps are filled downstream like any track's.
+//!    taken for it); short gaps are filled downstream like any track's. Markers that
+//!    misfit in most frames do not move as one stick (one of them is elsewhere): refused.
+//! 4. **Where the tip is expected** ([`MarkerBody::tip_prior`]): on the axis of markers
+//!    along the shaft, just past one end of them; a compact cluster says nothing of the
+//!    stick's direction, so it gets a rigid body's prior.
 //!
 //! Positions are metres in the file's own axes; rotations are world from body.
 
@@ -187,11 +191,11 @@ pub fn from_markers(tracks: &[&Track]) -> Result<MarkerBody, MarkerBodyError> {
             Err(Misfit::TooFewSeen) => {}
         }
     }
-    let seen = body.misfit_frames + body.positions.iter().flatten().count();
-    if 2 * body.misfit_frames > seen {
+    let judged = body.misfit_frames + body.positions.iter().flatten().count();
+    if 2 * body.misfit_frames > judged {
         return Err(MarkerBodyError::NotRigid {
             misfit: body.misfit_frames,
-            seen,
+            seen: judged,
         });
     }
     Ok(body)
