@@ -253,6 +253,33 @@ pub(super) fn punch_gaps(track: &mut OutTrack, runs: Vec<[usize; 2]>) {
     track.gaps = runs;
 }
 
+/// Swap the first two markers of a stick of loose markers (`label`: `A+B+…`) for
+/// `style.marker_swaps` runs of 5–40 frames each, as a labelling pass that mistook one
+/// for the other would.
+pub(super) fn swap_labels(tracks: &mut [OutTrack], label: &str, style: &LabStyle, rng: &mut Rng) {
+    let names: Vec<&str> = label.split('+').collect();
+    let (Some(a), Some(b)) = (
+        tracks
+            .iter()
+            .position(|t| Some(&t.label.as_str()) == names.first()),
+        tracks
+            .iter()
+            .position(|t| Some(&t.label.as_str()) == names.get(1)),
+    ) else {
+        return;
+    };
+    let frames = tracks[a].positions.len();
+    for _ in 0..style.marker_swaps {
+        let len = 5 + (rng.unit() * 36.0) as usize;
+        let start = (rng.unit() * frames.saturating_sub(len) as f64) as usize;
+        for f in start..(start + len).min(frames) {
+            let p = tracks[a].positions[f];
+            tracks[a].positions[f] = tracks[b].positions[f];
+            tracks[b].positions[f] = p;
+        }
+    }
+}
+
 /// The frames to drop: about `fraction` of them, never the first or last.
 pub(super) fn dropped_frames(frames: usize, fraction: f64, rng: &mut Rng) -> Vec<usize> {
     let target = (fraction * frames as f64).round() as usize;
@@ -286,6 +313,14 @@ pub(super) fn capture(take: &PerformerTake, style: &LabStyle, rng: Rng) -> Gener
     }
     if style.layout == Layout::Motive {
         tracks = with_cluster_markers(tracks);
+    }
+    for (k, t) in truth_tracks.iter().enumerate() {
+        swap_labels(
+            &mut tracks,
+            &t.label,
+            style,
+            &mut rng.fork(0x5A9 + k as u64),
+        );
     }
     for t in &mut truth_tracks {
         // A stick of loose markers (`A+B+…`) has the gaps of each of them.

@@ -249,6 +249,9 @@ pub struct LabStyle {
     /// from the tip toward the grip; [`LabStyle::on_the_shaft`] puts them on the shaft);
     /// empty: a tip marker.
     pub stick_markers_m: Vec<[f64; 3]>,
+    /// Runs (5–40 frames each, per stick) where the first two loose stick markers have
+    /// each other's labels.
+    pub marker_swaps: usize,
     pub sticks: Sticks,
     /// An extra first line, if any (the vendor layout's own title is replaced by it).
     pub title: Option<String>,
@@ -296,6 +299,7 @@ impl LabStyle {
             origin_from_tip_m: 0.27,
             cluster: DQuat::from_rotation_x(FRAC_PI_2) * DQuat::from_rotation_z(20f64.to_radians()),
             stick_markers_m: Vec::new(),
+            marker_swaps: 0,
             sticks: Sticks::Playing,
             title: None,
             gap_fraction: 0.02,
@@ -322,13 +326,14 @@ impl LabStyle {
             .collect()
     }
 
-    /// The same style without noise, gaps or dropped rows.
+    /// The same style without noise, gaps, dropped rows or swapped markers.
     pub fn clean(&self) -> LabStyle {
         LabStyle {
             gap_fraction: 0.0,
             dropped_fraction: 0.0,
             position_noise_m: 0.0,
             rotation_noise_rad: 0.0,
+            marker_swaps: 0,
             ..self.clone()
         }
     }
