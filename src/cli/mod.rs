@@ -353,8 +353,9 @@ pub enum MocapCommand {
         #[arg(long)]
         profile: Option<String>,
         /// The sticks' tracks: "LEFT,RIGHT", "LEFT," / ",RIGHT", or one label (its hand
-        /// from --hand, the profile, or the label: StickL, RSTK, …) [default: from the
-        /// profile or the labels].
+        /// from --hand, the profile, or the label: StickL, RSTK, …); a stick tracked by
+        /// loose markers joins them with "+", from the tip toward the grip
+        /// ("RSTK1+RSTK2+RSTK3") [default: from the profile or the labels].
         #[arg(long, value_parser = parse_tips)]
         tips: Option<mocap::TipsArg>,
         /// Which axis of the capture points up (default: the profile's, y for Motive, z
