@@ -63,6 +63,7 @@ fn options_for(truth: &Truth, align: Alignment) -> IngestOptions {
         tip_offset_m: None,
         // As a user lists a stick's loose markers: from the tip (as the corpus writes them).
         markers_from_tip: true,
+        tip_past_first_m: None,
         align,
         mode: Some(
             truth
@@ -351,7 +352,8 @@ fn sticks_of_loose_markers_come_back() {
 
 /// A file whose stick is three loose markers (`StickR1`…`3`, beside arm markers) imports
 /// without `--tips`: the three are taken as one stick, its tip estimated, every stroke
-/// found.
+/// found; and as a lab that knows its layout gives it (`--tips A+B+C --tip-past 0.06`,
+/// placed as `marker_body`'s unit test checks), every stroke found with no estimate.
 #[test]
 fn cli_takes_a_hands_stick_markers_as_one_stick() {
     let db = shipped_db();
@@ -364,31 +366,41 @@ fn cli_takes_a_hands_stick_markers_as_one_stick() {
     let capture = labcorpus::generate(&db, 17 % db.index.takes.len(), &style).unwrap();
     let (name, bytes) = &capture.files[0];
     std::fs::write(dir.join(name), bytes).unwrap();
-    let output = std::process::Command::new(env!("CARGO_BIN_EXE_timpanist"))
-        .args(["mocap", "import", "--align", "auto"])
-        .arg(dir.join(name))
-        .arg("-o")
-        .arg(dir.join("db"))
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&output.stdout).to_string();
-    let stderr = String::from_utf8_lossy(&output.stderr).to_string();
+    let import = |extra: &[&str]| {
+        let output = std::process::Command::new(env!("CARGO_BIN_EXE_timpanist"))
+            .args(["mocap", "import", "--align", "auto"])
+            .args(extra)
+            .arg(dir.join(name))
+            .arg("-o")
+            .arg(dir.join("db"))
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&output.stdout).to_string();
+        let stderr = String::from_utf8_lossy(&output.stderr).to_string();
+        assert!(output.status.success(), "{stdout}\n{stderr}");
+        stdout
+    };
+    let found = import(&[]);
+    // The lab knows its layout: the first marker 6 cm from the tip.
+    let told = import(&["--tips", "StickR1+StickR2+StickR3", "--tip-past", "0.06"]);
     std::fs::remove_dir_all(&dir).ok();
-    assert!(output.status.success(), "{stdout}\n{stderr}");
     let track = &capture.truth.tracks[0];
     assert_eq!(track.label, "Player:StickR1+Player:StickR2+Player:StickR3");
-    let line = stdout
-        .lines()
-        .find(|l| l.contains(&format!("stick \"{}\"", track.label)))
-        .unwrap_or_else(|| panic!("{stdout}"));
-    let impacts: usize = line
-        .split(": ")
-        .nth(1)
-        .and_then(|s| s.split(' ').next())
-        .and_then(|s| s.parse().ok())
-        .unwrap_or_else(|| panic!("{line}"));
-    assert_eq!(impacts, track.impacts.len(), "{stdout}");
-    assert!(stdout.contains("tip estimated at"), "{stdout}");
+    for stdout in [&found, &told] {
+        let line = stdout
+            .lines()
+            .find(|l| l.contains(&format!("stick \"{}\"", track.label)))
+            .unwrap_or_else(|| panic!("{stdout}"));
+        let impacts: usize = line
+            .split(": ")
+            .nth(1)
+            .and_then(|s| s.split(' ').next())
+            .and_then(|s| s.parse().ok())
+            .unwrap_or_else(|| panic!("{line}"));
+        assert_eq!(impacts, track.impacts.len(), "{stdout}");
+    }
+    assert!(found.contains("tip estimated at"), "{found}");
+    assert!(!told.contains("tip estimated at"), "{told}");
 }
 
 /// A hand-given transform is applied as given: the stored tips are the lab tips turned

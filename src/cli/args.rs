@@ -64,6 +64,16 @@ pub fn parse_tips(s: &str) -> Result<crate::cli::mocap::TipsArg, String> {
     }
 }
 
+/// `--tip-past`: a distance in metres, 0–0.5.
+pub fn parse_tip_past(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(d) if (0.0..=0.5).contains(&d) => Ok(d),
+        _ => Err(format!(
+            "expected the tip's distance past the first marker, 0–0.5 metres, found \"{s}\""
+        )),
+    }
+}
+
 /// Three comma-separated numbers.
 pub fn parse_vec3(s: &str) -> Result<glam::DVec3, String> {
     let v: Vec<f64> = s

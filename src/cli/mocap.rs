@@ -167,6 +167,8 @@ pub struct ImportArgs {
     pub up: Option<UpAxis>,
     pub unit: Option<String>,
     pub tip_offset_m: Option<glam::DVec3>,
+    /// For a stick of loose markers: the tip's distance past the first, m.
+    pub tip_past_m: Option<f64>,
     /// "none", "auto" or "x,y,z,yaw".
     pub align: String,
     /// The kit to align to (default: the standard set).
@@ -245,6 +247,7 @@ pub fn import(args: ImportArgs) -> anyhow::Result<()> {
             tip_offset_m: source.tip_offset_m,
             // Markers the user listed (`--tips A+B+…`) run from the tip.
             markers_from_tip: !matches!(args.tips, TipsArg::Unnamed),
+            tip_past_first_m: args.tip_past_m,
             align: align.clone(),
             mode: args.mode,
             location: args.location,

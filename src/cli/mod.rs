@@ -19,8 +19,8 @@ mod transcribe;
 
 use crate::io::open::OpenAction;
 use args::{
-    DynamicArg, GripArg, LocationArg, ModeArg, RoomArg, SideArg, UpArg, parse_format, parse_tips,
-    parse_vec3,
+    DynamicArg, GripArg, LocationArg, ModeArg, RoomArg, SideArg, UpArg, parse_format,
+    parse_tip_past, parse_tips, parse_vec3,
 };
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -369,6 +369,10 @@ pub enum MocapCommand {
         /// profile's, else estimated from the impacts and reported).
         #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
         tip_offset: Option<glam::DVec3>,
+        /// For a stick of loose markers along its shaft (--tips A+B+…, from the tip): the
+        /// tip's distance past the first marker, metres (default: estimated).
+        #[arg(long, value_parser = parse_tip_past)]
+        tip_past: Option<f64>,
         /// Place the takes in the performer frame: "auto" fits each take's impacts to
         /// its drum's head, "x,y,z,yaw" (metres, degrees) turns about the vertical then
         /// moves, "none" keeps the capture's coordinates.
@@ -631,6 +635,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             up,
             unit,
             tip_offset,
+            tip_past,
             align,
             kit,
             drum,
@@ -650,6 +655,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             up: up.map(Into::into),
             unit,
             tip_offset_m: tip_offset,
+            tip_past_m: tip_past,
             align,
             kit,
             drum,

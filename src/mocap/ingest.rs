@@ -42,6 +42,9 @@ pub struct IngestOptions {
     /// grip, so the tip lies past the first (the user named them so); `false`: past the
     /// end that comes down faster (`mocap::marker_body`).
     pub markers_from_tip: bool,
+    /// For a stick of loose markers along its shaft: the tip lies this far past the first
+    /// listed marker, m; `None` estimates it.
+    pub tip_past_first_m: Option<f64>,
     /// How the take is placed in the performer frame.
     pub align: Alignment,
     /// Labels; `None` reads them from the file path (see [`labels_from_path`]).
@@ -498,9 +501,16 @@ fn stick(
             })?;
             if options.tip_offset_m.is_some() {
                 notices.push(format!(
-                    "stick \"{joined}\": --tip-offset is the tip in a rigid body's own frame; this stick is loose markers, whose frame is built here, so its tip is estimated"
+                    "stick \"{joined}\": --tip-offset is the tip in a rigid body's own frame; this stick is loose markers, whose frame is built here, so --tip-past or the estimate places its tip"
                 ));
             }
+            let given = options
+                .tip_past_first_m
+                .map(|d| body.tip_past_first(d))
+                .transpose()
+                .map_err(|e| {
+                    ImportError::format(path, format!("stick \"{joined}\""), e.to_string())
+                })?;
             if body.misfit_frames > 0 {
                 notices.push(format!(
                     "stick \"{joined}\": {} frames left out where its markers did not keep their places on the stick (a swapped or ghost marker)",
@@ -508,7 +518,7 @@ fn stick(
                 ));
             }
             let known = body.tip_prior(options.markers_from_tip);
-            (joined, body.positions, body.rotations, known, None)
+            (joined, body.positions, body.rotations, known, given)
         }
     };
     let positions: Vec<Option<DVec3>> = positions
@@ -731,8 +741,14 @@ fn pick<T: std::fmt::Debug + Copy>(
 /// Which hand a track label names, when it says: "left"/"right" in it, a word that is
 /// just L or R ("R_STICK_TIP", "RStick2", "Stick_L", "TipR"), or an L/R at either end
 /// of its letters ("StickL", "LSTK") — in its last `:`-separated part, else in the parts
-/// before it ("StickR:Marker1", a rigid body's marker in Motive).
+/// before it ("StickR:Marker1", a rigid body's marker in Motive); for a stick of loose
+/// markers (`A+B+…`), the hand all of them name.
 pub fn hand_from_label(label: &str) -> Option<Side> {
+    // A stick of loose markers (`A+B+…`): the hand all of them name.
+    if label.contains('+') {
+        let hands: Vec<Option<Side>> = label.split('+').map(hand_from_label).collect();
+        return hands[0].filter(|h| hands.iter().all(|o| *o == Some(*h)));
+    }
     let lower = label.to_ascii_lowercase();
     if lower.contains("left") {
         return Some(Side::Left);
@@ -839,6 +855,8 @@ mod tests {
             ("StickR:Marker1", Some(Side::Right)),
             ("Player:TipL", Some(Side::Left)),
             ("Player:CLAV", None),
+            ("LSTK1+LSTK2", Some(Side::Left)),
+            ("LSTK1+RSTK2", None),
         ];
         for (label, hand) in cases {
             assert_eq!(hand_from_label(label), hand, "{label}");
@@ -917,6 +935,7 @@ mod tests {
             up: UpAxis::Y,
             tip_offset_m: None,
             markers_from_tip: false,
+            tip_past_first_m: None,
             align: Alignment::None,
             mode: None,
             location: None,

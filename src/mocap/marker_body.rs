@@ -38,6 +38,8 @@ use glam::{DMat3, DQuat, DVec3};
 /// Markers within this distance of one line (RMS across it) are treated as a line, m
 /// (markers on a shaft stand about 12 mm off its axis; a cluster's arms 3 cm and more).
 pub const LINE_TOLERANCE_M: f64 = 0.015;
+/// And at most this share of their RMS reach along it.
+pub const LINE_SLENDERNESS: f64 = 0.25;
 /// A frame's markers may stand this far off the shape (RMS), m.
 pub const MISFIT_M: f64 = 0.01;
 /// A line's markers may be spaced this much (relative) off their usual spacing.
@@ -79,6 +81,22 @@ impl MarkerBody {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
                 (lo.min(p.x), hi.max(p.x))
             })
+    }
+
+    /// The tip, known to lie `distance_m` past the first marker along the shaft (away
+    /// from the others), in the body frame (m). Markers in a compact cluster, or listed
+    /// with a middle one first, do not say which way the shaft runs.
+    pub fn tip_past_first(&self, distance_m: f64) -> Result<DVec3, MarkerBodyError> {
+        let (lo, hi) = self.along_m();
+        if !self.line && hi - lo < SPREAD_ALONG_M {
+            return Err(MarkerBodyError::NotAlongShaft);
+        }
+        let first = self.layout.first().map_or(0.0, |p| p.x);
+        if (first - lo).abs() > 1e-9 && (first - hi).abs() > 1e-9 {
+            return Err(MarkerBodyError::FirstInMiddle);
+        }
+        let outward = if first >= 0.5 * (lo + hi) { 1.0 } else { -1.0 };
+        Ok(DVec3::X * (first + outward * distance_m))
     }
 
     /// Where the tip is expected before the capture says (`tip_estimate`): markers on
@@ -125,6 +143,14 @@ pub enum MarkerBodyError {
         "its markers do not move as one stick: in {misfit} of the {seen} frames where enough of them are seen they do not keep their places (is one of them not on the stick?)"
     )]
     NotRigid { misfit: usize, seen: usize },
+    #[error(
+        "its markers sit in a compact cluster, not along the shaft, so a distance past the first says nothing of where the tip is"
+    )]
+    NotAlongShaft,
+    #[error(
+        "its first marker is not at an end of the row along the shaft: list the markers from the tip"
+    )]
+    FirstInMiddle,
 }
 
 /// The rigid body `tracks`' markers form (module doc).
@@ -161,7 +187,9 @@ pub fn from_markers(tracks: &[&Track]) -> Result<MarkerBody, MarkerBodyError> {
     let axes = DMat3::from_cols(x, y, x.cross(y));
     let mut layout: Vec<DVec3> = shape.iter().map(|p| axes.transpose() * *p).collect();
     let across = (layout.iter().map(|p| p.y * p.y + p.z * p.z).sum::<f64>() / n as f64).sqrt();
-    let line = n == 2 || across < LINE_TOLERANCE_M;
+    // Across the line little, and little against the markers' reach along it (a small
+    // cluster's triangle is not a line).
+    let line = n == 2 || (across < LINE_TOLERANCE_M && across < LINE_SLENDERNESS * extent);
     if line {
         for p in &mut layout {
             *p = DVec3::X * p.x;
@@ -614,6 +642,38 @@ mod tests {
             let found = through_body(&body, tip, f).unwrap();
             assert!(found.distance(o + q * tip) < 1e-6, "frame {f}");
         }
+    }
+
+    /// A tip given as a distance past the first marker lands there, on the side away
+    /// from the others; a middle marker listed first, or a compact cluster, is refused.
+    #[test]
+    fn a_tip_past_the_first_marker() {
+        let shaft = markers(
+            &[DVec3::X * 0.05, DVec3::X * 0.15, DVec3::X * 0.25],
+            50,
+            0.0,
+            7,
+        );
+        let body = from_markers(&shaft.iter().collect::<Vec<_>>()).unwrap();
+        // The markers sit 5, 15 and 25 cm from the stick frame's origin: the tip.
+        let tip = body.tip_past_first(0.05).unwrap();
+        for f in 0..50 {
+            let (o, _) = stick_pose(f);
+            let found = body.positions[f].unwrap() + body.rotations[f].unwrap() * tip;
+            assert!(found.distance(o) < 1e-9, "frame {f}: {found} against {o}");
+        }
+        let reordered = [&shaft[1], &shaft[0], &shaft[2]];
+        let body = from_markers(&reordered).unwrap();
+        assert_eq!(
+            body.tip_past_first(0.05),
+            Err(MarkerBodyError::FirstInMiddle)
+        );
+        let cluster = markers(&[DVec3::ZERO, DVec3::Y * 0.04, DVec3::Z * 0.04], 50, 0.0, 8);
+        let body = from_markers(&cluster.iter().collect::<Vec<_>>()).unwrap();
+        assert_eq!(
+            body.tip_past_first(0.05),
+            Err(MarkerBodyError::NotAlongShaft)
+        );
     }
 
     /// Too few markers, never seen together, or all in one place: a clear error.
