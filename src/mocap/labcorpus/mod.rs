@@ -36,7 +36,10 @@
 //! origin on the stick `origin_from_tip_m` (default 0.27 m) from the tip, so that
 //! `tip = origin + R·tip_offset_body` with `tip_offset_body = R_c⁻¹·(0, 0, −d)` (in
 //! [`TrackTruth::tip_offset_body_m`]). A **marker** layout (Vicon, TRC) writes a tip
-//! marker per stick and arm markers (shoulder, elbow, wrist; finger for TrajOptDrums).
+//! marker per stick and arm markers (shoulder, elbow, wrist; finger for TrajOptDrums) —
+//! or, with [`LabStyle::stick_markers_m`], loose markers on each stick (`Stick{L,R}1`,
+//! `2`, …, their places in [`TrackTruth::stick_markers_m`]), the first two optionally
+//! swapping labels in runs ([`LabStyle::marker_swaps`]).
 //!
 //! Imperfections, all seeded: Gaussian noise on positions (default σ 1 mm per axis) and
 //! rotations (σ 0.3° per axis, applied in the lab frame); gaps (default 2 % of the frames
