@@ -131,6 +131,18 @@ fn tip_in_marker_body(take: &Take, label: &str, places: &[[f64; 3]]) -> DVec3 {
     body_mean - turn * stick_mean
 }
 
+/// [`run`] on every capture, then the scratch folder `dir` removed.
+fn run_all(
+    captures: &[GeneratedCapture],
+    dir: &Path,
+    kit: &Kit,
+    habits: &HabitBook,
+) -> Vec<Outcome> {
+    let outcomes = captures.iter().map(|c| run(c, dir, kit, habits)).collect();
+    std::fs::remove_dir_all(dir).ok();
+    outcomes
+}
+
 /// Import `capture` into a fresh database with `--align auto` and compare.
 fn run(capture: &GeneratedCapture, dir: &Path, kit: &Kit, habits: &HabitBook) -> Outcome {
     run_listed(capture, dir, kit, habits, true)
@@ -248,11 +260,7 @@ fn lab_captures_come_back() {
     let y = std::fs::read_to_string(fixture("trajoptdrums/JointCenters_YPose_cm.csv")).unwrap();
     captures
         .push(labcorpus::from_trajoptdrums(&x, &y, &LabStyle::typical(Layout::Vicon), 12).unwrap());
-    let outcomes: Vec<Outcome> = captures
-        .iter()
-        .map(|c| run(c, &dir, &kit, &habits))
-        .collect();
-    std::fs::remove_dir_all(&dir).ok();
+    let outcomes = run_all(&captures, &dir, &kit, &habits);
     report_and_check(&outcomes);
 }
 
@@ -336,11 +344,7 @@ fn sticks_of_loose_markers_come_back() {
         .unwrap()
         .with_suffix("-two-markers"),
     ];
-    let outcomes: Vec<Outcome> = captures
-        .iter()
-        .map(|c| run(c, &dir, &kit, &habits))
-        .collect();
-    std::fs::remove_dir_all(&dir).ok();
+    let outcomes = run_all(&captures, &dir, &kit, &habits);
     report_and_check(&outcomes);
     for o in &outcomes {
         let tip = o
@@ -698,11 +702,7 @@ fn a_compact_cluster_at_the_grip_over_twelve_takes() {
         [0.03, -0.02, 0.27],
         [-0.025, -0.015, 0.29],
     ];
-    let outcomes: Vec<Outcome> = twelve_takes(&db, &cluster, 0.0003, 0)
-        .iter()
-        .map(|c| run(c, &dir, &kit, &habits))
-        .collect();
-    std::fs::remove_dir_all(&dir).ok();
+    let outcomes = run_all(&twelve_takes(&db, &cluster, 0.0003, 0), &dir, &kit, &habits);
     print_table(&outcomes);
     for o in &outcomes {
         let false_found = (o.found - o.matched.min(o.found)) as f64 / o.found.max(1) as f64;
