@@ -187,6 +187,8 @@ struct Stick {
     /// A rigid body's origin (somewhere on the stick behind the tip); empty for a marker.
     origin: Vec<Option<DVec3>>,
     estimate: Option<TipEstimate>,
+    /// Whether the stick is loose markers made into a body (`mocap::marker_body`).
+    loose_markers: bool,
 }
 
 /// Add `take` (read from `path`) to `db` as a new take file `takes/NAME.tmot`.
@@ -302,7 +304,7 @@ pub fn ingest(
             missing_frames: seg.missing_frames,
             filled_frames: seg.filled_frames,
             tip_estimate: s.estimate,
-            loose_markers: s.label.contains('+'),
+            loose_markers: s.loose_markers,
             fit: fits.iter().find(|f| f.hand == s.hand).copied(),
             impact_centroid_m: {
                 let at: Vec<DVec3> = seg.impacts.iter().filter_map(|&i| filled[i]).collect();
@@ -496,9 +498,10 @@ fn stick(
                 .map(|t| t.label.as_str())
                 .collect::<Vec<_>>()
                 .join("+");
-            let body = marker_body::from_markers(markers).map_err(|e| {
+            let refused = |e: marker_body::MarkerBodyError| {
                 ImportError::format(path, format!("stick \"{joined}\""), e.to_string())
-            })?;
+            };
+            let body = marker_body::from_markers(markers).map_err(refused)?;
             if options.tip_offset_m.is_some() {
                 notices.push(format!(
                     "stick \"{joined}\": --tip-offset is the tip in a rigid body's own frame; this stick is loose markers, whose frame is built here, so --tip-past or the estimate places its tip"
@@ -508,9 +511,7 @@ fn stick(
                 .tip_past_first_m
                 .map(|d| body.tip_past_first(d))
                 .transpose()
-                .map_err(|e| {
-                    ImportError::format(path, format!("stick \"{joined}\""), e.to_string())
-                })?;
+                .map_err(refused)?;
             if body.misfit_frames > 0 {
                 notices.push(format!(
                     "stick \"{joined}\": {} frames left out where its markers did not keep their places on the stick (a swapped or ghost marker)",
@@ -576,6 +577,7 @@ fn stick(
             Vec::new()
         },
         estimate,
+        loose_markers: tracks.len() > 1,
     })
 }
 

@@ -83,19 +83,34 @@ impl MarkerBody {
             })
     }
 
+    /// Whether the markers show where the shaft runs: on one line, or spread over
+    /// [`SPREAD_ALONG_M`] of it.
+    fn along_shaft(&self) -> bool {
+        let (lo, hi) = self.along_m();
+        self.line || hi - lo >= SPREAD_ALONG_M
+    }
+
+    /// The first marker's place along the shaft, m, and whether it is nearer the high
+    /// end of the row than the low one.
+    fn first_along(&self) -> (f64, bool) {
+        let (lo, hi) = self.along_m();
+        let first = self.layout.first().map_or(0.0, |p| p.x);
+        (first, first >= 0.5 * (lo + hi))
+    }
+
     /// The tip, known to lie `distance_m` past the first marker along the shaft (away
     /// from the others), in the body frame (m). Markers in a compact cluster, or listed
     /// with a middle one first, do not say which way the shaft runs.
     pub fn tip_past_first(&self, distance_m: f64) -> Result<DVec3, MarkerBodyError> {
-        let (lo, hi) = self.along_m();
-        if !self.line && hi - lo < SPREAD_ALONG_M {
+        if !self.along_shaft() {
             return Err(MarkerBodyError::NotAlongShaft);
         }
-        let first = self.layout.first().map_or(0.0, |p| p.x);
+        let (lo, hi) = self.along_m();
+        let (first, high) = self.first_along();
         if (first - lo).abs() > 1e-9 && (first - hi).abs() > 1e-9 {
             return Err(MarkerBodyError::FirstInMiddle);
         }
-        let outward = if first >= 0.5 * (lo + hi) { 1.0 } else { -1.0 };
+        let outward = if high { 1.0 } else { -1.0 };
         Ok(DVec3::X * (first + outward * distance_m))
     }
 
@@ -108,21 +123,21 @@ impl MarkerBody {
     /// marker when `first_nearest_tip` (the user listed them from the tip), else the
     /// estimate's choice (the end that comes down faster).
     pub fn tip_prior(&self, first_nearest_tip: bool) -> TipPrior {
+        if !self.along_shaft() {
+            return TipPrior::Cluster;
+        }
         let (lo, hi) = self.along_m();
         let (ahead, behind) = if hi - lo >= SPREAD_ALONG_M {
             (hi + PAST_LAST_MARKER_M, lo - PAST_LAST_MARKER_M)
-        } else if self.line {
+        } else {
             let reach = tip_estimate::PRIOR_LENGTH_M;
             (reach, -reach)
-        } else {
-            return TipPrior::Cluster;
         };
-        let first = self.layout.first().map_or(0.0, |p| p.x);
-        let ends_m = match first_nearest_tip {
-            // The first marker nearer the high end: the tip is there.
-            true if first >= 0.5 * (lo + hi) => [ahead, ahead],
-            true => [behind, behind],
-            false => [ahead, behind],
+        let ends_m = match (first_nearest_tip, self.first_along().1) {
+            // Listed from the tip: the tip is past the end the first marker is nearer.
+            (true, true) => [ahead, ahead],
+            (true, false) => [behind, behind],
+            (false, _) => [ahead, behind],
         };
         TipPrior::OnAxis { ends_m }
     }
