@@ -1,6 +1,7 @@
 //! `timpanist mocap import` end to end: a Motive-style CSV export with one rigid body per
 //! stick (Y up, metres, 250 Hz), written from a synthetic take whose impacts are known,
-//! is cut into the right units; bad input leaves the database untouched.
+//! is cut into the right units; bad input, or a take with no strokes on the tracks
+//! taken as sticks, leaves the database untouched.
 
 use glam::{DQuat, DVec3};
 use std::fmt::Write as _;
@@ -125,6 +126,33 @@ fn motive_rigid_body_export_imports() {
         "tip back in the performer frame: {tip}"
     );
 
+    // Bodies named only by their hand ("L", "R") are the sticks when the take holds
+    // nothing else.
+    let plain = dir.path().join("legato_spot_f_french_plain.csv");
+    let renamed = motive_csv(&source)
+        .replace("StickL", "L")
+        .replace("StickR", "R");
+    std::fs::write(&plain, renamed).unwrap();
+    let plain_db = dir.path().join("plain-db");
+    let out = timpanist(&[
+        "mocap",
+        "import",
+        plain.to_str().unwrap(),
+        "--format",
+        "motive",
+        "--tip-offset",
+        &offset,
+        "-o",
+        plain_db.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let plain_units = MotionDb::load(&plain_db).unwrap().index.units;
+    assert_eq!(plain_units.len(), db.index.units.len());
+
     // A second file with an unknown label fails and leaves the database as it was.
     let before = std::fs::read_to_string(db_dir.join("index.ron")).unwrap();
     let out = timpanist(&[
@@ -144,30 +172,40 @@ fn motive_rigid_body_export_imports() {
     );
 }
 
-/// The real C3D files import (they hold no strokes, so no units) without error, and a
-/// corrupt capture fails with one line naming it.
+/// The real C3D files hold no strokes: one read with the wrists taken for sticks is
+/// refused naming the tracks, as is one whose only "right" label is a body's sternum
+/// (`Daphnee:STER`), and nothing is written; a corrupt capture fails with one line
+/// naming it.
 #[test]
 fn c3d_and_corrupt_files() {
     let dir = tempfile::tempdir().unwrap();
     let c3d = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/c3d/ezc3d_Vicon.c3d");
     let db_dir = dir.path().join("db");
-    let out = timpanist(&[
-        "mocap",
-        "import",
-        c3d.to_str().unwrap(),
-        "--tips",
-        "Daphnee:WRIST,Daphnee:INDEX",
-        "--mode",
-        "legato",
-        "-o",
-        db_dir.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let import = |extra: &[&str]| {
+        let mut args = vec!["mocap", "import", c3d.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["--mode", "legato", "-o", db_dir.to_str().unwrap()]);
+        timpanist(&args)
+    };
+    let out = import(&["--tips", "Daphnee:WRIST,Daphnee:INDEX"]);
+    assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stdout).contains("580 frames at 100 Hz"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("ezc3d_Vicon.c3d: no strokes found")
+            && err.contains("Left \"Daphnee:WRIST\"")
+            && err.contains("Right \"Daphnee:INDEX\""),
+        "{err}"
+    );
+    assert!(!db_dir.exists());
+    let out = import(&[]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("cannot tell which track is which stick") && err.contains("Daphnee:STER,"),
+        "{err}"
+    );
+    assert!(!db_dir.exists());
     let bad = dir.path().join("bad.c3d");
     std::fs::write(&bad, &std::fs::read(&c3d).unwrap()[..700]).unwrap();
     let out = timpanist(&[

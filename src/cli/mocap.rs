@@ -260,6 +260,7 @@ pub fn import(args: ImportArgs) -> anyhow::Result<()> {
         };
         let report = ingest(&mut db, &source.path, &source.take, &options)?;
         print_report(source, &report, &align);
+        refuse_if_strokeless(&source.path, &report)?;
         if matches!(align, Alignment::None) {
             warn_if_off_the_kit(&source.path, &report);
         }
@@ -487,7 +488,13 @@ fn resolve_tips(
             for side in [Side::Left, Side::Right] {
                 let mine: Vec<&str> = sides.iter().filter(|s| s.0 == side).map(|s| s.1).collect();
                 let sticks: Vec<&str> = mine.iter().copied().filter(|l| names_a_stick(l)).collect();
-                if let [one] = mine[..] {
+                // A lone hand-named track is the stick only if it says so, or if the
+                // take holds nothing else (two tracks, `L` and `R`): a body's
+                // `Daphnee:STER` reads as "right" too.
+                let sticks_only = labels.len() <= 2;
+                if let [one] = mine[..]
+                    && (names_a_stick(one) || sticks_only)
+                {
                     place(side, one.to_string());
                 } else if let Some(label) = one_stick(take, &sticks) {
                     place(side, label);
@@ -510,6 +517,24 @@ fn resolve_tips(
         );
     }
     Ok(tips)
+}
+
+/// A take none of whose sticks gave a stroke is not a stroke capture, or its sticks were
+/// taken from the wrong tracks: refuse it (before anything is written) naming them.
+fn refuse_if_strokeless(path: &Path, report: &IngestReport) -> anyhow::Result<()> {
+    if report.hands.iter().any(|h| h.units > 0) {
+        return Ok(());
+    }
+    let taken: Vec<String> = report
+        .hands
+        .iter()
+        .map(|h| format!("{:?} \"{}\"", h.hand, h.label))
+        .collect();
+    anyhow::bail!(
+        "{}: no strokes found on the tracks taken as sticks ({}); if they are not the sticks, name them with --tips LEFT,RIGHT; nothing written",
+        path.display(),
+        taken.join(", ")
+    )
 }
 
 /// A take kept in its own coordinates whose impacts are nowhere near a drum of the
