@@ -474,7 +474,8 @@ fn osc_sends_a_message_per_contact() {
     }
 }
 
-/// A bad `--osc` target is refused by name before anything is rendered or written.
+/// A bad `--osc` target is refused by name before anything is rendered or written; a
+/// good one where nothing listens gets a note, the render standing.
 #[test]
 fn osc_target_is_checked() {
     let dir = tempfile::tempdir().unwrap();
@@ -494,6 +495,26 @@ fn osc_target_is_checked() {
         assert!(err.contains("--osc"), "{bad}: {err}");
     }
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    // A good address where nothing listens (UDP): the render stands, with a note.
+    let port = std::net::UdpSocket::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let target = format!("127.0.0.1:{port}");
+    let out = render(
+        "scores/improvisation.ron",
+        &[
+            "--wav".as_ref(),
+            wav.as_os_str(),
+            "--osc".as_ref(),
+            target.as_ref(),
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("no program was listening"), "{err}");
+    assert!(wav.exists());
 }
 
 /// `--glb` is read back by the `gltf` crate (an independent reader): one scene with the

@@ -1,6 +1,6 @@
 //! The ground floor: the vocabulary every other layer shares and nothing else. Musical
 //! pitch, problems found while checking a file, the deterministic random generator,
-//! strict RON reading with atomic writing, the limits inputs are held to, the median, the
+//! strict RON reading, atomic writing (`staged`), the limits inputs are held to, the median, the
 //! words of a gesture score (side, hand, playing mode, grip, dynamic, impact location), a
 //! performed hit (`hit`: what `render` makes and `io` writes) and the choices its settings
 //! make (control pipeline, IK method, mode frequencies, sound model), work spread over
@@ -18,4 +18,5 @@ pub mod pitch;
 pub mod problem;
 pub mod rng;
 pub mod ron_file;
+pub mod staged;
 pub mod stats;

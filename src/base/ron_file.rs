@@ -78,19 +78,42 @@ pub fn unsupported_version(path: &Path, found: u32, supported: u32) -> FileError
     }
 }
 
-/// Read a whole text file (at most [`MAX_TEXT_FILE_BYTES`](super::limits::MAX_TEXT_FILE_BYTES)).
+/// Read a whole text file (at most [`MAX_TEXT_FILE_BYTES`](super::limits::MAX_TEXT_FILE_BYTES)),
+/// without the byte-order mark an editor on Windows may put first. Bytes that are not
+/// UTF-8 are refused naming their line and column (and what the file looks like, when it
+/// is a recording or a MIDI file given where a score belongs).
 pub fn read_text(path: &Path) -> Result<String, FileError> {
     let bytes = super::limits::read_at_most(path, super::limits::MAX_TEXT_FILE_BYTES, "text file")
         .map_err(|e| FileError::io(path, e))?;
-    String::from_utf8(bytes).map_err(|e| {
+    let mut text = String::from_utf8(bytes).map_err(|e| {
+        let valid = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+        let line = valid.iter().filter(|&&b| b == b'\n').count() + 1;
+        let column = valid.iter().rev().take_while(|&&b| b != b'\n').count() + 1;
+        let looks_like = match e.as_bytes() {
+            [b'M', b'T', b'h', b'd', ..] => "; it is a MIDI file: import it with import-midi",
+            [b'R', b'I', b'F', b'F', ..]
+            | [b'F', b'O', b'R', b'M', ..]
+            | [b'f', b'L', b'a', b'C', ..] => "; it is a recording: transcribe it with transcribe",
+            [b'P', b'K', ..] => {
+                "; it is a zip (a compressed MusicXML?): import it with import-musicxml"
+            }
+            _ => "",
+        };
         FileError::io(
             path,
             std::io::Error::new(
                 std::io::ErrorKind::InvalidData,
-                format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to()),
+                format!(
+                    "not UTF-8 text (line {line}, column {column}, byte {}){looks_like}",
+                    valid.len()
+                ),
             ),
         )
-    })
+    })?;
+    if text.starts_with('\u{feff}') {
+        text.drain(..'\u{feff}'.len_utf8());
+    }
+    Ok(text)
 }
 
 /// Parse RON text strictly into `T`, naming `path` and the line and column on error.
@@ -117,32 +140,16 @@ pub fn to_pretty<T: Serialize>(value: &T) -> String {
     text
 }
 
-/// Write `bytes` to `path` atomically: a temporary file beside it, synced, then renamed.
-/// On any error the target is untouched and no temporary file is left behind.
+/// Write `bytes` to `path` atomically ([`super::staged`]: a temporary file beside it,
+/// synced, then renamed; a link followed, a device written through). On any error the
+/// target is untouched and no temporary file is left behind.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".timpanist-").suffix(".tmp");
-    // A replaced file keeps its permissions; a new one gets the usual rw-r--r-- (a bare
-    // temporary file would be private to its owner).
-    #[cfg(unix)]
-    builder.permissions(std::fs::metadata(path).map_or_else(
-        |_| std::os::unix::fs::PermissionsExt::from_mode(0o644),
-        |m| m.permissions(),
-    ));
-    let mut tmp = builder
-        .tempfile_in(dir)
-        .map_err(|e| FileError::io(path, e))?;
-    tmp.write_all(bytes).map_err(|e| FileError::io(path, e))?;
-    tmp.as_file()
-        .sync_all()
-        .map_err(|e| FileError::io(path, e))?;
-    tmp.persist(path)
-        .map_err(|e| FileError::io(path, e.error))?;
-    Ok(())
+    let dest = super::staged::destination(path);
+    let io = |e| FileError::io(path, e);
+    let mut tmp = super::staged::beside(&dest, ".tmp").map_err(io)?;
+    tmp.write_all(bytes).map_err(io)?;
+    tmp.as_file().sync_all().map_err(io)?;
+    super::staged::put(tmp.into_temp_path(), &dest).map_err(io)
 }
 
 /// Save `value` as pretty RON to `path`, atomically.
@@ -242,6 +249,24 @@ mod tests {
     }
 
     /// The top-level name is found past comments and extension attributes.
+    /// A byte-order mark is dropped; bytes that are not UTF-8 are refused with their line
+    /// and column, and a MIDI file given as text is named as one.
+    #[test]
+    fn text_files_read_as_editors_write_them() {
+        let dir = tempfile::tempdir().unwrap();
+        let bom = dir.path().join("bom.ron");
+        std::fs::write(&bom, "\u{feff}Kit(a: 1)").unwrap();
+        assert_eq!(read_text(&bom).unwrap(), "Kit(a: 1)");
+        let latin = dir.path().join("latin.ron");
+        std::fs::write(&latin, b"Score(\n  title: \"\xc9tude\",\n)").unwrap();
+        let err = read_text(&latin).unwrap_err().to_string();
+        assert!(err.contains("line 2, column 11, byte 17"), "{err}");
+        let midi = dir.path().join("song.ron");
+        std::fs::write(&midi, b"MThd\0\0\0\x06\0\x01\0\x01\x01\xe0").unwrap();
+        let err = read_text(&midi).unwrap_err().to_string();
+        assert!(err.contains("it is a MIDI file"), "{err}");
+    }
+
     #[test]
     fn finds_top_level_name() {
         assert_eq!(

@@ -11,6 +11,7 @@ mod midi;
 mod mocap;
 mod musicxml;
 mod osc;
+mod overwrite;
 mod pack;
 mod render;
 mod sound;
@@ -518,6 +519,9 @@ fn edit(_score: Option<PathBuf>) -> anyhow::Result<ExitCode> {
 }
 
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
+    if let Some(command) = &cli.command {
+        overwrite::check_outputs(command)?;
+    }
     match cli.command {
         None => match cli.file {
             Some(file) => open_file(&file),

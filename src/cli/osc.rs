@@ -30,10 +30,18 @@ pub fn connect((host, port): &(String, u16)) -> anyhow::Result<UdpSocket> {
     Ok(socket)
 }
 
+/// What [`send`] did: messages sent, and of them how many the receiving host said no
+/// program was listening for (UDP: the hit is lost, the next ones are still sent).
+pub struct Sent {
+    pub sent: usize,
+    pub unheard: usize,
+}
+
 /// Send one message per hit in time order; with `realtime`, each at its score time
-/// after the call. Returns how many were sent.
-pub fn send(socket: &UdpSocket, hits: &[Hit], realtime: bool) -> anyhow::Result<usize> {
+/// after the call.
+pub fn send(socket: &UdpSocket, hits: &[Hit], realtime: bool) -> anyhow::Result<Sent> {
     let start = Instant::now();
+    let mut unheard = 0;
     for hit in hits {
         if realtime {
             let due = Duration::from_secs_f64(hit.time_s.max(0.0));
@@ -41,9 +49,16 @@ pub fn send(socket: &UdpSocket, hits: &[Hit], realtime: bool) -> anyhow::Result<
                 std::thread::sleep(wait);
             }
         }
-        socket
-            .send(&osc::encode(hit))
-            .map_err(|e| anyhow::anyhow!("--osc: sending a hit: {e}"))?;
+        match socket.send(&osc::encode(hit)) {
+            Ok(_) => {}
+            // The port answered that nothing listens (an earlier datagram's ICMP
+            // reply): a receiver may start later, so keep sending.
+            Err(e) if e.kind() == std::io::ErrorKind::ConnectionRefused => unheard += 1,
+            Err(e) => anyhow::bail!("--osc: sending a hit: {e}"),
+        }
     }
-    Ok(hits.len())
+    Ok(Sent {
+        sent: hits.len(),
+        unheard,
+    })
 }

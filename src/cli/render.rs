@@ -419,8 +419,14 @@ pub fn run(
         print_stats(&rendering);
     }
     if let Some(socket) = osc {
-        let sent = super::osc::send(&socket, &hits, ex.osc_realtime)?;
+        let super::osc::Sent { sent, unheard } = super::osc::send(&socket, &hits, ex.osc_realtime)?;
         println!("sent {sent} OSC hits to {}", socket.peer_addr()?);
+        if unheard > 0 {
+            eprintln!(
+                "note: {}: no program was listening for {unheard} of them (start the receiver first, e.g. the Pure Data patch in README \"Exports\")",
+                socket.peer_addr()?
+            );
+        }
     }
     Ok(())
 }

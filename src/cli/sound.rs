@@ -6,7 +6,12 @@ use crate::sound::calibration::{Calibration, Residual};
 use crate::sound::fit::{self, Note};
 use std::path::{Path, PathBuf};
 
-/// Render one scripted stroke at `pitch` and `dynamic` to a mono WAV, heard in `room`.
+/// How far past the range of the nearest standard drum `sound stroke` tunes its head,
+/// semitones: a fifth (a C2 on the 32-inch drum, whose range starts at D2).
+const MAX_SEMITONES_PAST_RANGE: i32 = 7;
+
+/// Render one scripted stroke at `pitch` and `dynamic` to a mono WAV, heard in `room`;
+/// a pitch more than a fifth past every standard drum's range is refused.
 pub fn stroke(
     (pitch, dynamic): (&str, crate::score::Dynamic),
     seconds: f64,
@@ -18,6 +23,29 @@ pub fn stroke(
         anyhow::bail!("--seconds {seconds} is outside 0.1-60 s");
     }
     let kit = fit::kit_for(pitch.hz());
+    let drum = &kit.drums[0];
+    let past = |edge: crate::base::pitch::Pitch| (i32::from(edge.0) - i32::from(pitch.0)).abs();
+    if !drum.in_range(pitch) && past(drum.lowest).min(past(drum.highest)) > MAX_SEMITONES_PAST_RANGE
+    {
+        let standard = crate::kit::Kit::standard();
+        let (low, high) = (
+            standard
+                .drums
+                .iter()
+                .map(|d| d.lowest)
+                .min()
+                .unwrap_or(drum.lowest),
+            standard
+                .drums
+                .iter()
+                .map(|d| d.highest)
+                .max()
+                .unwrap_or(drum.highest),
+        );
+        anyhow::bail!(
+            "--pitch {pitch}: no timpani of the standard kit reaches it (they span {low}-{high}; a head may be tuned up to {MAX_SEMITONES_PAST_RANGE} semitones past its drum's range)"
+        );
+    }
     let (mut mono, contact) = fit::struck(&kit, dynamic, Calibration::shipped(), seconds)?;
     crate::sound::room::reverberate_mono(room, &mut mono);
     let audio = crate::sound::Audio {

@@ -88,28 +88,20 @@ impl Figure {
     /// Draw the figure to a PNG at `path`, atomically.
     pub fn save_png(&self, path: &Path) -> Result<(), PlotError> {
         register_font();
-        let dir = match path.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p,
-            _ => Path::new("."),
+        let io = |source| PlotError::Io {
+            path: path.to_path_buf(),
+            source,
         };
-        let tmp = tempfile::Builder::new()
-            .prefix(".timpanist-")
-            .suffix(".png")
-            .tempfile_in(dir)
-            .map_err(|source| PlotError::Io {
-                path: path.to_path_buf(),
-                source,
-            })?;
-        let root = BitMapBackend::new(tmp.path(), self.size).into_drawing_area();
+        let dest = crate::base::staged::destination(path);
+        let tmp = crate::base::staged::beside(&dest, ".png")
+            .map_err(io)?
+            .into_temp_path();
+        let root = BitMapBackend::new(&tmp, self.size).into_drawing_area();
         self.draw(root).map_err(|e| PlotError::Draw {
             path: path.to_path_buf(),
             message: e.to_string(),
         })?;
-        tmp.persist(path).map_err(|e| PlotError::Io {
-            path: path.to_path_buf(),
-            source: e.error,
-        })?;
-        Ok(())
+        crate::base::staged::put(tmp, &dest).map_err(io)
     }
 
     /// The figure as the text of an SVG document (`width` and `height` in pixels of

@@ -180,10 +180,8 @@ pub fn encode(
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let staged = tempfile::Builder::new()
-        .prefix(&format!(".{name}."))
-        .suffix(".partial")
-        .tempfile_in(&dir)
+    let dest = crate::base::staged::destination(out);
+    let staged = crate::base::staged::beside(&dest, &format!(".{name}.partial"))
         .map_err(io(&dir))?
         .into_temp_path();
     // The mix beside it, for ffmpeg to read (removed when `wav` drops).
@@ -263,11 +261,7 @@ pub fn encode(
             message: format!("{status}: {}", message.trim()),
         });
     }
-    staged.persist(out).map_err(|e| VideoError::Io {
-        path: out.to_path_buf(),
-        source: e.error,
-    })?;
-    Ok(())
+    crate::base::staged::put(staged, &dest).map_err(io(out))
 }
 
 /// The frames as the new folder `dir` (refused if it holds anything, unless `replace`):

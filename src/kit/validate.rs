@@ -9,6 +9,9 @@ fn positive(x: f64) -> bool {
     x.is_finite() && x > 0.0
 }
 
+/// The kettle volumes a drum may have, as shares of π·a³ (a the head's radius).
+const KETTLE_SHARE: (f64, f64) = (0.2, 5.0);
+
 /// Every problem in `kit`, in file order.
 pub fn problems(kit: &Kit) -> Vec<Problem> {
     let mut out = Vec::new();
@@ -39,6 +42,18 @@ pub fn problems(kit: &Kit) -> Vec<Problem> {
         }
         if !(positive(m.air_loading) && m.air_loading <= 1.0) {
             bad(format!("air_loading {} is not in (0, 1]", m.air_loading));
+        }
+        if let Some(v) = d.kettle_volume_m3 {
+            // A kettle holds about π·a³ of air under a head of radius a (the standard
+            // 26-inch drum's 0.111 m³ is 0.98 of it); far outside that it is no kettle.
+            let cube = std::f64::consts::PI * d.radius_m().powi(3);
+            let (low, high) = (KETTLE_SHARE.0 * cube, KETTLE_SHARE.1 * cube);
+            if !(v.is_finite() && (low..=high).contains(&v)) {
+                bad(format!(
+                    "kettle_volume_m3 {v} is not between {low:.3} and {high:.3} m³ ({}–{} times π·a³ for this head)",
+                    KETTLE_SHARE.0, KETTLE_SHARE.1
+                ));
+            }
         }
         if d.modes.is_empty() {
             bad("the mode table is empty".into());
@@ -100,4 +115,28 @@ pub fn problems(kit: &Kit) -> Vec<Problem> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The standard kettles pass; none, an empty, a negative, a NaN or a room-sized one
+    /// is named with the drum.
+    #[test]
+    fn kettle_volumes_are_held_to_the_head() {
+        let standard = Kit::standard();
+        assert!(problems(&standard).is_empty());
+        for v in [0.0, -0.1, 1e-9, f64::NAN, 1e9] {
+            let mut kit = standard.clone();
+            kit.drums[2].kettle_volume_m3 = Some(v);
+            let found = problems(&kit);
+            assert_eq!(found.len(), 1, "{v}: {found:?}");
+            let text = found[0].to_string();
+            assert!(
+                text.contains("drum 2") && text.contains("kettle_volume_m3"),
+                "{text}"
+            );
+        }
+    }
 }

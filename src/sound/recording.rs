@@ -17,6 +17,10 @@ use symphonia::core::io::{MediaSourceStream, ReadOnlySource};
 /// energy is read from its loudest channel instead: spaced microphones out of phase cancel.
 const MIN_MIX_SHARE: f64 = 0.5;
 
+/// A mean above this share of the recording's RMS level (about −12 dB) is an offset to
+/// remove ([`remove_offset`]); the embedded notes' means are 0.01–0.03 of it.
+const MAX_OFFSET_SHARE: f64 = 0.25;
+
 /// The formats read, as a user would name them (for messages).
 pub const FORMATS: &str = "WAV, AIFF, FLAC, MP3 or Ogg Vorbis";
 
@@ -151,7 +155,25 @@ pub fn read_mono_bytes(path: &Path, bytes: &[u8]) -> Result<(Vec<f32>, u32), Rea
             "it holds samples that are not numbers (NaN or infinite)".into(),
         ));
     }
-    Ok((downmix(&raw, channels), rate))
+    let mut mono = downmix(&raw, channels);
+    remove_offset(&mut mono);
+    Ok((mono, rate))
+}
+
+/// A constant offset standing within [`MAX_OFFSET_SHARE`] of the sound's own RMS level
+/// (an interface's DC, not the slight asymmetry of a struck note, whose mean over the file
+/// is 1–2 % of its RMS) is subtracted: it would read as a step at the file's start and
+/// raise every window's level, hiding the strokes above it.
+fn remove_offset(mono: &mut [f32]) {
+    let n = mono.len().max(1) as f64;
+    let mean = mono.iter().map(|&x| f64::from(x)).sum::<f64>() / n;
+    let power = mono.iter().map(|&x| f64::from(x).powi(2)).sum::<f64>() / n;
+    let ac_rms = (power - mean * mean).max(0.0).sqrt();
+    if mean.abs() > MAX_OFFSET_SHARE * ac_rms {
+        for x in mono.iter_mut() {
+            *x = (f64::from(*x) - mean) as f32;
+        }
+    }
 }
 
 /// Interleaved frames of `ch` channels to mono: their mean, or the loudest channel when the
@@ -183,6 +205,25 @@ fn downmix(raw: &[f32], ch: usize) -> Vec<f32> {
 mod tests {
     use super::*;
     use std::f64::consts::TAU;
+
+    /// An interface's offset is removed; a note's own slight mean is kept bit for bit.
+    #[test]
+    fn a_dc_offset_is_removed_a_notes_own_mean_kept() {
+        let note: Vec<f32> = (0..48_000)
+            .map(|i| {
+                let t = i as f64 / 48_000.0;
+                ((TAU * 100.0 * t).sin() * (-3.0 * t).exp() * 0.5 + 0.004 * (-20.0 * t).exp())
+                    as f32
+            })
+            .collect();
+        let mut kept = note.clone();
+        remove_offset(&mut kept);
+        assert_eq!(kept, note);
+        let mut offset: Vec<f32> = note.iter().map(|&x| x + 0.2).collect();
+        remove_offset(&mut offset);
+        let mean = offset.iter().map(|&x| f64::from(x)).sum::<f64>() / offset.len() as f64;
+        assert!(mean.abs() < 1e-6, "{mean}");
+    }
 
     /// Two channels hearing the head out of phase are read from the louder, not cancelled;
     /// two in phase are averaged.

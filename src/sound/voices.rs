@@ -331,6 +331,10 @@ impl VoiceBank {
     /// Ring for `out.len()` samples driven by `input` (per sample one row of
     /// [`stride`](Self::stride) accelerations, m/s², held over the sample), adding to `out`.
     pub fn render_driven(&mut self, input: &[f32], out: &mut [f32]) {
+        if self.stride() == 0 {
+            // No voices (every mode of the head above the band): nothing sounds.
+            return;
+        }
         #[cfg(target_arch = "x86_64")]
         if width() != Width::Portable {
             // SAFETY: the CPU has AVX2 (checked by `width`).
