@@ -875,6 +875,112 @@ fn choosing_the_part() {
     assert!(err.to_string().contains("\"Tuba\""), "{err}");
 }
 
+/// Timpani parts named in other languages and abbreviations are found ("Kettledrums",
+/// "Kettle Drums", "Tympani", "Tymp."), by whole words only: "Paukenschlag Violin" is no
+/// timpani part. A score with no part at all says so instead of listing nothing.
+#[test]
+fn timpani_names_and_no_parts() {
+    let kit = Kit::standard();
+    let go = |xml: &str| {
+        import(
+            Path::new("names.musicxml"),
+            xml.as_bytes(),
+            &kit,
+            &ImportOptions::default(),
+        )
+    };
+    let violin = "<part-name>Violin</part-name>";
+    for name in ["Kettledrums", "Kettle Drums", "Tympani", "Tymp."] {
+        let (_, r) = go(&two_parts(
+            violin,
+            &format!("<part-name>{name}</part-name>"),
+        ))
+        .unwrap();
+        assert!(
+            r.source.starts_with(&format!("part P2 \"{name}\"")),
+            "{}",
+            r.source
+        );
+    }
+    let err = go(&two_parts(
+        violin,
+        "<part-name>Paukenschlag Violin</part-name>",
+    ))
+    .unwrap_err();
+    assert!(matches!(err, MusicXmlError::NoTimpani { .. }), "{err}");
+    let empty = "<score-partwise version=\"4.0\"><part-list/></score-partwise>";
+    let err = go(empty).unwrap_err().to_string();
+    assert_eq!(
+        err,
+        "names.musicxml: the score holds no parts (its part list and its <part> elements are empty), so there is nothing to import"
+    );
+}
+
+/// Tempo is the whole score's: marks written only in the top part (a `<sound tempo>` with
+/// its metronome mark at bar 1, a bare metronome mark at an offset in bar 3) set the
+/// timpani part's tempo; a mark of the timpani part's own (bar 2) still counts, and the
+/// same mark written in both parts is one; the import says where the marks came from.
+#[test]
+fn tempo_marks_of_other_parts() {
+    let metronome = |bpm: u32| {
+        format!(
+            "<direction-type><metronome><beat-unit>quarter</beat-unit><per-minute>{bpm}</per-minute></metronome></direction-type>"
+        )
+    };
+    let bar = |dirs: &str, pitch: &str| format!("{dirs}{}", note(pitch, 4, ""));
+    let top = [
+        format!(
+            "{}{}",
+            attrs(1),
+            bar(
+                &format!(
+                    "<direction>{}<sound tempo=\"66\"/></direction>",
+                    metronome(66)
+                ),
+                "C5"
+            )
+        ),
+        bar("<direction><sound tempo=\"90\"/></direction>", "C5"),
+        format!(
+            "<note><pitch><step>C</step><octave>5</octave></pitch><duration>2</duration></note><direction>{}</direction><note><pitch><step>C</step><octave>5</octave></pitch><duration>2</duration></note>",
+            metronome(132)
+        ),
+    ];
+    let timp = [
+        format!("{}{}", attrs(1), bar("", "D3")),
+        bar(&format!("<direction>{}</direction>", metronome(90)), "A2"),
+        bar("", "D3"),
+    ];
+    let part = |id: &str, ms: &[String]| {
+        let body: String = ms
+            .iter()
+            .enumerate()
+            .map(|(i, m)| format!("<measure number=\"{}\">{m}</measure>", i + 1))
+            .collect();
+        format!("<part id=\"{id}\">{body}</part>")
+    };
+    let xml = format!(
+        r#"<score-partwise version="4.0"><part-list>
+<score-part id="P1"><part-name>Violin</part-name></score-part><score-part id="P2"><part-name>Timpani</part-name></score-part>
+</part-list>{}{}</score-partwise>"#,
+        part("P1", &top),
+        part("P2", &timp)
+    );
+    let (score, report) = run(&xml);
+    let tpq = u64::from(score.ticks_per_quarter);
+    let tempo: Vec<(u64, f64)> = score.tempo.iter().map(|t| (t.tick, t.bpm)).collect();
+    assert_eq!(tempo, vec![(0, 66.0), (4 * tpq, 90.0), (10 * tpq, 132.0)]);
+    assert!(
+        report
+            .notices
+            .iter()
+            .any(|n| n.starts_with("tempo mark written in another part")
+                && n.contains("part P1 \"Violin\", measure 1")),
+        "{:?}",
+        report.notices
+    );
+}
+
 // ---- bad input ----
 
 /// Malformed XML names the file, line and column; a bad value names the line and

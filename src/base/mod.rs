@@ -5,13 +5,15 @@
 //! performed hit (`hit`: what `render` makes and `io` writes) and the choices its settings
 //! make (control pipeline, IK method, mode frequencies, sound model), work spread over
 //! threads in order (`parallel`) and records kept in shared chunks that clone without a
-//! copy (`chunks`). Imports no other module of the crate.
+//! copy (`chunks`), and the names scores give the timpani part (`instrument_name`).
+//! Imports no other module of the crate.
 
 pub mod choices;
 pub mod chunks;
 pub mod dirs;
 pub mod gesture;
 pub mod hit;
+pub mod instrument_name;
 pub mod limits;
 pub mod parallel;
 pub mod pitch;

@@ -60,8 +60,8 @@ pub enum Command {
         #[arg(short, long)]
         output: PathBuf,
         /// The track to read, by index (from 0) or by (part of) its name; default: the
-        /// track or channel with GM program 48 (Timpani), a track named like "Timpani",
-        /// or the channel-10 percussion.
+        /// track or channel with GM program 48 (Timpani), a track or instrument named
+        /// like "Timpani", "Pk.", "Kettledrums", or the channel-10 percussion.
         #[arg(long)]
         track: Option<String>,
         /// The kit to map pitches onto (default: the bundled standard kit).
@@ -83,7 +83,7 @@ pub enum Command {
         output: PathBuf,
         /// The part to read, by id ("P4") or by (part of) its name; default: the part
         /// whose instrument sound is drum.timpani or MIDI program 48, else a part named
-        /// like "Timpani", "Pk.", "Pauken" or "Timbales".
+        /// like "Timpani", "Tymp.", "Kettledrums", "Pk.", "Pauken" or "Timbales".
         #[arg(long)]
         part: Option<String>,
         /// The kit to map pitches onto (default: the bundled standard kit).

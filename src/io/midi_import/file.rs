@@ -50,6 +50,8 @@ pub(in crate::io) struct Note {
 #[derive(Default)]
 pub(super) struct TrackInfo {
     pub(super) name: String,
+    /// The first instrument name (meta event FF 04).
+    pub(super) instrument: String,
     pub(super) notes: Vec<Note>,
     /// The first program change on each channel.
     pub(super) programs: [Option<u8>; 16],
@@ -64,13 +66,13 @@ pub(super) struct FileInfo {
     pub(super) meters: Vec<(u64, u8, u8)>,
 }
 
-pub(super) fn read_file(smf: &Smf<'_>, clock: &Clock) -> FileInfo {
+pub(super) fn read_file(tracks: &[Vec<TrackEvent<'_>>], clock: &Clock) -> FileInfo {
     let mut file = FileInfo {
         tracks: Vec::new(),
         tempos: Vec::new(),
         meters: Vec::new(),
     };
-    for track in &smf.tracks {
+    for track in tracks {
         let mut info = TrackInfo::default();
         let mut file_tick = 0u64;
         let mut pending: Option<(u64, BeatData)> = None;
@@ -80,6 +82,11 @@ pub(super) fn read_file(smf: &Smf<'_>, clock: &Clock) -> FileInfo {
             match event.kind {
                 TrackEventKind::Meta(MetaMessage::TrackName(name)) if info.name.is_empty() => {
                     info.name = decode_text(name).trim().to_string();
+                }
+                TrackEventKind::Meta(MetaMessage::InstrumentName(name))
+                    if info.instrument.is_empty() =>
+                {
+                    info.instrument = decode_text(name).trim().to_string();
                 }
                 TrackEventKind::Meta(MetaMessage::Tempo(us)) => {
                     file.tempos.push((tick, us.as_int()));

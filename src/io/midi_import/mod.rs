@@ -2,7 +2,8 @@
 //! its notes into a score that a timpanist can play on a given kit.
 //!
 //! The part is the track (or, in a type 0 file, the channel) with General MIDI program 48
-//! "Timpani", else a track named like "Timpani"/"Pauken", else the percussion channel 10;
+//! "Timpani", else a track whose name or instrument name (meta event FF 04) names the
+//! timpani (`crate::base::instrument_name`, shared with MusicXML), else the percussion channel 10;
 //! `--track` overrides. Every distinct note becomes a beat on a drum whose range holds its
 //! pitch, chosen as a timpanist would (a drum already tuned to the pitch, else the one idle
 //! longest); exact duplicates are dropped (seed 003, footnote 1). Tempo and time signatures
@@ -10,7 +11,8 @@
 //! drum, impact location and roll, which are restored. Channels and programs are counted
 //! from 1 in messages, as General MIDI does.
 //!
-//! The file's events are read in [`file`], the part chosen in [`part`], its notes cleaned in
+//! The file's tracks are read in [`chunks`] (damage reported with its track and byte,
+//! what can be read kept), their events in [`file`], the part chosen in [`part`], its notes cleaned in
 //! [`notes`] and given drums in [`drums`], its tempo and meter maps made in [`timing`].
 
 use super::midi_export::{BeatData, GM_TIMPANI};
@@ -22,7 +24,7 @@ use crate::score::{
     Beat, Dynamic, Hand, ImpactLocation, MeterChange, MeterMap, PlayingMode, Roll, Score,
     TempoPoint,
 };
-use midly::{Format, MetaMessage, MidiMessage, Smf, Timing, TrackEventKind};
+use midly::{Format, MetaMessage, MidiMessage, Timing, TrackEvent, TrackEventKind};
 use std::cmp::Reverse;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -145,10 +147,28 @@ pub enum MidiError {
     },
     /// Nothing looks like a timpani part.
     #[error(
-        "{}: no timpani part found (no General MIDI program 48 \"Timpani\", no track named \"Timp…\" or \"Pauk…\", no notes on percussion channel 10); choose a track with --track N or --track NAME:\n{tracks}",
-        path.display()
+        "{}: no timpani part found (no General MIDI program 48 \"Timpani\", no track or instrument named {}, no notes on percussion channel 10); choose a track with --track N or --track NAME:\n{tracks}",
+        path.display(), crate::base::instrument_name::TIMPANI_NAMES
     )]
     NoTimpani { path: PathBuf, tracks: String },
+    /// A header and no track.
+    #[error(
+        "{}: the file holds no tracks (a MIDI header and nothing after it), so there is nothing to import",
+        path.display()
+    )]
+    NoTracks { path: PathBuf },
+    /// Damage cost the file its timpani part (or every track).
+    #[error(
+        "{}: {damage}; no timpani part found in what can be read: repair the file or export it again from your notation program{choices}",
+        path.display()
+    )]
+    Damaged {
+        path: PathBuf,
+        /// Where the (first) damage that lost events is.
+        damage: String,
+        /// ", or choose a track …" with the readable tracks, or nothing if there are none.
+        choices: String,
+    },
 }
 
 /// Read and import a MIDI file.
@@ -177,7 +197,7 @@ pub fn import(
     kit: &Kit,
     options: &ImportOptions,
 ) -> Result<(Score, ImportReport), MidiError> {
-    let smf = Smf::parse(bytes).map_err(|e| MidiError::Malformed {
+    let (header, track_chunks) = midly::parse(bytes).map_err(|e| MidiError::Malformed {
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
@@ -185,12 +205,12 @@ pub fn import(
         path: path.to_path_buf(),
         message: message.into(),
     };
-    if smf.header.format == Format::Sequential {
+    if header.format == Format::Sequential {
         return Err(MidiError::Sequential {
             path: path.to_path_buf(),
         });
     }
-    let clock = match smf.header.timing {
+    let clock = match header.timing {
         Timing::Metrical(t) if t.as_int() == 0 => return Err(malformed("0 ticks per quarter")),
         // Scores need at least 24 ticks per quarter: scale finer, exactly, if needed.
         Timing::Metrical(t) => Clock::Metrical {
@@ -202,9 +222,11 @@ pub fn import(
             ticks_per_s: f64::from(fps.as_f32()) * f64::from(sub),
         },
     };
-    let file = read_file(&smf, &clock);
-    let mut warnings = Vec::new();
-    let (source, chosen) = choose(path, &file, options)?;
+    let (tracks, damage) = read_tracks(bytes, track_chunks.unread());
+    let file = read_file(&tracks, &clock);
+    let (source, chosen) =
+        choose(path, &file, options).map_err(|e| damaged_instead(path, &file, &damage, e))?;
+    let mut warnings: Vec<String> = damage.iter().map(|d| damage_text(&file, d)).collect();
     let notes: Vec<Note> = file.tracks[chosen.track]
         .notes
         .iter()
@@ -240,8 +262,9 @@ pub fn import(
         .to_string();
     score.kit = options.kit_ref.clone();
     score.ticks_per_quarter = tpq;
-    score.tempo = tempo_points(&file.tempos, &clock, &mut warnings);
     score.meter = meter_changes(&file.meters, tpq, &mut warnings);
+    let meter = MeterMap::new(&score.meter, tpq);
+    score.tempo = tempo_points(&file.tempos, &clock, &meter, &mut warnings);
     score.beats = beats;
     score.sort_beats();
     trim_rolls(&mut score.beats);
@@ -258,6 +281,7 @@ pub fn import(
     Ok((score, report))
 }
 
+mod chunks;
 mod drums;
 mod file;
 mod notes;
@@ -266,6 +290,7 @@ mod part;
 mod tests;
 mod timing;
 
+use chunks::*;
 pub(in crate::io) use drums::{assign_drums, move_into_range, trim_rolls};
 pub(in crate::io) use file::Note;
 pub use file::decode_text;

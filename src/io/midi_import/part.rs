@@ -1,8 +1,10 @@
 //! Choosing the timpani part: the track (or channel of a type 0 file) named by `--track`,
-//! else the one with General MIDI program 48, else one named like "Timpani", else the
+//! else the one with General MIDI program 48, else one whose track or instrument name
+//! names the timpani (`crate::base::instrument_name`), else the
 //! percussion channel 10; the reason for the choice is reported.
 
 use super::*;
+use crate::base::instrument_name::is_timpani_name;
 
 /// The notes to import: a track, optionally one channel of it.
 pub(super) struct Chosen {
@@ -40,7 +42,11 @@ pub(super) fn track_listing(file: &FileInfo) -> String {
     let mut out = String::new();
     for (i, t) in file.tracks.iter().enumerate() {
         let counts = channel_counts(t);
-        let _ = write!(out, "  {}: ", track_label(file, i));
+        let _ = write!(out, "  {}", track_label(file, i));
+        if !t.instrument.is_empty() {
+            let _ = write!(out, " (instrument \"{}\")", t.instrument);
+        }
+        out.push_str(": ");
         if counts.is_empty() {
             out.push_str("no notes");
         }
@@ -70,6 +76,11 @@ pub(super) fn choose(
         channel: None,
         percussion: false,
     };
+    if file.tracks.is_empty() {
+        return Err(MidiError::NoTracks {
+            path: path.to_path_buf(),
+        });
+    }
     match &options.track {
         Some(TrackChoice::Index(i)) if *i < file.tracks.len() => {
             return Ok((
@@ -127,9 +138,11 @@ pub(super) fn choose(
                 by_program.push((n, why, on(false)));
             }
         }
-        let name = t.name.to_lowercase();
-        if !t.notes.is_empty() && (name.contains("timp") || name.contains("pauk")) {
-            let why = format!("{}: named like a timpani part", track_label(file, i));
+        let named = [&t.name, &t.instrument]
+            .into_iter()
+            .find(|n| is_timpani_name(n));
+        if let Some(named) = named.filter(|_| !t.notes.is_empty()) {
+            let why = format!("{}: named \"{named}\"", track_label(file, i));
             by_name.push((t.notes.len(), why, whole(i)));
         }
     }
@@ -152,4 +165,41 @@ pub(super) fn choose(
         let _ = write!(why, ", the most of {} candidates", others + 1);
     }
     Ok((why, chosen))
+}
+
+/// "track 2 \"Perc\" is damaged at byte 97: …", or "the file is damaged at byte 97: …".
+pub(super) fn damage_text(file: &FileInfo, d: &Damage) -> String {
+    let whose = match d.track {
+        Some(t) if t < file.tracks.len() => track_label(file, t),
+        _ => "the file".into(),
+    };
+    format!("{whose} is damaged at byte {}: {}", d.byte, d.what)
+}
+
+/// A file with damage that lost events and no timpani part (or no track, or not the
+/// track asked for) is reported as damaged, not as lacking a timpani part.
+pub(super) fn damaged_instead(
+    path: &Path,
+    file: &FileInfo,
+    damage: &[Damage],
+    error: MidiError,
+) -> MidiError {
+    let Some(first) = damage.iter().find(|d| d.lost) else {
+        return error;
+    };
+    if !matches!(
+        error,
+        MidiError::NoTimpani { .. } | MidiError::NoTracks { .. } | MidiError::TrackIndex { .. }
+    ) {
+        return error;
+    }
+    let choices = match track_listing(file) {
+        listing if listing.is_empty() => String::new(),
+        listing => format!(", or choose a track with --track N or --track NAME:\n{listing}"),
+    };
+    MidiError::Damaged {
+        path: path.to_path_buf(),
+        damage: damage_text(file, first),
+        choices,
+    }
 }

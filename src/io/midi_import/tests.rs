@@ -209,14 +209,41 @@ fn meter_and_tempo() {
     assert!(warnings[0].contains("bar 3"), "{}", warnings[0]);
     assert_eq!(meter_changes(&[], 960, &mut warnings)[0].numerator, 4);
     let clock = Clock::Metrical { tpq: 960, scale: 1 };
+    let map = MeterMap::new(&meter, 960);
     let tempo = tempo_points(
         &[(0, 500_000), (960, 600_000), (1920, 600_000)],
         &clock,
+        &map,
         &mut warnings,
     );
     let bpms: Vec<(u64, f64)> = tempo.iter().map(|p| (p.tick, p.bpm)).collect();
     assert_eq!(bpms, vec![(0, 120.0), (960, 100.0)]);
-    assert_eq!(tempo_points(&[], &clock, &mut warnings)[0].bpm, 120.0);
+    assert_eq!(tempo_points(&[], &clock, &map, &mut warnings)[0].bpm, 120.0);
+}
+
+/// A tempo outside 10–400 bpm is clamped, and the warning names where the first was:
+/// 1000 bpm (60 000 µs) at tick 4800, which is bar 2 beat 2 in 4/4 at 960 per quarter.
+#[test]
+fn clamped_tempo_warning_names_its_place() {
+    let mut warnings = Vec::new();
+    let clock = Clock::Metrical { tpq: 960, scale: 1 };
+    let meter = meter_changes(&[], 960, &mut warnings);
+    let map = MeterMap::new(&meter, 960);
+    let tempo = tempo_points(
+        &[(4800, 60_000), (9600, 60_000_000)],
+        &clock,
+        &map,
+        &mut warnings,
+    );
+    assert_eq!(tempo[1].bpm, 400.0);
+    assert_eq!(tempo[2].bpm, 10.0);
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(
+        warnings[0].starts_with("2 tempo events")
+            && warnings[0].contains("the first, 1000 bpm, at tick 4800, bar 2 beat 2"),
+        "{}",
+        warnings[0]
+    );
 }
 
 /// Tempos read as the round numbers MIDI rounded to µs, else exactly.

@@ -15,10 +15,12 @@ pub(super) fn bpm_of(us: u32) -> f64 {
 }
 
 /// Tempo points from (tick, µs per quarter) events: steps, repeats merged, 120 bpm until
-/// the first; SMPTE-timed files get 120 bpm throughout.
+/// the first; SMPTE-timed files get 120 bpm throughout. Tempi outside the score's range
+/// are clamped, the warning naming the first one's tick and bar on `meter`.
 pub(super) fn tempo_points(
     tempos: &[(u64, u32)],
     clock: &Clock,
+    meter: &MeterMap,
     warnings: &mut Vec<String>,
 ) -> Vec<TempoPoint> {
     if matches!(clock, Clock::Timecode { .. }) {
@@ -27,20 +29,26 @@ pub(super) fn tempo_points(
     let mut sorted = tempos.to_vec();
     sorted.sort_by_key(|t| t.0);
     let mut clamped = 0;
+    let mut first = None;
     let points = tempo::steps(
         DEFAULT_BPM,
         sorted.iter().map(|&(tick, us)| {
             let exact = bpm_of(us);
             let bpm = exact.clamp(*BPM_RANGE.start(), *BPM_RANGE.end());
-            clamped += usize::from(bpm != exact);
+            if bpm != exact {
+                clamped += 1;
+                first.get_or_insert((tick, exact));
+            }
             (tick, bpm)
         }),
     );
-    if clamped > 0 {
+    if let Some((tick, exact)) = first {
         warnings.push(format!(
-            "{clamped} tempo events outside {}–{} bpm were clamped into that range",
+            "{clamped} tempo events outside {}–{} bpm were clamped into that range (the first, {} bpm, at tick {tick}, {})",
             BPM_RANGE.start(),
-            BPM_RANGE.end()
+            BPM_RANGE.end(),
+            (exact * 100.0).round() / 100.0,
+            meter.position(tick)
         ));
     }
     points

@@ -4,7 +4,8 @@
 //!
 //! The part is the one named by `--part` (its id, or part of its name), else one whose
 //! instrument sound is `drum.timpani…` or whose MIDI program is 48 (General MIDI
-//! "Timpani"), else one named like "Timpani", "Timp.", "Pk.", "Pauken" or "Timbales".
+//! "Timpani"), else one named like "Timpani", "Timp.", "Kettledrums", "Pk.", "Pauken" or
+//! "Timbales" (whole words: `crate::base::instrument_name`, shared with the MIDI import).
 //! Musical time is exact: the score's ticks per quarter are the least common multiple of
 //! 960 and every `<divisions>` of the part. Each sounding note (a tie's later notes extend
 //! the first; grace and cue notes are skipped and reported) becomes a beat on a drum chosen
@@ -13,15 +14,17 @@
 //! volta endings expanded ([`repeats`]). Tremolo marks become rolls (a
 //! two-note tremolo: strokes alternating between its two notes), dynamics and hairpins
 //! per-beat dynamics, articulations playing modes, `<stopped/>` damping when the note
-//! ends, `<other-technical>` R/L the hand, `<sound tempo>` and `<metronome>` the tempo
-//! map (quarter notes per minute), time signatures and measure lengths the meter map.
+//! ends, `<other-technical>` R/L the hand, `<sound tempo>` and `<metronome>` — of every
+//! part, since tempo is the whole score's — the tempo map (quarter notes per minute),
+//! time signatures and measure lengths the meter map.
 //! Whatever is read but not performed (fermatas, jumps, ornaments, texts…) is listed in
 //! [`ImportReport::notices`]; notation that only concerns the page (clefs, keys, beams,
 //! stems, layout, lyrics, chord symbols) is left out silently.
 //!
 //! The file's text is read in [`file`], the part chosen in [`parts`] and read in
 //! [`reader`] (its measures put in performed order by [`repeats`]), its dynamics over
-//! time kept in [`levels`], its tempo and meter maps made in [`timing`].
+//! time kept in [`levels`], the tempo marks of every part found in [`score_tempo`], its
+//! tempo and meter maps made in [`timing`].
 
 use super::midi_import::{self as midi, ANY_DRUM, Note};
 use crate::kit::Kit;
@@ -41,12 +44,14 @@ mod levels;
 mod parts;
 mod reader;
 mod repeats;
+mod score_tempo;
 mod timing;
 
 use file::*;
 use levels::*;
 use parts::*;
 use reader::*;
+use score_tempo::*;
 use timing::*;
 
 /// Ticks per quarter note that every import's resolution is a multiple of.
@@ -145,10 +150,16 @@ pub enum MusicXmlError {
     },
     /// Nothing looks like a timpani part.
     #[error(
-        "{}: no timpani part found (no instrument sound \"drum.timpani\", no MIDI program 48, no part named \"Timp…\", \"Pk.\", \"Pauken\" or \"Timbales\"); choose one with --part ID or --part NAME:\n{parts}",
-        path.display()
+        "{}: no timpani part found (no instrument sound \"drum.timpani\", no MIDI program 48, no part named {}); choose one with --part ID or --part NAME:\n{parts}",
+        path.display(), crate::base::instrument_name::TIMPANI_NAMES
     )]
     NoTimpani { path: PathBuf, parts: String },
+    /// A score with no part at all.
+    #[error(
+        "{}: the score holds no parts (its part list and its <part> elements are empty), so there is nothing to import",
+        path.display()
+    )]
+    NoParts { path: PathBuf },
 }
 
 /// Read and import a MusicXML file (`.musicxml`, `.xml` or `.mxl`).
@@ -224,6 +235,7 @@ pub fn import(
     let tpq = ticks_per_quarter(part_node, &mut notices);
     let mut reader = PartReader::new(path, &doc, tpq, instrument);
     reader.notices = notices;
+    reader.score_tempos = score_tempo::other_parts(root, part_node, &parts);
     reader.read(part_node)?;
     let PartReader {
         notes: xnotes,

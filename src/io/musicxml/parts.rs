@@ -3,6 +3,7 @@
 //! General MIDI program or its name); the resolution its `<divisions>` need.
 
 use super::*;
+use crate::base::instrument_name::is_timpani_name;
 
 /// A `<score-part>` of the part list.
 #[derive(Clone, Debug)]
@@ -128,18 +129,6 @@ pub(super) fn part_listing(parts: &[PartInfo]) -> String {
     out
 }
 
-/// A word of a name that marks a timpani part: "Timpani", "Timp.", "Pk.", "Pauken",
-/// "Timbales" (any case).
-pub(super) fn timpani_name(name: &str) -> bool {
-    let lower = name.to_lowercase();
-    lower.contains("timp")
-        || lower.contains("pauk")
-        || lower.contains("timbal")
-        || lower
-            .split(|c: char| !c.is_alphanumeric())
-            .any(|w| w == "pk" || w == "pkn")
-}
-
 /// A way to recognise the timpani part: (the instrument id if one matched, why).
 pub(super) type Rule = dyn Fn(&PartInfo) -> Option<(String, String)>;
 
@@ -149,6 +138,11 @@ pub(super) fn choose(
     parts: &[PartInfo],
     options: &ImportOptions,
 ) -> Result<(String, usize, Option<String>), MusicXmlError> {
+    if parts.is_empty() {
+        return Err(MusicXmlError::NoParts {
+            path: path.to_path_buf(),
+        });
+    }
     if let Some(want) = &options.part {
         let lower = want.to_lowercase();
         let found = parts.iter().position(|p| p.id == *want).or_else(|| {
@@ -185,7 +179,7 @@ pub(super) fn choose(
         let named = [p.name.as_str(), p.abbreviation.as_str()]
             .into_iter()
             .chain(p.instruments.iter().map(|(_, n, _)| n.as_str()))
-            .find(|n| timpani_name(n))?;
+            .find(|n| is_timpani_name(n))?;
         Some((String::new(), format!("named \"{named}\"")))
     };
     let rules: [&Rule; 2] = [&by_sound, &by_name];

@@ -83,8 +83,10 @@ pub(super) struct PartReader<'a, 'd> {
     pub(super) transpose: i32,
     pub(super) notes: Vec<XNote>,
     pub(super) measures: Vec<Measure>,
-    /// (tick, bpm, from `<sound tempo>`).
-    pub(super) tempos: Vec<(u64, f64, bool)>,
+    /// The part's own tempo marks and, placed on its measures, the other parts'.
+    pub(super) tempos: Vec<TempoMark>,
+    /// The other parts' tempo marks by written measure ([`score_tempo::other_parts`]).
+    pub(super) score_tempos: Vec<Vec<WrittenTempo>>,
     pub(super) dynamics: Vec<(u64, DynEvent)>,
     pub(super) notices: Notices,
     /// Open ties: (pitch, note index).
@@ -155,6 +157,7 @@ impl<'a, 'd> PartReader<'a, 'd> {
             notes: Vec::new(),
             measures: Vec::new(),
             tempos: Vec::new(),
+            score_tempos: Vec::new(),
             dynamics: Vec::new(),
             notices: Notices::default(),
             ties: Vec::new(),
@@ -242,9 +245,18 @@ impl<'a, 'd> PartReader<'a, 'd> {
                 order.len()
             ));
         }
-        for m in order.into_iter().map(|i| written[i]) {
+        for i in order {
+            let m = written[i];
             let number = m.attribute("number").unwrap_or("?").to_string();
             let start = self.measures.iter().map(|m| m.length).sum::<u64>();
+            for t in self.score_tempos.get(i).into_iter().flatten() {
+                self.tempos.push(TempoMark {
+                    tick: start + (t.quarters * self.tpq as f64).round() as u64,
+                    bpm: t.bpm,
+                    sound: t.sound,
+                    other_part: Some(t.place.clone()),
+                });
+            }
             let length = self.read_measure(m, start, &number)?;
             let nominal = self
                 .signature
@@ -788,9 +800,7 @@ impl<'a, 'd> PartReader<'a, 'd> {
     /// A `<direction>` whose time is `tick`.
     fn direction(&mut self, el: Node, tick: u64, number: &str) {
         let place = format!("measure {number}");
-        let has_sound_tempo = el
-            .children()
-            .any(|c| c.has_tag_name("sound") && c.attribute("tempo").is_some());
+        let has_sound_tempo = has_sound_tempo(el);
         for c in el.children().filter(Node::is_element) {
             match c.tag_name().name() {
                 "direction-type" => {
@@ -833,7 +843,12 @@ impl<'a, 'd> PartReader<'a, 'd> {
                     return;
                 }
                 match metronome_bpm(t) {
-                    Some(bpm) => self.tempos.push((tick, bpm, false)),
+                    Some(bpm) => self.tempos.push(TempoMark {
+                        tick,
+                        bpm,
+                        sound: false,
+                        other_part: None,
+                    }),
                     None => self.notices.add(
                         "metronome mark other than \"note = number\" (e.g. a metric modulation): not read",
                         place,
@@ -859,18 +874,17 @@ impl<'a, 'd> PartReader<'a, 'd> {
     /// A `<sound>`: its tempo (quarter notes per minute); jumps are reported.
     fn sound(&mut self, s: Node, tick: u64, number: &str) {
         let place = format!("measure {number}");
-        if let Some(tempo) = s.attribute("tempo") {
-            match tempo
-                .trim()
-                .parse::<f64>()
-                .ok()
-                .filter(|t| t.is_finite() && *t > 0.0)
-            {
-                Some(bpm) => self.tempos.push((tick, bpm, true)),
-                None => self
-                    .notices
-                    .add(format!("<sound tempo=\"{tempo}\">: not a tempo"), &place),
-            }
+        match sound_bpm(s) {
+            Some(Ok(bpm)) => self.tempos.push(TempoMark {
+                tick,
+                bpm,
+                sound: true,
+                other_part: None,
+            }),
+            Some(Err(tempo)) => self
+                .notices
+                .add(format!("<sound tempo=\"{tempo}\">: not a tempo"), &place),
+            None => {}
         }
         // Jumps (dacapo, dalsegno, tocoda, fine, segno, coda) are followed by
         // `repeats`; a forward repeat is read from the bar line.
@@ -969,42 +983,6 @@ pub(super) fn alternate(a: &XNote, b: &XNote, spq: u32, tpq: u64) -> Vec<XNote> 
             }
         })
         .collect()
-}
-
-/// Quarter notes per minute of a `<metronome>` "beat-unit [dots] = per-minute".
-pub(super) fn metronome_bpm(m: Node) -> Option<f64> {
-    let units: Vec<Node> = m
-        .children()
-        .filter(|c| c.has_tag_name("beat-unit"))
-        .collect();
-    let [unit] = units[..] else { return None };
-    let quarters = match unit.text()?.trim() {
-        "maxima" => 32.0,
-        "long" => 16.0,
-        "breve" => 8.0,
-        "whole" => 4.0,
-        "half" => 2.0,
-        "quarter" => 1.0,
-        "eighth" => 0.5,
-        "16th" => 0.25,
-        "32nd" => 0.125,
-        "64th" => 0.0625,
-        _ => return None,
-    };
-    let dots = m
-        .children()
-        .filter(|c| c.has_tag_name("beat-unit-dot"))
-        .count();
-    let dotted = quarters * (2.0 - 0.5f64.powi(i32::try_from(dots).ok()?));
-    let text = text_of(m, "per-minute");
-    // "120", "c. 120", "120-132": the first number.
-    let start = text.find(|c: char| c.is_ascii_digit())?;
-    let rest = &text[start..];
-    let end = rest
-        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
-        .unwrap_or(rest.len());
-    let per_minute: f64 = rest[..end].trim_end_matches('.').parse().ok()?;
-    (per_minute > 0.0).then_some(per_minute * dotted)
 }
 
 /// The movement title, else the work title.

@@ -1,16 +1,30 @@
-//! The tempo map (`<sound tempo>` and `<metronome>` marks, quarter notes per minute) and
-//! the meter map (each bar as long as its measure) of the part.
+//! The tempo map (`<sound tempo>` and `<metronome>` marks of every part, quarter notes per
+//! minute) and the meter map (each bar as long as its measure) of the part.
 
 use super::*;
 
-/// Tempo points from (tick, bpm, from `<sound>`): a `<sound tempo>` wins over a metronome
-/// mark at the same tick; 120 bpm until the first; steps; clamped into the score's range.
-pub(super) fn tempo_points(tempos: &[(u64, f64, bool)], notices: &mut Notices) -> Vec<TempoPoint> {
+/// Tempo points from the tempo marks of every part: at one tick the chosen part's mark
+/// wins over another part's and a `<sound tempo>` over a metronome mark (the same mark
+/// written in several parts is one); 120 bpm until the first; steps; clamped into the
+/// score's range. Marks taken from other parts are reported with the first one's place.
+pub(super) fn tempo_points(tempos: &[TempoMark], notices: &mut Notices) -> Vec<TempoPoint> {
     let mut sorted = tempos.to_vec();
-    sorted.sort_by_key(|a| (a.0, a.2));
+    sorted.sort_by_key(|m| (m.tick, m.precedence()));
+    // The played mark of each tick: the last of its tick.
+    sorted.reverse();
+    sorted.dedup_by_key(|m| m.tick);
+    sorted.reverse();
+    for m in &sorted {
+        if let Some(place) = &m.other_part {
+            notices.add(
+                "tempo mark written in another part: played (tempo is the whole score's)",
+                place,
+            );
+        }
+    }
     tempo::steps(
         DEFAULT_BPM,
-        sorted.into_iter().map(|(tick, bpm, _)| {
+        sorted.into_iter().map(|TempoMark { tick, bpm, .. }| {
             let clamped = bpm.clamp(*BPM_RANGE.start(), *BPM_RANGE.end());
             if clamped != bpm {
                 notices.add(
