@@ -249,14 +249,6 @@ impl<'a, 'd> PartReader<'a, 'd> {
             let m = written[i];
             let number = m.attribute("number").unwrap_or("?").to_string();
             let start = self.measures.iter().map(|m| m.length).sum::<u64>();
-            for t in self.score_tempos.get(i).into_iter().flatten() {
-                self.tempos.push(TempoMark {
-                    tick: start + (t.quarters * self.tpq as f64).round() as u64,
-                    bpm: t.bpm,
-                    sound: t.sound,
-                    other_part: Some(t.place.clone()),
-                });
-            }
             let length = self.read_measure(m, start, &number)?;
             let nominal = self
                 .signature
@@ -267,6 +259,18 @@ impl<'a, 'd> PartReader<'a, 'd> {
             } else {
                 length
             };
+            // Other parts' marks, none later than the end of this measure.
+            for t in self.score_tempos.get(i).into_iter().flatten() {
+                let offset = (t.quarters * self.tpq as f64)
+                    .round()
+                    .clamp(0.0, length as f64);
+                self.tempos.push(TempoMark {
+                    tick: start + offset as u64,
+                    bpm: t.bpm,
+                    sound: t.sound,
+                    other_part: Some(t.place.clone()),
+                });
+            }
             self.measures.push(Measure {
                 length,
                 signature: self.signature,
