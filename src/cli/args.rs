@@ -41,7 +41,14 @@ arg_enum!(DynamicArg => Dynamic {
     Ff => Dynamic::Ff,
 });
 arg_enum!(GripArg => Grip { French => Grip::French, German => Grip::German });
-arg_enum!(UpArg => UpAxis { Y => UpAxis::Y, Z => UpAxis::Z });
+arg_enum!(UpArg => UpAxis {
+    X => UpAxis::X,
+    Y => UpAxis::Y,
+    Z => UpAxis::Z,
+    NegX => UpAxis::NegX,
+    NegY => UpAxis::NegY,
+    NegZ => UpAxis::NegZ,
+});
 
 /// A capture format by name (c3d, motive, vicon, trc, csv).
 pub fn parse_format(s: &str) -> Result<Format, String> {

@@ -13,7 +13,7 @@ use crate::mocap::ingest::{
     Alignment, IngestOptions, IngestReport, UpAxis, hand_from_label, ingest,
 };
 use crate::mocap::take::Take;
-use crate::mocap::{stats, synth};
+use crate::mocap::{stats, synth, vertical};
 use crate::score::{Dynamic, Grip};
 use std::path::{Path, PathBuf};
 
@@ -357,15 +357,40 @@ fn read_take(
     })
 }
 
-/// The up axis: `--up`, else the profile's, else Y for Motive files and Z otherwise.
-fn up_axis(args: &ImportArgs, profile: Option<&CaptureProfile>, format: Option<Format>) -> UpAxis {
-    args.up
-        .or_else(|| profile.and_then(|p| p.up.map(Into::into)))
-        .unwrap_or(match format {
-            // Motive and OpenSim (TRC) are Y up by convention; Vicon, Qualisys, C3D Z up.
-            Some(Format::Motive | Format::Trc) => UpAxis::Y,
-            _ => UpAxis::Z,
-        })
+/// The up axis: `--up`, else a profile file's (a lab's own, written for its session),
+/// else found from the sticks' strokes (`mocap::vertical`), else the format's usual one
+/// (a shipped profile's; Y for Motive and TRC, Z otherwise), with a note in the take
+/// when the strokes overrule that or cannot tell.
+fn up_axis(
+    args: &ImportArgs,
+    profile: Option<&CaptureProfile>,
+    format: Option<Format>,
+    take: &mut Take,
+    tips: &[Option<String>; 2],
+) -> UpAxis {
+    let lab_profile = args
+        .profile
+        .as_deref()
+        .is_some_and(|p| Path::new(p).is_file());
+    let profile_up = profile.and_then(|p| p.up.map(UpAxis::from));
+    if let Some(up) = args.up.or(profile_up.filter(|_| lab_profile)) {
+        return up;
+    }
+    let usual = profile_up.unwrap_or(match format {
+        // Motive and OpenSim (TRC) are Y up by convention; Vicon, Qualisys, C3D Z up.
+        Some(Format::Motive | Format::Trc) => UpAxis::Y,
+        _ => UpAxis::Z,
+    });
+    let tracks: Vec<&crate::mocap::Track> = tips
+        .iter()
+        .flatten()
+        .flat_map(|label| label.split('+'))
+        .filter_map(|label| take.track(label.trim()))
+        .collect();
+    let detection = vertical::detect(&tracks, take.rate_hz);
+    let (up, note) = vertical::choose(usual, &detection);
+    take.notes.extend(note);
+    up
 }
 
 /// One file as one take; `only` restricts it to one hand (a file of a pair).
@@ -375,11 +400,12 @@ fn single_source(
     profile: Option<&CaptureProfile>,
     only: Option<Side>,
 ) -> anyhow::Result<Source> {
-    let (take, format) = read_take(path, args, profile)?;
+    let (mut take, format) = read_take(path, args, profile)?;
     let tips = resolve_tips(path, &take, args, profile, only)?;
+    let up = up_axis(args, profile, format, &mut take, &tips);
     Ok(Source {
         path: path.to_path_buf(),
-        up: up_axis(args, profile, format),
+        up,
         tip_offset_m: args
             .tip_offset_m
             .or_else(|| profile.and_then(CaptureProfile::tip_offset)),

@@ -359,8 +359,9 @@ pub enum MocapCommand {
         /// ("RSTK1+RSTK2+RSTK3") [default: from the profile or the labels].
         #[arg(long, value_parser = parse_tips)]
         tips: Option<mocap::TipsArg>,
-        /// Which axis of the capture points up (default: the profile's, y for Motive, z
-        /// otherwise).
+        /// Which axis of the capture points up: x, y, z, neg-x, neg-y or neg-z (default:
+        /// a profile file's; else found from the strokes, which rebound sharply along
+        /// it, and when they cannot tell it, y for Motive and TRC, z otherwise).
         #[arg(long, value_enum)]
         up: Option<UpArg>,
         /// Length unit of the file, overriding what it says: mm, cm or m.

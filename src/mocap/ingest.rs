@@ -20,14 +20,7 @@ use crate::score::{Dynamic, Grip, ImpactLocation, PlayingMode};
 use glam::{DQuat, DVec3};
 use std::path::Path;
 
-/// Which axis of the capture points up.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum UpAxis {
-    /// Y up (OptiTrack Motive's default): (x, y, z) ↦ (x, −z, y).
-    Y,
-    /// Z up (Vicon, Qualisys, most C3D files): kept.
-    Z,
-}
+pub use super::vertical::UpAxis;
 
 /// How to read one capture into the database.
 #[derive(Clone, Debug)]
@@ -815,20 +808,16 @@ fn words(label: &str) -> Vec<String> {
     words
 }
 
-/// A capture position in the performer frame.
+/// A capture position in the performer frame ([`UpAxis::to_performer`]).
 pub fn to_performer(p: DVec3, up: UpAxis) -> DVec3 {
-    match up {
-        UpAxis::Z => p,
-        UpAxis::Y => DVec3::new(p.x, -p.z, p.y),
-    }
+    up.to_performer(p)
 }
 
-/// A capture orientation (world from body) with the world turned like [`to_performer`]:
-/// for Y up, a quarter turn about X.
+/// A capture orientation (world from body) with the world turned like [`to_performer`].
 pub fn rotation_to_performer(q: DQuat, up: UpAxis) -> DQuat {
     match up {
         UpAxis::Z => q,
-        UpAxis::Y => (DQuat::from_rotation_x(std::f64::consts::FRAC_PI_2) * q).normalize(),
+        _ => (up.rotation() * q).normalize(),
     }
 }
 

@@ -14,5 +14,6 @@ pub mod stats;
 pub mod synth;
 pub mod take;
 pub mod tip_estimate;
+pub mod vertical;
 
 pub use take::{ImportError, Take, Track};

@@ -22,7 +22,7 @@
 //!     unit: None,                 // "mm" | "cm" | "m"; else `unit_key`, else the unit row,
 //!     unit_key: None,             //   else metres
 //!     zero_is_missing: false,     // a position (quaternion, matrix) of all zeros is unseen
-//!     up: None,                   // Some(Y) | Some(Z): the capture's up axis (data for the caller)
+//!     up: None,                   // Some(Y) | Some(Z) | Some(NegY) …: the capture's up axis
 //!     tracks: [                   // explicit tracks
 //!         Track(label: "StickR", position: ("StickR X", "StickR Y", "StickR Z"),
 //!               orientation: Some(Euler(columns: ("Roll", "Pitch", "Yaw"), order: "XYZ",
@@ -213,15 +213,23 @@ pub enum TimeColumn {
 /// The capture's up axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Up {
+    X,
     Y,
     Z,
+    NegX,
+    NegY,
+    NegZ,
 }
 
 impl From<Up> for crate::mocap::ingest::UpAxis {
     fn from(up: Up) -> Self {
         match up {
+            Up::X => crate::mocap::ingest::UpAxis::X,
             Up::Y => crate::mocap::ingest::UpAxis::Y,
             Up::Z => crate::mocap::ingest::UpAxis::Z,
+            Up::NegX => crate::mocap::ingest::UpAxis::NegX,
+            Up::NegY => crate::mocap::ingest::UpAxis::NegY,
+            Up::NegZ => crate::mocap::ingest::UpAxis::NegZ,
         }
     }
 }

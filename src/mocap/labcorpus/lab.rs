@@ -356,11 +356,7 @@ pub(super) fn capture(take: &PerformerTake, style: &LabStyle, rng: Rng) -> Gener
         first_frame_number: style.layout.first_frame_number(),
         dropped_frames: dropped,
         unit: style.written_unit().symbol().into(),
-        up_axis: match style.up {
-            UpAxis::Y => "Y",
-            UpAxis::Z => "Z",
-        }
-        .into(),
+        up_axis: style.up.name().trim_start_matches('+').into(),
         lab: style.transform(),
         noise: Noise {
             position_m: style.position_noise_m,

@@ -381,7 +381,8 @@ impl LabStyle {
 }
 
 /// Performer frame → lab frame: turn about the vertical by `yaw_rad`, shift by
-/// `translation_m`, then (Y-up labs) remap (x, y, z) ↦ (x, z, −y).
+/// `translation_m`, then the lab's vertical put where it is (Y-up labs: (x, y, z) ↦
+/// (x, z, −y); [`UpAxis::from_performer`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LabTransform {
     /// Turn about the vertical, rad (counter-clockwise seen from above).
@@ -393,20 +394,13 @@ pub struct LabTransform {
 impl LabTransform {
     /// The lab rotation (applied to performer-frame rotations and directions).
     pub fn rotation(&self, up: UpAxis) -> DQuat {
-        let axes = match up {
-            UpAxis::Z => DQuat::IDENTITY,
-            UpAxis::Y => DQuat::from_rotation_x(-FRAC_PI_2),
-        };
-        axes * DQuat::from_rotation_z(self.yaw_rad)
+        up.rotation().conjugate() * DQuat::from_rotation_z(self.yaw_rad)
     }
 
     /// A performer-frame point in the lab frame, m.
     pub fn to_lab(&self, p: DVec3, up: UpAxis) -> DVec3 {
         let z_up = DQuat::from_rotation_z(self.yaw_rad) * p + DVec3::from(self.translation_m);
-        match up {
-            UpAxis::Z => z_up,
-            UpAxis::Y => DVec3::new(z_up.x, z_up.z, -z_up.y),
-        }
+        up.from_performer(z_up)
     }
 
     /// A lab-frame point back in the performer frame, m.
