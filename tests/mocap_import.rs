@@ -508,3 +508,44 @@ fn corrupt_and_truncated_files_never_panic() {
         }
     }
 }
+
+/// A sample written as exactly (0, 0, 0) — how Vicon, Cortex and many C3D writers mark
+/// an unseen marker — is read as a gap, in C3D and in text, and the note counts them.
+#[test]
+fn zeros_are_read_as_gaps() {
+    let frames = 50;
+    let positions: Vec<Option<DVec3>> = (0..frames)
+        .map(|f| Some(DVec3::new(0.1 * f as f64, 0.2, 0.8)))
+        .collect();
+    let mut zeroed = positions.clone();
+    for f in [3, 4, 5, 30] {
+        zeroed[f] = Some(DVec3::ZERO);
+    }
+    let take = Take {
+        source: "zeros.c3d".into(),
+        rate_hz: 100.0,
+        frames,
+        file_unit: "mm".into(),
+        tracks: vec![Track {
+            label: "TipR".into(),
+            positions: zeroed,
+            rotations: Vec::new(),
+        }],
+        notes: Vec::new(),
+    };
+    let read = import::read_bytes(Path::new("zeros.c3d"), &write_c3d(&take), Format::C3d).unwrap();
+    assert_eq!(seen(&read.tracks[0]), frames - 4);
+    assert!(read.tracks[0].positions[4].is_none());
+    assert!(
+        read.notes
+            .iter()
+            .any(|n| n.starts_with("4 samples at exactly (0, 0, 0)")),
+        "{:?}",
+        read.notes
+    );
+    let csv = "time_s,TipR_x,TipR_y,TipR_z\n0.00,0.1,0.2,0.8\n0.01,0,0,0\n0.02,0.1,0.0,0.8\n0.03,0.1,0.2,0.8\n";
+    let read = import::read_bytes(Path::new("zeros.csv"), csv.as_bytes(), Format::Csv).unwrap();
+    assert_eq!(seen(&read.tracks[0]), 3);
+    assert!(read.tracks[0].positions[1].is_none());
+    assert!(read.notes[0].starts_with("1 sample at"), "{:?}", read.notes);
+}

@@ -56,6 +56,31 @@ impl Take {
         })
     }
 
+    /// Read every sample exactly at the origin (all three coordinates 0.0) as missing,
+    /// as Vicon, Cortex and many C3D writers mark an unseen marker (a rigid body's
+    /// rotation goes with it), with a note; returns how many.
+    pub fn zeros_as_gaps(&mut self) -> usize {
+        let mut n = 0;
+        for t in &mut self.tracks {
+            for (f, p) in t.positions.iter_mut().enumerate() {
+                if *p == Some(DVec3::ZERO) {
+                    *p = None;
+                    if let Some(q) = t.rotations.get_mut(f) {
+                        *q = None;
+                    }
+                    n += 1;
+                }
+            }
+        }
+        if n > 0 {
+            self.notes.push(format!(
+                "{n} {} at exactly (0, 0, 0) read as gaps (the way Vicon, Cortex and many C3D writers mark an unseen marker)",
+                if n == 1 { "sample" } else { "samples" }
+            ));
+        }
+        n
+    }
+
     /// All labels, in file order.
     pub fn labels(&self) -> Vec<&str> {
         self.tracks.iter().map(|t| t.label.as_str()).collect()

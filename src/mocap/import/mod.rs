@@ -216,13 +216,15 @@ pub fn read_bytes_with_unit(
     format: Format,
     unit: Option<LengthUnit>,
 ) -> Result<Take, ImportError> {
-    match format {
+    let mut take = match format {
         Format::C3d => c3d::read(path, bytes, unit),
         Format::Motive => motive::read(path, bytes, unit),
         Format::Vicon => vicon::read(path, bytes, unit),
         Format::Csv => plain_csv::read(path, bytes, unit),
         Format::Trc => trc::read(path, bytes, unit),
-    }
+    }?;
+    take.zeros_as_gaps();
+    Ok(take)
 }
 
 /// Read a column-mapped text capture as `profile` describes it (see [`profile`] and
