@@ -408,6 +408,7 @@ pub fn run(
         },
         wall.as_secs_f64()
     );
+    warn_of_missed_beats(&rendering);
     if ex.bvh.is_some() || ex.glb.is_some() {
         println!(
             "motion frame 0 (BVH, glTF) is at {:.3} s of the score, the WAV's start at 0 s",
@@ -430,6 +431,33 @@ pub fn run(
     }
     Ok(())
 }
+
+/// Name the beats whose strokes found no head (the first [`NAMED_MISSES`]), so a
+/// performance the body could not follow is not taken for a good one.
+fn warn_of_missed_beats(rendering: &Rendering) {
+    let missed = &rendering.missed_beats;
+    if missed.is_empty() {
+        return;
+    }
+    let named: Vec<String> = missed
+        .iter()
+        .take(NAMED_MISSES)
+        .map(|b| b.to_string())
+        .collect();
+    eprintln!(
+        "warning: the strokes of {} beat(s) found no head: beat {}{}; the simulated player could not follow there (a passage too fast or too far for it, or a body that lost its balance after a long run: see README \"Rendering a score\")",
+        missed.len(),
+        named.join(", "),
+        if missed.len() > NAMED_MISSES {
+            ", …"
+        } else {
+            ""
+        }
+    );
+}
+
+/// How many missed beats [`warn_of_missed_beats`] names.
+const NAMED_MISSES: usize = 12;
 
 /// `--video` and `--video-frames`, with a progress bar.
 fn film(rendering: &Rendering, score: &crate::score::Score, ex: &ExportArgs) -> anyhow::Result<()> {

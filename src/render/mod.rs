@@ -251,6 +251,9 @@ pub struct Rendering {
     pub events: Vec<StrikeEvent>,
     /// Timing of the strokes.
     pub timing: Timing,
+    /// The beats (score indices, in time order, each once) of the strokes that found no
+    /// contact.
+    pub missed_beats: Vec<usize>,
     /// Stereo audio from score time 0.
     pub audio: Audio,
     pub stats: Stats,
@@ -501,6 +504,7 @@ pub fn render_composition(
         &matches,
     ));
     let events = strikes::events(&composition.strokes, drums.contacts(), &matches);
+    let missed_beats = strikes::missed_beats(&composition.strokes, &matches);
     Ok(Rendering {
         reference: performance.targets.reference(&performance.warp),
         motion: performance.sim.motion().clone(),
@@ -509,6 +513,7 @@ pub fn render_composition(
         drums: drums.clone(),
         events,
         timing,
+        missed_beats,
         audio,
         stats,
         complete,

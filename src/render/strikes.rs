@@ -219,6 +219,18 @@ pub fn forces_by_dynamic(events: &[StrikeEvent]) -> Vec<DynamicForces> {
         .collect()
 }
 
+/// The beats of the strokes `matches` found no contact for, in the strokes' order, each
+/// once (a roll's strokes share their beat).
+pub fn missed_beats(strokes: &[PlannedStroke], matches: &[Option<usize>]) -> Vec<usize> {
+    let mut beats: Vec<usize> = Vec::new();
+    for (stroke, _) in strokes.iter().zip(matches).filter(|(_, m)| m.is_none()) {
+        if !beats.contains(&stroke.beat) {
+            beats.push(stroke.beat);
+        }
+    }
+    beats
+}
+
 /// How well contacts kept time.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Timing {
@@ -320,6 +332,7 @@ mod tests {
         assert_eq!(e[3].scheduled_s, Some(2.0));
         let t = timing(&errors(&strokes, &contacts, &m));
         assert_eq!((t.strokes, t.missed), (3, 1));
+        assert_eq!(missed_beats(&strokes, &m), vec![30]);
         assert!((t.worst_abs_s - 0.003).abs() < 1e-9 && (t.median_abs_s - 0.0025).abs() < 1e-9);
     }
 }
