@@ -242,7 +242,7 @@ pub fn transcribe(
         Levels::Relative => relative_shift(&strokes, kit),
     };
     let mut table = MarkLevels::default();
-    let mut marks = |p: Pitch| table.at(p).map(|l| l - shift);
+    let mut marks = |p: Pitch| table.at(p).map(|l| l + shift);
     let (placed, found_notes) = notate::place(&strokes, kit, &map, tpq, &mut marks);
     let (beats, rolls) = notate::beats(&placed, kit, tpq);
     score.beats = beats;
@@ -371,7 +371,49 @@ impl MarkLevels {
 
 #[cfg(test)]
 mod tests {
-    use super::fast_runs;
+    use super::*;
+
+    /// Strokes at p, mf and ff on D3, 1.5 s apart, as one recording at `gain`.
+    fn three_dynamics(gain: f32) -> Vec<f32> {
+        let kit = fit::kit_for(Pitch(50).hz());
+        let mut out = vec![0.0f32; (5.0 * f64::from(crate::sound::SAMPLE_RATE_HZ)) as usize];
+        for (k, dynamic) in [Dynamic::P, Dynamic::Mf, Dynamic::F]
+            .into_iter()
+            .enumerate()
+        {
+            let (mono, _) = fit::struck(&kit, dynamic, Calibration::shipped(), 1.5).unwrap();
+            let at = ((0.2 + 1.5 * k as f64) * 48_000.0) as usize;
+            for (o, x) in out[at..].iter_mut().zip(&mono) {
+                *o += gain * x;
+            }
+        }
+        out
+    }
+
+    /// With relative levels the median stroke reads mf whatever the recording's gain, and
+    /// the others keep their order; absolute levels read a quiet recording as softer.
+    #[test]
+    fn relative_levels_undo_the_gain() {
+        let kit = Kit::standard();
+        let dynamics = |gain: f32, levels: Levels| -> Vec<f64> {
+            let options = Options {
+                levels,
+                ..Options::default()
+            };
+            let samples = three_dynamics(gain);
+            let (score, _) = transcribe(&samples, 48_000, &kit, "test", &options).unwrap();
+            score.beats.iter().map(|b| b.dynamic.velocity()).collect()
+        };
+        let mf = Dynamic::Mf.velocity();
+        for gain in [1.0, 0.1, 0.03] {
+            let got = dynamics(gain, Levels::Relative);
+            assert_eq!(got.len(), 3, "gain {gain}: {got:?}");
+            assert_eq!(got[1], mf, "gain {gain}: {got:?}");
+            assert!(got[0] < got[1] && got[1] < got[2], "gain {gain}: {got:?}");
+        }
+        let quiet = dynamics(0.03, Levels::Absolute);
+        assert!(quiet[1] < mf, "{quiet:?}");
+    }
 
     /// Four or more onsets each within 0.15 s of the next make a run; fewer, or a wider
     /// gap, do not.
