@@ -234,6 +234,101 @@ fn c3d_writer_round_trips_gaps_and_drops_rotations() {
     assert!(back.tracks[0].rotations.is_empty());
 }
 
+/// A one-point take whose X (metres) is its frame number / 1000, so a frame read from
+/// the wrong place shows.
+fn counting_take(frames: usize) -> Take {
+    Take {
+        source: "count.c3d".into(),
+        rate_hz: 200.0,
+        frames,
+        file_unit: "mm".into(),
+        tracks: vec![Track {
+            label: "Tip".into(),
+            positions: (0..frames)
+                .map(|f| Some(DVec3::new(f as f64 * 1e-3, 0.1, 0.8)))
+                .collect(),
+            rotations: vec![],
+        }],
+        notes: Vec::new(),
+    }
+}
+
+/// Overwrite a 16-bit header word (1-based, Intel byte order).
+fn set_header_word(bytes: &mut [u8], word: usize, v: u16) {
+    bytes[2 * (word - 1)..2 * word].copy_from_slice(&v.to_le_bytes());
+}
+
+/// Byte position of a parameter record (its name length, group id, then `name`).
+fn param_at(bytes: &[u8], name: &str) -> usize {
+    let n = name.len();
+    (0..bytes.len() - n - 2)
+        .find(|&i| {
+            usize::from(bytes[i]) == n
+                && (bytes[i + 1] as i8) > 0
+                && &bytes[i + 2..i + 2 + n] == name.as_bytes()
+        })
+        .unwrap_or_else(|| panic!("no parameter {name}"))
+}
+
+#[test]
+fn c3d_data_start_parameter_overrules_a_wrong_header_pointer() {
+    let take = counting_take(200);
+    let good = write_c3d(&take);
+    let info = c3d::inspect(Path::new("good.c3d"), &good).unwrap();
+    assert!(info.notes.is_empty(), "{:?}", info.notes);
+    let block = info.data_offset / 512 + 1;
+    // Before the data (on the parameters) and past their start (inside the data).
+    for wrong in [2, block + 2] {
+        let mut bytes = good.clone();
+        set_header_word(&mut bytes, 9, wrong as u16);
+        let back = import::read_bytes(Path::new("moved.c3d"), &bytes, Format::C3d).unwrap();
+        assert_eq!(back.frames, 200);
+        for f in [0, 1, 199] {
+            assert_near(
+                back.tracks[0].positions[f].unwrap(),
+                take.tracks[0].positions[f].unwrap(),
+                1e-6,
+            );
+        }
+        let note = back.notes.join("\n");
+        assert!(
+            note.contains(&format!(
+                "data block {wrong} (word 9), POINT:DATA_START block {block}"
+            )),
+            "{note}"
+        );
+    }
+    // A POINT:DATA_START past the end of the file leaves the header's pointer in charge.
+    let mut bytes = good.clone();
+    let at = param_at(&bytes, "DATA_START") + 2 + "DATA_START".len() + 4;
+    bytes[at..at + 2].copy_from_slice(&9000u16.to_le_bytes());
+    let back = import::read_bytes(Path::new("far.c3d"), &bytes, Format::C3d).unwrap();
+    assert_near(
+        back.tracks[0].positions[199].unwrap(),
+        DVec3::new(0.199, 0.1, 0.8),
+        1e-6,
+    );
+    assert!(
+        back.notes.join(" ").contains("block 9000"),
+        "{:?}",
+        back.notes
+    );
+    // The real files' two pointers agree.
+    for rel in [
+        "c3d/ezc3d_Optotrak.c3d",
+        "c3d/ezc3d_Qualisys.c3d",
+        "c3d/ezc3d_Vicon.c3d",
+    ] {
+        let bytes = std::fs::read(fixture(rel)).unwrap();
+        let info = c3d::inspect(&fixture(rel), &bytes).unwrap();
+        assert!(
+            info.notes.iter().all(|n| !n.contains("DATA_START")),
+            "{rel}: {:?}",
+            info.notes
+        );
+    }
+}
+
 // ---------------------------------------------------------------- Motive
 
 #[test]

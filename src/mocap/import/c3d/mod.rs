@@ -34,6 +34,9 @@
 //!   little-endian and an exponent bias 2 larger: the value is the word-swapped IEEE
 //!   value divided by 4.
 //! * The parameter section's first two bytes are often 0 (Qualisys, Optotrak): ignored.
+//! * **Header word 9 and `POINT:DATA_START` disagreeing** on where the data start: the
+//!   parameter is taken when it points after the parameters inside the file, with a note
+//!   naming both blocks (`layout`).
 //! * The frame count is the header's last − first + 1; `POINT:FRAMES` (an int16 that may
 //!   be meant unsigned) and `POINT:LONG_FRAMES` / `TRIAL` fields are used when they show
 //!   the header overflowed.
@@ -42,6 +45,8 @@
 //!   frames that are not in the file marked missing, and says so in its notes ([`inspect`]
 //!   reports both counts). A file with no whole frame at all is refused. (The Optotrak sample shipped with
 //!   ezc3d declares 1149 frames but holds 29.)
+
+mod layout;
 
 use super::LengthUnit;
 use crate::mocap::take::{ImportError, Take, Track};
@@ -170,6 +175,8 @@ struct Param<'a> {
 struct Params<'a> {
     proc: Processor,
     list: Vec<Param<'a>>,
+    /// Byte offset just past the last record's name, offset word and data.
+    end: usize,
 }
 
 impl<'a> Params<'a> {
@@ -288,6 +295,9 @@ pub struct C3dInfo {
     pub data_offset: usize,
     /// Point labels, one per point.
     pub labels: Vec<String>,
+    /// What the reader had to decide where the header and parameters disagree (data
+    /// start, frame count), one sentence each.
+    pub notes: Vec<String>,
 }
 
 /// Read the header and parameters of a C3D file and work out its layout.
@@ -356,7 +366,7 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
                 .push((!invalid && v.is_finite()).then_some(v));
         }
     }
-    let mut notes = Vec::new();
+    let mut notes = info.notes.clone();
     // Keep the declared length (the frames not in the file marked missing) unless the
     // header claims more samples than any real capture holds.
     const MAX_PADDED_SAMPLES: usize = 50_000_000;
@@ -436,9 +446,10 @@ fn parse(path: &Path, bytes: &[u8]) -> Result<(C3dInfo, Processor), ImportError>
     let rate_hz = frame_rate(path, &params, &h)?;
     let (float_data, scale) = point_storage(path, &params, &h, points)?;
     let analog_values_per_frame = analog_values_per_frame(path, &params, &h, rate_hz)?;
-    let data_offset = data_offset(&bin, &params, &h)?;
-    let declared = declared_frames(&params, &h);
-    let frames = frames_present(
+    let mut notes = Vec::new();
+    let data_offset = layout::data_offset(&bin, &params, &h, usize::from(param_block), &mut notes)?;
+    let declared = layout::declared_frames(&params, &h);
+    let frames = layout::frames_present(
         &bin,
         data_offset,
         points,
@@ -466,6 +477,7 @@ fn parse(path: &Path, bytes: &[u8]) -> Result<(C3dInfo, Processor), ImportError>
             analog_values_per_frame,
             data_offset,
             labels,
+            notes,
         },
         proc,
     ))
@@ -617,102 +629,6 @@ fn analog_values_per_frame(
     })
 }
 
-/// Byte offset of the first frame: the block in header word 9, else in
-/// `POINT:DATA_START`; it must be block 2 or later and inside the file.
-fn data_offset(bin: &Bin, params: &Params, h: &Header) -> Result<usize, ImportError> {
-    let data_block = if h.data_block >= 2 {
-        h.data_block
-    } else {
-        params.first_count("POINT", "DATA_START").unwrap_or(0)
-    };
-    let place = "header word 9 (byte 16)";
-    if data_block < 2 {
-        return Err(ImportError::format(
-            bin.path,
-            place,
-            format!(
-                "expected the first data block (2 or more), found {}",
-                h.data_block
-            ),
-        ));
-    }
-    let data_offset = block_offset(data_block);
-    if data_offset > bin.bytes.len() {
-        return Err(ImportError::format(
-            bin.path,
-            place,
-            format!(
-                "expected the data to start inside the file, found block {data_block} (byte \
-                 {data_offset}) in a file of {} bytes: truncated?",
-                bin.bytes.len()
-            ),
-        ));
-    }
-    Ok(data_offset)
-}
-
-/// Frames declared: the header's last − first + 1, or `POINT:FRAMES` when larger, or
-/// `POINT:LONG_FRAMES` (else the TRIAL start and end fields) when above 65535.
-fn declared_frames(params: &Params, h: &Header) -> usize {
-    let header_frames = if h.last >= h.first {
-        usize::from(h.last - h.first) + 1
-    } else {
-        0
-    };
-    let mut declared = match params.first_count("POINT", "FRAMES") {
-        Some(p) if p > header_frames => p,
-        _ => header_frames,
-    };
-    let long = params.first_count("POINT", "LONG_FRAMES").or_else(|| {
-        let start = params.long_field("TRIAL", "ACTUAL_START_FIELD")?;
-        let end = params.long_field("TRIAL", "ACTUAL_END_FIELD")?;
-        (end >= start).then(|| (end - start) as usize + 1)
-    });
-    if let Some(l) = long.filter(|&l| l > usize::from(u16::MAX)) {
-        declared = declared.max(l);
-    }
-    declared
-}
-
-/// Whole frames present in the data section from `data_offset`, at most `declared`
-/// (`declared` when frames have no size); a data section without one whole frame is
-/// refused.
-fn frames_present(
-    bin: &Bin,
-    data_offset: usize,
-    points: usize,
-    analog_values_per_frame: usize,
-    float_data: bool,
-    declared: usize,
-) -> Result<usize, ImportError> {
-    let (point_size, value_size) = value_sizes(float_data);
-    let frame_size = points
-        .checked_mul(point_size)
-        .and_then(|p| {
-            analog_values_per_frame
-                .checked_mul(value_size)
-                .and_then(|a| p.checked_add(a))
-        })
-        .ok_or_else(|| ImportError::format(bin.path, "header", "expected a sensible frame size"))?;
-    if frame_size == 0 || points == 0 {
-        return Ok(declared);
-    }
-    let data_len = bin.bytes.len() - data_offset;
-    let whole = data_len / frame_size;
-    if whole == 0 && declared > 0 {
-        return Err(ImportError::format(
-            bin.path,
-            format!("byte {data_offset}"),
-            format!(
-                "expected {declared} frames of {frame_size} bytes ({points} points, \
-                 {analog_values_per_frame} analog values), found only {data_len} bytes of \
-                 data: truncated?"
-            ),
-        ));
-    }
-    Ok(whole.min(declared))
-}
-
 /// One label per point: `POINT:LABELS`, then `LABELS2`, `LABELS3`, …; a missing or
 /// blank label becomes `point_<n>` (1-based).
 fn point_labels(params: &Params, points: usize) -> Vec<String> {
@@ -743,6 +659,7 @@ fn parse_params<'a>(
     // (group id, param) with group names filled in at the end (groups may come later).
     let mut raw: Vec<(u8, Param<'a>)> = Vec::new();
     let what = "a parameter record";
+    let mut end = pos;
     loop {
         if data_offset.is_some_and(|d| pos >= d) {
             break;
@@ -756,6 +673,7 @@ fn parse_params<'a>(
         let name = text(bin.slice(pos + 2, n, "a parameter name")?);
         let q = pos + 2 + n;
         let next = bin.u16(q, what)?;
+        end = end.max(q + 2);
         if id < 0 {
             groups.push((id.unsigned_abs(), name));
         } else if id > 0 {
@@ -783,6 +701,7 @@ fn parse_params<'a>(
                 ));
             };
             let data = bin.slice(q + 4 + nd, len, &format!("parameter {name}'s data"))?;
+            end = end.max(q + 4 + nd + len);
             raw.push((
                 id.unsigned_abs(),
                 Param {
@@ -829,6 +748,7 @@ fn parse_params<'a>(
     Ok(Params {
         proc: bin.proc,
         list,
+        end,
     })
 }
 
