@@ -329,6 +329,58 @@ fn c3d_data_start_parameter_overrules_a_wrong_header_pointer() {
     }
 }
 
+#[test]
+fn c3d_over_65535_frames_without_a_long_count_is_read_whole() {
+    let take = counting_take(70_000);
+    let mut bytes = write_c3d(&take);
+    // Hide the writer's long counts (same-length names, so the records stay in place).
+    for (name, hidden) in [
+        ("LONG_FRAMES", "XONG_FRAMES"),
+        ("ACTUAL_END_FIELD", "XCTUAL_END_FIELD"),
+    ] {
+        let at = param_at(&bytes, name) + 2;
+        bytes[at..at + name.len()].copy_from_slice(hidden.as_bytes());
+    }
+    let frames_at = param_at(&bytes, "FRAMES") + 2 + "FRAMES".len() + 4;
+    // Clamped: last frame 65535 (as written); wrapped: 70000 mod 65536; wrapped with a
+    // trailing partial frame of junk after the data.
+    let clamped = bytes.clone();
+    let mut wrapped = bytes.clone();
+    set_header_word(&mut wrapped, 5, 4464);
+    wrapped[frames_at..frames_at + 2].copy_from_slice(&4464u16.to_le_bytes());
+    let data_end = c3d::inspect(Path::new("w.c3d"), &wrapped)
+        .unwrap()
+        .data_offset
+        + 70_000 * 16;
+    let mut junk = wrapped.clone();
+    junk.truncate(data_end);
+    junk.extend_from_slice(&[0x11; 9]);
+    for (case, bytes, why) in [
+        ("clamped", clamped, "its last frame 65535"),
+        ("wrapped", wrapped, "wraps past 65535"),
+        ("junk", junk, "wraps past 65535"),
+    ] {
+        let back = import::read_bytes(Path::new("long.c3d"), &bytes, Format::C3d).unwrap();
+        assert_eq!(back.frames, 70_000, "{case}");
+        assert_eq!(back.tracks[0].positions.len(), 70_000, "{case}");
+        assert_near(
+            back.tracks[0].positions[69_999].unwrap(),
+            DVec3::new(69.999, 0.1, 0.8),
+            1e-4,
+        );
+        let note = back.notes.join(" ");
+        assert!(
+            note.contains(why) && note.contains("holds 70000 whole frames"),
+            "{case}: {note}"
+        );
+    }
+    // A short take's padding is no extra frame.
+    let short = write_c3d(&counting_take(65_535));
+    let back = import::read_bytes(Path::new("s.c3d"), &short, Format::C3d).unwrap();
+    assert_eq!(back.frames, 65_535);
+    assert!(back.notes.is_empty(), "{:?}", back.notes);
+}
+
 // ---------------------------------------------------------------- Motive
 
 #[test]

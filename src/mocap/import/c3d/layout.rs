@@ -7,9 +7,12 @@
 //!   records, inside the file), else the header's, with a note naming both blocks.
 //! * **Frame count**: the header's last − first + 1 (16-bit words), `POINT:FRAMES`
 //!   when larger, `POINT:LONG_FRAMES` or the `TRIAL` start and end fields when above
-//!   65535; at most the whole frames the data section holds.
+//!   65535. Without those last, a take over 65535 frames shows as a header whose last
+//!   frame is clamped to 65535 or whose count wrapped past 65535; the count is then
+//!   taken from the data section's whole frames (a wrapped count by whole turns of
+//!   65536, a clamped one less the zero padding of the last block), with a note.
 
-use super::{Bin, Header, Params, block_offset, value_sizes};
+use super::{BLOCK, Bin, Header, Params, block_offset, value_sizes};
 use crate::mocap::take::ImportError;
 
 /// Byte offset of the first frame: `POINT:DATA_START` when sane, else header word 9
@@ -82,14 +85,15 @@ pub(super) fn data_offset(
 }
 
 /// Frames declared: the header's last − first + 1, or `POINT:FRAMES` when larger, or
-/// `POINT:LONG_FRAMES` (else the TRIAL start and end fields) when above 65535.
-pub(super) fn declared_frames(params: &Params, h: &Header) -> usize {
+/// `POINT:LONG_FRAMES` (else the TRIAL start and end fields) when above 65535. Also
+/// whether a long count was given by either of those last.
+pub(super) fn declared_frames(params: &Params, h: &Header) -> (usize, bool) {
     let header_frames = if h.last >= h.first {
         usize::from(h.last - h.first) + 1
     } else {
         0
     };
-    let mut declared = match params.first_count("POINT", "FRAMES") {
+    let declared = match params.first_count("POINT", "FRAMES") {
         Some(p) if p > header_frames => p,
         _ => header_frames,
     };
@@ -98,34 +102,59 @@ pub(super) fn declared_frames(params: &Params, h: &Header) -> usize {
         let end = params.long_field("TRIAL", "ACTUAL_END_FIELD")?;
         (end >= start).then(|| (end - start) as usize + 1)
     });
-    if let Some(l) = long.filter(|&l| l > usize::from(u16::MAX)) {
-        declared = declared.max(l);
+    match long.filter(|&l| l > usize::from(u16::MAX)) {
+        Some(l) => (declared.max(l), true),
+        None => (declared, false),
     }
-    declared
+}
+
+/// What the data section holds.
+pub(super) struct Present {
+    /// Frames declared, corrected for a clamped or wrapped 16-bit count.
+    pub declared: usize,
+    /// Whole frames read (≤ `declared`).
+    pub frames: usize,
+}
+
+/// The frame layout: bytes per frame of `points` points and `analog` analog values.
+pub(super) struct FrameShape {
+    pub points: usize,
+    pub analog: usize,
+    pub float_data: bool,
 }
 
 /// Whole frames present in the data section from `data_offset`, at most `declared`
 /// (`declared` when frames have no size); a data section without one whole frame is
-/// refused.
+/// refused. Without a long count (`long_known` false), a header whose last frame is
+/// 65535 or whose count is short of the data by whole turns of 65536 gets the count
+/// from the data, with a note.
 pub(super) fn frames_present(
     bin: &Bin,
     data_offset: usize,
-    points: usize,
-    analog_values_per_frame: usize,
-    float_data: bool,
-    declared: usize,
-) -> Result<usize, ImportError> {
+    shape: &FrameShape,
+    h: &Header,
+    (declared, long_known): (usize, bool),
+    notes: &mut Vec<String>,
+) -> Result<Present, ImportError> {
+    let FrameShape {
+        points,
+        analog,
+        float_data,
+    } = *shape;
     let (point_size, value_size) = value_sizes(float_data);
     let frame_size = points
         .checked_mul(point_size)
         .and_then(|p| {
-            analog_values_per_frame
+            analog
                 .checked_mul(value_size)
                 .and_then(|a| p.checked_add(a))
         })
         .ok_or_else(|| ImportError::format(bin.path, "header", "expected a sensible frame size"))?;
     if frame_size == 0 || points == 0 {
-        return Ok(declared);
+        return Ok(Present {
+            declared,
+            frames: declared,
+        });
     }
     let data_len = bin.bytes.len() - data_offset;
     let whole = data_len / frame_size;
@@ -135,10 +164,55 @@ pub(super) fn frames_present(
             format!("byte {data_offset}"),
             format!(
                 "expected {declared} frames of {frame_size} bytes ({points} points, \
-                 {analog_values_per_frame} analog values), found only {data_len} bytes of \
-                 data: truncated?"
+                 {analog} analog values), found only {data_len} bytes of data: truncated?"
             ),
         ));
     }
-    Ok(whole.min(declared))
+    let declared = if long_known {
+        declared
+    } else {
+        uncapped_count(bin, frame_size, data_len, declared, h, notes)
+    };
+    Ok(Present {
+        declared,
+        frames: whole.min(declared),
+    })
+}
+
+/// The frame count of a take over 65535 frames written without `POINT:LONG_FRAMES` or
+/// `TRIAL` fields: the data's whole frames when the header's last frame is clamped at
+/// 65535 (less trailing all-zero frames in the last block's padding), or the declared
+/// count plus the whole turns of 65536 the data hold beyond it (a wrapped count);
+/// otherwise `declared`.
+fn uncapped_count(
+    bin: &Bin,
+    frame_size: usize,
+    data_len: usize,
+    declared: usize,
+    h: &Header,
+    notes: &mut Vec<String>,
+) -> usize {
+    const TURN: usize = 1 << 16;
+    let whole = data_len / frame_size;
+    let (count, why) = if h.last == u16::MAX {
+        let padding = bin.bytes.iter().rev().take_while(|&&b| b == 0).count();
+        let partial = data_len - whole * frame_size;
+        let count = whole - padding.min(BLOCK - 1).saturating_sub(partial) / frame_size;
+        (
+            count,
+            "its last frame 65535 is the most a 16-bit word holds",
+        )
+    } else {
+        let turns = whole.saturating_sub(declared) / TURN;
+        (declared + turns * TURN, "a 16-bit count wraps past 65535")
+    };
+    if count <= declared {
+        return declared;
+    }
+    notes.push(format!(
+        "the header declares {declared} frames ({why}) and neither POINT:LONG_FRAMES nor \
+         TRIAL:ACTUAL_START_FIELD/ACTUAL_END_FIELD gives the count; the data section holds \
+         {count} whole frames: all are read"
+    ));
+    count
 }

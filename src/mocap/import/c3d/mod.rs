@@ -39,7 +39,9 @@
 //!   naming both blocks (`layout`).
 //! * The frame count is the header's last − first + 1; `POINT:FRAMES` (an int16 that may
 //!   be meant unsigned) and `POINT:LONG_FRAMES` / `TRIAL` fields are used when they show
-//!   the header overflowed.
+//!   the header overflowed; without those, a last frame clamped at 65535 or a count
+//!   short of the data by whole turns of 65536 gives way to the data's whole frames,
+//!   with a note (`layout`).
 //! * **A data section that stops early** (fewer whole frames in the file than declared)
 //!   is read up to the last whole frame; the take keeps the declared length with the
 //!   frames that are not in the file marked missing, and says so in its notes ([`inspect`]
@@ -448,14 +450,18 @@ fn parse(path: &Path, bytes: &[u8]) -> Result<(C3dInfo, Processor), ImportError>
     let analog_values_per_frame = analog_values_per_frame(path, &params, &h, rate_hz)?;
     let mut notes = Vec::new();
     let data_offset = layout::data_offset(&bin, &params, &h, usize::from(param_block), &mut notes)?;
-    let declared = layout::declared_frames(&params, &h);
-    let frames = layout::frames_present(
+    let shape = layout::FrameShape {
+        points,
+        analog: analog_values_per_frame,
+        float_data,
+    };
+    let present = layout::frames_present(
         &bin,
         data_offset,
-        points,
-        analog_values_per_frame,
-        float_data,
-        declared,
+        &shape,
+        &h,
+        layout::declared_frames(&params, &h),
+        &mut notes,
     )?;
     let labels = point_labels(&params, points);
     let unit = params
@@ -469,8 +475,8 @@ fn parse(path: &Path, bytes: &[u8]) -> Result<(C3dInfo, Processor), ImportError>
             points,
             rate_hz,
             first_frame: u32::from(h.first),
-            declared_frames: declared,
-            frames,
+            declared_frames: present.declared,
+            frames: present.frames,
             float_data,
             scale,
             unit,
