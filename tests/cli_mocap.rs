@@ -20,6 +20,19 @@ fn timpanist(args: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
+/// A synthetic take of six French legato forte strokes of the right hand.
+fn right_hand_legato() -> MotionDb {
+    synthesize(&SynthConfig {
+        grips: vec![Grip::French],
+        modes: vec![PlayingMode::Legato],
+        locations: vec![ImpactLocation::PlayingSpot],
+        hands: vec![Side::Right],
+        dynamics: vec![Dynamic::F],
+        strokes_per_dynamic: 6,
+        ..SynthConfig::default()
+    })
+}
+
 /// Performer frame (Z up) to Motive's Y-up frame, for positions and rotations.
 fn to_y_up(p: DVec3) -> DVec3 {
     DVec3::new(p.x, p.z, -p.y)
@@ -62,15 +75,7 @@ fn motive_csv(db: &MotionDb) -> String {
 /// yields the units the synthetic take was cut into (impacts ±1 frame).
 #[test]
 fn motive_rigid_body_export_imports() {
-    let source = synthesize(&SynthConfig {
-        grips: vec![Grip::French],
-        modes: vec![PlayingMode::Legato],
-        locations: vec![ImpactLocation::PlayingSpot],
-        hands: vec![Side::Right],
-        dynamics: vec![Dynamic::F],
-        strokes_per_dynamic: 6,
-        ..SynthConfig::default()
-    });
+    let source = right_hand_legato();
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("legato_spot_f_french.csv");
     std::fs::write(&csv, motive_csv(&source)).unwrap();
@@ -226,4 +231,67 @@ fn c3d_and_corrupt_files() {
         "{err}"
     );
     assert!(!dir.path().join("db2").exists());
+}
+
+/// Two tracks labelled alike: refused, naming both places, when the label is the stick
+/// (named by --tips or picked by itself); only a note among tracks not taken.
+#[test]
+fn duplicate_labels_are_refused_when_used() {
+    let source = right_hand_legato();
+    let tip = &source.takes[0].tips[1];
+    let dir = tempfile::tempdir().unwrap();
+    // A Vicon CSV: the tip, then two more tracks labelled `second` and `third` (mm).
+    let write = |name: &str, second: &str, third: &str| {
+        let mut out = format!(
+            "Trajectories\n{}\n,,StickR:Tip,,,{second},,,{third},,\nFrame,Sub Frame,X,Y,Z,X,Y,Z,X,Y,Z\n",
+            source.takes[0].rate_hz
+        );
+        for (f, p) in tip.iter().enumerate() {
+            let p = p.unwrap_or(DVec3::new(0.3, 0.2, 1.0)) * 1000.0;
+            writeln!(
+                out,
+                "{},0,{},{},{},100,500,1200,200,500,1200",
+                f + 1,
+                p.x,
+                p.y,
+                p.z
+            )
+            .unwrap();
+        }
+        let path = dir.path().join(name);
+        std::fs::write(&path, out).unwrap();
+        path
+    };
+    let db_dir = dir.path().join("db");
+    let import = |csv: &Path, extra: &[&str]| {
+        let mut args = vec!["mocap", "import", csv.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["--mode", "legato", "-o", db_dir.to_str().unwrap()]);
+        timpanist(&args)
+    };
+    let arms = write("arms.csv", "Player:WristR", "Player:WristR");
+    let out = import(&arms, &[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains(
+            "two tracks are named \"Player:WristR\" (tracks 2 and 3) (not taken as a stick)"
+        ),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&db_dir).unwrap();
+    let tips = write("tips.csv", "Player:WristR", "StickR:Tip");
+    for extra in [&["--tips", ",StickR:Tip"][..], &[]] {
+        let out = import(&tips, extra);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{extra:?}: {err}");
+        assert!(
+            err.contains(
+                "tips.csv: labels: two tracks are named \"StickR:Tip\" (tracks 1 and 3): rename one"
+            ),
+            "{extra:?}: {err}"
+        );
+        assert!(!err.contains("twice"), "{err}");
+        assert!(!db_dir.exists());
+    }
 }

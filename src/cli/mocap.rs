@@ -402,6 +402,13 @@ fn single_source(
 ) -> anyhow::Result<Source> {
     let (mut take, format) = read_take(path, args, profile)?;
     let tips = resolve_tips(path, &take, args, profile, only)?;
+    let used: Vec<String> = tips
+        .iter()
+        .flatten()
+        .flat_map(|label| label.split('+'))
+        .filter_map(|label| Some(take.track(label.trim())?.label.clone()))
+        .collect();
+    take.note_unused_duplicates(&used);
     let up = up_axis(args, profile, format, &mut take, &tips);
     Ok(Source {
         path: path.to_path_buf(),
@@ -506,7 +513,10 @@ fn resolve_tips(
             place(side, label.clone());
         }
         TipsArg::Unnamed => {
-            let labels = take.labels();
+            // A label two tracks share is looked at once (and refused if taken).
+            let mut labels = take.labels();
+            let mut seen = std::collections::HashSet::new();
+            labels.retain(|l| seen.insert(l.to_ascii_lowercase()));
             let sides: Vec<(Side, &str)> = labels
                 .iter()
                 .filter_map(|l| Some((hand_of(l)?, *l)))

@@ -598,9 +598,10 @@ fn find_tracks<'a>(
     Ok(tracks)
 }
 
-/// The track labelled `label`, or an error listing the labels the file has.
+/// The track labelled `label`, or an error listing the labels the file has, or naming
+/// the places of two tracks labelled alike (which one is the stick cannot be told).
 fn find_track<'a>(path: &Path, take: &'a Take, label: &str) -> Result<&'a Track, ImportError> {
-    take.track(label).ok_or_else(|| {
+    let track = take.track(label).ok_or_else(|| {
         ImportError::format(
             path,
             "labels",
@@ -609,7 +610,19 @@ fn find_track<'a>(path: &Path, take: &'a Take, label: &str) -> Result<&'a Track,
                 take.labels().join(", ")
             ),
         )
-    })
+    })?;
+    let places = take.places_of(track);
+    if places.len() > 1 {
+        return Err(ImportError::format(
+            path,
+            "labels",
+            format!(
+                "{}: rename one in the capture software (or export it again) so the stick's is told apart",
+                crate::mocap::take::duplicate_label(&track.label, &places)
+            ),
+        ));
+    }
+    Ok(track)
 }
 
 /// Medians of the interval between `impacts`, the lift and the approach speed of a tip

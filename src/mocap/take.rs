@@ -81,10 +81,52 @@ impl Take {
         n
     }
 
+    /// The 1-based places in file order of the tracks labelled like `track`
+    /// (case-insensitive): one place, or more when the file names two tracks alike.
+    pub fn places_of(&self, track: &Track) -> Vec<usize> {
+        (1..=self.tracks.len())
+            .filter(|&i| self.tracks[i - 1].label.eq_ignore_ascii_case(&track.label))
+            .collect()
+    }
+
+    /// Note each label two or more tracks share when none of them is among `used` (the
+    /// labels of the tracks taken as sticks); a used one is refused where it is taken.
+    pub fn note_unused_duplicates(&mut self, used: &[String]) {
+        let mut notes = Vec::new();
+        for (i, t) in self.tracks.iter().enumerate() {
+            let places = self.places_of(t);
+            let unused = !used.iter().any(|u| u.eq_ignore_ascii_case(&t.label));
+            if places.len() > 1 && places[0] == i + 1 && unused {
+                notes.push(format!(
+                    "{} (not taken as a stick)",
+                    duplicate_label(&t.label, &places)
+                ));
+            }
+        }
+        self.notes.extend(notes);
+    }
+
     /// All labels, in file order.
     pub fn labels(&self) -> Vec<&str> {
         self.tracks.iter().map(|t| t.label.as_str()).collect()
     }
+}
+
+/// `two tracks are named "L" (tracks 3 and 7)`.
+pub fn duplicate_label(label: &str, places: &[usize]) -> String {
+    let list: Vec<String> = places.iter().map(usize::to_string).collect();
+    let (head, last) = list.split_at(list.len().saturating_sub(1));
+    let count = match places.len() {
+        2 => "two".to_string(),
+        3 => "three".to_string(),
+        n => n.to_string(),
+    };
+    format!(
+        "{count} tracks are named \"{label}\" (tracks {}{}{})",
+        head.join(", "),
+        if head.is_empty() { "" } else { " and " },
+        last.join("")
+    )
 }
 
 /// Why a capture file could not be read.
