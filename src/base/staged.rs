@@ -20,6 +20,14 @@ pub fn destination(path: &Path) -> PathBuf {
     })
 }
 
+/// The folder `path` is in: its parent, or `.` for a bare file name.
+pub fn folder_of(path: &Path) -> &Path {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
 /// Whether `dest` is a device, a pipe or a socket: written into, never replaced.
 fn is_special(dest: &Path) -> bool {
     std::fs::metadata(dest).is_ok_and(|m| !m.is_file() && !m.is_dir())
@@ -30,10 +38,10 @@ fn is_special(dest: &Path) -> bool {
 /// permissions `dest` has, or rw-r--r-- (less the umask) for a new file.
 pub fn beside(dest: &Path, suffix: &str) -> std::io::Result<tempfile::NamedTempFile> {
     let temp_dir = std::env::temp_dir();
-    let dir = match dest.parent() {
-        _ if is_special(dest) => temp_dir.as_path(),
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
+    let dir = if is_special(dest) {
+        temp_dir.as_path()
+    } else {
+        folder_of(dest)
     };
     let mut builder = tempfile::Builder::new();
     builder.prefix(".timpanist-").suffix(suffix);

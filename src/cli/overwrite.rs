@@ -7,6 +7,7 @@
 //! exist or that is a folder, and an output folder that is a file.
 
 use super::{Command, MocapCommand, SoundCommand};
+use crate::base::staged::folder_of;
 use std::path::{Path, PathBuf};
 
 /// The files `command` reads, the files it writes and the folders it writes into.
@@ -108,11 +109,7 @@ fn identity(path: &Path) -> PathBuf {
     if let Ok(real) = std::fs::canonicalize(path) {
         return real;
     }
-    let parent = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    match (std::fs::canonicalize(parent), path.file_name()) {
+    match (std::fs::canonicalize(folder_of(path)), path.file_name()) {
         (Ok(dir), Some(name)) => dir.join(name),
         _ => path.to_path_buf(),
     }
@@ -132,10 +129,7 @@ pub fn check_outputs(command: &Command) -> anyhow::Result<()> {
         if out.is_dir() {
             anyhow::bail!("{}: is a folder; give a file name", out.display());
         }
-        let folder = match out.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p,
-            _ => Path::new("."),
-        };
+        let folder = folder_of(out);
         if !folder.is_dir() {
             anyhow::bail!(
                 "{}: the folder {} does not exist",

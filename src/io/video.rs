@@ -168,10 +168,7 @@ pub fn encode(
     check_target(out)?;
     let format = container(out)?;
     ffmpeg_version()?;
-    let dir = match out.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
+    let dir = crate::base::staged::folder_of(out).to_path_buf();
     let io = |path: &Path| {
         let path = path.to_path_buf();
         move |source| VideoError::Io { path, source }

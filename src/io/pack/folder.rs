@@ -48,10 +48,7 @@ impl Staging {
     /// above `target` if missing).
     pub fn begin(target: &Path, replace: bool) -> Result<Staging, PackError> {
         check(target, replace)?;
-        let parent = match target.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
+        let parent = crate::base::staged::folder_of(target).to_path_buf();
         let name = target
             .file_name()
             .ok_or_else(|| PackError::NoName {
