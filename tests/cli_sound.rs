@@ -178,3 +178,51 @@ fn a_stroke_heard_in_a_hall_fills_the_63_hz_band() {
     let said = String::from_utf8_lossy(&out.stderr);
     assert!(said.contains("studio") && said.contains("hall"), "{said}");
 }
+
+/// `sound analyse` measures every note it can: a recorder's unfinished WAV header (data
+/// size 0) is read with a note; of the times asked with `--at`, one past the file's end
+/// and one on silence are named on stderr while the note at 0 s is still measured; the
+/// command then fails and writes no plot.
+#[test]
+fn analyse_measures_what_it_can_and_names_the_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    let sample =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("kits/samples/Timpani_2R.wav");
+    let mut bytes = std::fs::read(&sample).unwrap();
+    let data = bytes.windows(4).position(|w| w == b"data").unwrap();
+    bytes[data + 4..data + 8].copy_from_slice(&0u32.to_le_bytes());
+    // Two seconds of silence after the note, so a time there finds no note.
+    let (rate, block) = (32_000usize, 2usize);
+    bytes.extend(std::iter::repeat_n(0u8, 2 * rate * block));
+    let wav = dir.path().join("crashed.wav");
+    std::fs::write(&wav, &bytes).unwrap();
+    let png = dir.path().join("spectra.png");
+    let args = [
+        "sound",
+        "analyse",
+        wav.to_str().unwrap(),
+        "--at",
+        "0,4.5,99",
+    ];
+    let out = timpanist(&[&args[..], &["--plot", png.to_str().unwrap()]].concat());
+    let (said, err) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert!(!out.status.success(), "{said}{err}");
+    assert!(
+        err.contains("crashed.wav: its header was not finished"),
+        "{err}"
+    );
+    assert!(
+        said.contains("crashed.wav at 0 s") && said.contains("(1,1)"),
+        "{said}"
+    );
+    assert!(err.contains("crashed.wav at 4.5 s"), "{err}");
+    assert!(err.contains("--at 99 s is outside the file"), "{err}");
+    assert!(
+        err.contains("2 of the 3 notes asked for could not be measured"),
+        "{err}"
+    );
+    assert!(!png.exists());
+}

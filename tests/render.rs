@@ -62,9 +62,11 @@ fn demo_scores_strike_every_beat_on_time() {
         if path.ends_with("roll-exercise.ron") {
             // A roll's attempts resume from the latest state their targets leave
             // unchanged: 43.3 s simulated for its 13.2 s (59.8 s when every attempt
-            // played the whole roll again).
+            // played the whole roll again); 50.6 s since the arms are pulled toward their
+            // posture (`body::sim::ARM_POSTURE_PULL`, 2026-12-07), which moves every
+            // stroke a little and the roll's compensation with it.
             let ratio = r.stats.simulated_s / r.stats.score_s;
-            assert!(ratio < 3.6, "{ratio:.2} s simulated per score second");
+            assert!(ratio < 4.0, "{ratio:.2} s simulated per score second");
         }
         for e in r.events.iter().filter(|e| e.beat.is_some()) {
             recontacts += usize::from(e.recontacts > 0);
@@ -855,6 +857,47 @@ fn the_face_turns_to_the_drum_about_to_be_struck() {
         "the face was {worst:.1}° off the drum about to be struck"
     );
     assert!(span.1 - span.0 > 20.0, "the face hardly turns: {span:?}");
+}
+
+/// A long fast passage: 75 s of sixteenths at 120 bpm going round all four drums in
+/// every mode. Until the arms were pulled back toward their posture (`body::sim::
+/// ARM_POSTURE_PULL`) their redundancy drifted stroke after stroke, and after a minute
+/// the flailing arms shook the trunk and head off their targets and 55 of the last 250
+/// strokes found no head. Every stroke sounds, and the head is still held near its target
+/// over the last ten seconds as over the first.
+#[test]
+fn a_long_fast_passage_plays_to_the_end() {
+    let mut score = Score::new("long fast passage");
+    score.tempo[0].bpm = 120.0;
+    let sixteenth = u64::from(score.ticks_per_quarter) / 4;
+    let dynamics = [Dynamic::P, Dynamic::Mf, Dynamic::F];
+    for i in 0..600u64 {
+        let mut beat = Beat::plain(i * sixteenth, [1, 2, 1, 2, 0, 3][(i % 6) as usize]);
+        beat.mode = PlayingMode::ALL[(i % 5) as usize];
+        beat.dynamic = dynamics[((i / 7) % 3) as usize];
+        score.beats.push(beat);
+    }
+    let loaded = LoadedScore::from_score(&root().join("long-passage.ron"), score).unwrap();
+    let r = render(&loaded, &db(), &RenderParams::default(), &mut |_| true).unwrap();
+    assert!(r.missed_beats.is_empty(), "missed {:?}", r.missed_beats);
+    assert_eq!(r.timing.missed, 0, "{:?}", r.timing);
+    // The neck's and head's turns (off their rest), largest per window: the gaze turns
+    // them by 10–25°; the run that lost the strokes had them at 100°.
+    let turned = |from_s: f64, to_s: f64| {
+        let rate = r.motion.rate_hz;
+        let (a, b) = ((from_s * rate) as usize, (to_s * rate) as usize);
+        let joints = [timpanist::body::Joint::Neck, timpanist::body::Joint::Head];
+        (a..b.min(r.motion.poses.len()))
+            .flat_map(|k| joints.map(|j| r.motion.poses[k][j.index()]))
+            .map(|q| (2.0 * q.w.abs().min(1.0).acos()).to_degrees())
+            .fold(0.0, f64::max)
+    };
+    let (first, last) = (turned(2.0, 12.0), turned(63.0, 73.0));
+    println!("neck and head turned at most {first:.1}° (first 10 s), {last:.1}° (last 10 s)");
+    assert!(
+        last < 40.0 && last < first + 10.0,
+        "{first:.1}° then {last:.1}°"
+    );
 }
 
 /// The contacts of at least [`RECONTACT_MIN_N`] (grazes below it come and go with any

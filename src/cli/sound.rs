@@ -85,7 +85,7 @@ pub fn fit(files: &[PathBuf], output: &Path) -> anyhow::Result<()> {
         files
             .iter()
             .map(|path| {
-                let (samples, rate_hz) = crate::sound::recording::read_mono(path)?;
+                let (samples, rate_hz) = read_recording(path)?;
                 if let Some(why) = analysis::not_a_note(&samples, rate_hz) {
                     anyhow::bail!("{}: {why}", path.display());
                 }
@@ -129,12 +129,37 @@ pub fn fit(files: &[PathBuf], output: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// A recording read to mono (samples, rate in Hz), its notes printed.
+fn read_recording(path: &Path) -> anyhow::Result<(Vec<f32>, u32)> {
+    let (samples, rate, notes) = crate::sound::recording::read_mono_noted(path)?;
+    for note in notes {
+        eprintln!("note: {note}");
+    }
+    Ok((samples, rate))
+}
+
 /// Print each file's measurements, one block per file (per note with `at`); with `plot`,
-/// draw their spectra against the recordings.
+/// draw their spectra against the recordings. A file or note that cannot be measured is
+/// named on stderr and the others are still measured; the command then fails, and no plot
+/// is written.
 pub fn analyse(files: &[PathBuf], at: &[f64], plot: Option<&Path>) -> anyhow::Result<()> {
     let mut panels = Vec::new();
+    let (mut asked, mut failed) = (0, 0);
+    let mut report = |result: anyhow::Result<()>| {
+        asked += 1;
+        if let Err(e) = result {
+            eprintln!("error: {e:#}");
+            failed += 1;
+        }
+    };
     for path in files {
-        let (all, rate) = crate::sound::recording::read_mono(path)?;
+        let (all, rate) = match read_recording(path) {
+            Ok(read) => read,
+            Err(e) => {
+                report(Err(e));
+                continue;
+            }
+        };
         let duration = all.len() as f64 / f64::from(rate);
         let starts: Vec<Option<f64>> = if at.is_empty() {
             vec![None]
@@ -146,10 +171,13 @@ pub fn analyse(files: &[PathBuf], at: &[f64], plot: Option<&Path>) -> anyhow::Re
                 Some(t) if t.is_finite() && (0.0..duration).contains(&t) => {
                     ((t - 0.01).max(0.0) * f64::from(rate)) as usize
                 }
-                Some(t) => anyhow::bail!(
-                    "{}: --at {t} s is outside the file (0-{duration:.2} s)",
-                    path.display()
-                ),
+                Some(t) => {
+                    report(Err(anyhow::anyhow!(
+                        "{}: --at {t} s is outside the file (0-{duration:.2} s)",
+                        path.display()
+                    )));
+                    continue;
+                }
                 None => 0,
             };
             // A note ends where the next one asked for starts.
@@ -162,11 +190,16 @@ pub fn analyse(files: &[PathBuf], at: &[f64], plot: Option<&Path>) -> anyhow::Re
                 .min(all.len());
             let label = start.map_or(String::new(), |t| format!(" at {t} s"));
             let name = format!("{}{label}", path.display());
-            analyse_note(&name, &all[from..to], rate)?;
-            if plot.is_some() {
+            let measured = analyse_note(&name, &all[from..to], rate);
+            if measured.is_ok() && plot.is_some() {
                 panels.push(spectrum_panel(&name, &all[from..to], rate));
             }
+            report(measured);
         }
+    }
+    if failed > 0 {
+        let plot = plot.map_or(String::new(), |p| format!(" ({} not written)", p.display()));
+        anyhow::bail!("{failed} of the {asked} notes asked for could not be measured{plot}");
     }
     if let Some(path) = plot {
         spectra_figure(panels).save_png(path)?;

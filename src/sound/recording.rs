@@ -39,7 +39,13 @@ pub struct ReadError {
 
 /// A recording's channels averaged to mono (samples in −1…1), with its rate, Hz.
 pub fn read_mono(path: &Path) -> Result<(Vec<f32>, u32), ReadError> {
-    let bytes = crate::base::limits::read_at_most(
+    read_mono_noted(path).map(|(samples, rate, _)| (samples, rate))
+}
+
+/// [`read_mono`], with notes on what was read round (a WAV header left unfinished by a
+/// recorder that stopped: [`finish_wav_sizes`]).
+pub fn read_mono_noted(path: &Path) -> Result<(Vec<f32>, u32, Vec<String>), ReadError> {
+    let mut bytes = crate::base::limits::read_at_most(
         path,
         crate::base::limits::MAX_CAPTURE_FILE_BYTES,
         "recording",
@@ -48,7 +54,69 @@ pub fn read_mono(path: &Path) -> Result<(Vec<f32>, u32), ReadError> {
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
-    read_mono_bytes(path, &bytes)
+    let notes: Vec<String> = finish_wav_sizes(&mut bytes)
+        .into_iter()
+        .map(|n| format!("{}: {n}", path.display()))
+        .collect();
+    let (samples, rate) = read_mono_bytes(path, &bytes)?;
+    Ok((samples, rate, notes))
+}
+
+/// The size a recorder writes in a WAV header it means to finish when it stops: a crash
+/// leaves 0 or 0xFFFFFFFF (streaming writers' "unknown").
+const UNFINISHED_SIZES: [u32; 2] = [0, u32::MAX];
+
+/// A RIFF/WAVE file whose RIFF size or `data` chunk size was left unfinished
+/// ([`UNFINISHED_SIZES`]) or runs past the file's end (a recorder that crashed or lost
+/// power before closing the file; ffmpeg and Audacity read such files) is given the sizes
+/// of what the file holds, in place. Returns what was changed, for a note.
+fn finish_wav_sizes(bytes: &mut [u8]) -> Option<String> {
+    if bytes.len() < 12 || &bytes[..4] != b"RIFF" || &bytes[8..12] != b"WAVE" {
+        return None;
+    }
+    let len = bytes.len();
+    let size_at =
+        |b: &[u8], at: usize| u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]);
+    let (mut at, mut data) = (12, None);
+    while at + 8 <= len {
+        let size = size_at(bytes, at + 4);
+        if &bytes[at..at + 4] == b"data" {
+            data = Some((at, size));
+            break;
+        }
+        at += 8 + size as usize + (size as usize & 1);
+    }
+    let (at, size) = data?;
+    let held = u32::try_from(len - (at + 8)).ok()?;
+    let riff = size_at(bytes, 4);
+    let riff_held = u32::try_from(len - 8).ok()?;
+    let data_unfinished = UNFINISHED_SIZES.contains(&size) && held > 0 || size > held;
+    let riff_unfinished = UNFINISHED_SIZES.contains(&riff) || riff > riff_held;
+    if !data_unfinished && !riff_unfinished {
+        return None;
+    }
+    bytes[4..8].copy_from_slice(&riff_held.to_le_bytes());
+    if data_unfinished {
+        bytes[at + 4..at + 8].copy_from_slice(&held.to_le_bytes());
+    }
+    Some(
+        if data_unfinished && size > held && !UNFINISHED_SIZES.contains(&size) {
+            format!(
+                "the file is cut short: its header gives {size} bytes of sound, it holds {held} \
+             (read those)"
+            )
+        } else {
+            let (what, said) = if data_unfinished {
+                ("sound data", size)
+            } else {
+                ("file size", riff)
+            };
+            format!(
+                "its header was not finished (it gives the {what} as {said} bytes: a recorder \
+             that stopped before closing the file?): read the {held} bytes of sound it holds"
+            )
+        },
+    )
 }
 
 /// [`read_mono`] of a recording held in memory (`path` names it in errors; its extension,
@@ -203,6 +271,53 @@ fn downmix(raw: &[f32], ch: usize) -> Vec<f32> {
 
 #[cfg(test)]
 mod tests {
+
+    /// A WAV whose recorder stopped before finishing its header (RIFF and data sizes 0 or
+    /// 0xFFFFFFFF, as crashed or streaming recorders leave them) or was cut short reads
+    /// the samples the file holds, the same as the whole file, with a note saying so.
+    #[test]
+    fn unfinished_wav_headers_read_what_the_file_holds() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("kits/samples/Timpani_2R.wav");
+        let whole = std::fs::read(&path).unwrap();
+        let (samples, rate) = read_mono_bytes(&path, &whole).unwrap();
+        let data = whole.windows(4).position(|w| w == b"data").unwrap();
+        let set =
+            |b: &mut Vec<u8>, at: usize, v: u32| b[at..at + 4].copy_from_slice(&v.to_le_bytes());
+        let max = Some(u32::MAX);
+        let cases = [
+            (Some(0), Some(0)),
+            (max, max),
+            (None, Some(0)),
+            (None, max),
+            (Some(0), None),
+            (max, None),
+        ];
+        for (riff, size) in cases {
+            let mut bytes = whole.clone();
+            if let Some(r) = riff {
+                set(&mut bytes, 4, r);
+            }
+            if let Some(s) = size {
+                set(&mut bytes, data + 4, s);
+            }
+            let note = finish_wav_sizes(&mut bytes).expect("a note");
+            assert!(note.contains("not finished"), "{note}");
+            assert_eq!(bytes, whole, "riff {riff:?} data {size:?}");
+            assert_eq!(
+                read_mono_bytes(&path, &bytes).unwrap(),
+                (samples.clone(), rate)
+            );
+        }
+        // Cut short: the first half of the sound.
+        let mut cut = whole[..data + 8 + (whole.len() - data - 8) / 2].to_vec();
+        let note = finish_wav_sizes(&mut cut).expect("a note");
+        assert!(note.contains("cut short"), "{note}");
+        let (half, _) = read_mono_bytes(&path, &cut).unwrap();
+        assert!(half.len() + 2 >= samples.len() / 2 && half.len() <= samples.len() / 2 + 2);
+        // A finished file is left alone.
+        let mut same = whole.clone();
+        assert_eq!(finish_wav_sizes(&mut same), None);
+    }
     use super::*;
     use std::f64::consts::TAU;
 

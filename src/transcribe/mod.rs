@@ -114,7 +114,7 @@ pub fn transcribe_file(
     kit: &Kit,
     options: &Options,
 ) -> Result<(Score, Report), TranscribeError> {
-    let (samples, rate) = recording::read_mono(path)?;
+    let (samples, rate, read_notes) = recording::read_mono_noted(path)?;
     let mut options = options.clone();
     if options.title.is_none() {
         options.title = path
@@ -122,7 +122,10 @@ pub fn transcribe_file(
             .map(|s| s.to_string_lossy().into_owned())
             .filter(|s| !s.is_empty());
     }
-    transcribe(&samples, rate, kit, &path.display().to_string(), &options)
+    let (score, mut report) =
+        transcribe(&samples, rate, kit, &path.display().to_string(), &options)?;
+    report.notices.splice(0..0, read_notes);
+    Ok((score, report))
 }
 
 /// Transcribe mono `samples` at `rate_hz` (named `source` in messages) onto `kit`.
