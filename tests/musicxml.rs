@@ -1036,6 +1036,51 @@ fn malformed_input_errors() {
     );
 }
 
+/// A compressed MusicXML archive holding `xml` as `name`, named by its container.
+fn mxl_of(name: &str, xml: &[u8]) -> Vec<u8> {
+    use std::io::Write as _;
+    let container = format!(
+        r#"<?xml version="1.0" encoding="UTF-8"?><container><rootfiles><rootfile full-path="{name}"/></rootfiles></container>"#
+    );
+    let deflated = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated);
+    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    for (entry, bytes) in [
+        ("META-INF/container.xml", container.as_bytes()),
+        (name, xml),
+    ] {
+        zip.start_file(entry, deflated).unwrap();
+        zip.write_all(bytes).unwrap();
+    }
+    zip.finish().unwrap().into_inner()
+}
+
+/// A zip bomb is refused: a score padded (inside an XML comment) to one byte past the
+/// 64 MiB an `.mxl` entry may unpack to names the file and the entry, the archive itself
+/// being a few hundred kB; the same score padded to exactly 64 MiB imports.
+#[test]
+fn mxl_entries_past_64_mib_are_refused() {
+    const LIMIT: usize = 64 << 20;
+    let kit = Kit::standard();
+    let opts = ImportOptions::default();
+    let score = doc(&[&format!("{}{}", attrs(1), note("D3", 4, ""))]);
+    let padded = |len: usize| {
+        let pad = len - score.len() - "<!---->".len();
+        format!("{score}<!--{}-->", " ".repeat(pad)).into_bytes()
+    };
+    let bomb = mxl_of("score.musicxml", &padded(LIMIT + 1));
+    assert!(bomb.len() < 1 << 20, "{} bytes", bomb.len());
+    let e = import(Path::new("bomb.mxl"), &bomb, &kit, &opts).unwrap_err();
+    assert!(matches!(e, MusicXmlError::EntryTooLarge { .. }), "{e:?}");
+    assert_eq!(
+        e.to_string(),
+        "bomb.mxl: score.musicxml expands past 64 MiB: not a score?"
+    );
+    let full = mxl_of("score.musicxml", &padded(LIMIT));
+    let (score, _) = import(Path::new("full.mxl"), &full, &kit, &opts).unwrap();
+    assert_eq!(score.beats.len(), 1);
+}
+
 /// Every file of the MusicXML test suite either imports into a playable score or fails
 /// with an error naming it; none panics. Files without a timpani part are read with
 /// `--part` set to their first part.

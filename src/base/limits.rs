@@ -1,7 +1,8 @@
 //! The limits timpanist holds its inputs to, so a huge or hostile file is refused with a
-//! clear message instead of exhausting memory: file sizes per kind, and the length of a
-//! score (beats and seconds: a render holds the whole performance, 10 kHz motion and
-//! 48 kHz audio per drum, in memory — a 30-minute score takes about 2 GB).
+//! clear message instead of exhausting memory: file sizes per kind (and what a compressed
+//! file may unpack to), and the length of a score (beats and seconds: a render holds the
+//! whole performance, 10 kHz motion and 48 kHz audio per drum, in memory — a 30-minute
+//! score takes about 2 GB).
 
 use std::io::Read;
 use std::path::Path;
@@ -13,6 +14,10 @@ pub const MAX_MIDI_FILE_BYTES: u64 = 16 << 20;
 /// Largest MusicXML file imported (plain or `.mxl`), bytes (a whole orchestral score in
 /// plain MusicXML is tens of MB).
 pub const MAX_MUSICXML_FILE_BYTES: u64 = 256 << 20;
+/// Most bytes one file inside a compressed MusicXML (`.mxl`) archive may unpack to
+/// (64 MiB): the largest real scores unpack to a few MB, so an entry beyond it is taken
+/// for a zip bomb and refused after reading this much, whatever size the archive declares.
+pub const MAX_MXL_ENTRY_BYTES: u64 = 64 << 20;
 /// Largest motion-capture file imported, bytes (an hour of 250 Hz C3D markers is a few
 /// hundred MB).
 pub const MAX_CAPTURE_FILE_BYTES: u64 = 1 << 30;

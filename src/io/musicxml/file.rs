@@ -20,10 +20,7 @@ pub(super) fn score_text(
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("mxl"));
     if is_mxl {
-        return Err(MusicXmlError::Archive {
-            path: path.to_path_buf(),
-            message: "the file is not a zip archive".into(),
-        });
+        return Err(archive_error(path, "the file is not a zip archive".into()));
     }
     decode(path, bytes)
 }
@@ -34,29 +31,9 @@ pub(super) fn unzip_root(
     bytes: &[u8],
     notices: &mut Notices,
 ) -> Result<(String, Vec<u8>), MusicXmlError> {
-    let archive_err = |message: String| MusicXmlError::Archive {
-        path: path.to_path_buf(),
-        message,
-    };
+    let archive_err = |message: String| archive_error(path, message);
     let mut zip = zip::ZipArchive::new(std::io::Cursor::new(bytes))
         .map_err(|e| archive_err(format!("corrupt zip: {e}")))?;
-    let read_entry = |zip: &mut zip::ZipArchive<_>, name: &str| -> Result<Vec<u8>, MusicXmlError> {
-        let entry = zip
-            .by_name(name)
-            .map_err(|e| archive_err(format!("cannot open {name}: {e}")))?;
-        if entry.size() > MAX_ENTRY_BYTES {
-            return Err(archive_err(format!(
-                "{name} is {} bytes unpacked, more than the {MAX_ENTRY_BYTES} read",
-                entry.size()
-            )));
-        }
-        let mut out = Vec::new();
-        entry
-            .take(MAX_ENTRY_BYTES)
-            .read_to_end(&mut out)
-            .map_err(|e| archive_err(format!("corrupt entry {name}: {e}")))?;
-        Ok(out)
-    };
     let names: Vec<String> = zip
         .file_names()
         .map(|n| n.map(|n| n.into_owned()))
@@ -64,7 +41,7 @@ pub(super) fn unzip_root(
         .map_err(|e| archive_err(format!("unreadable file name: {e}")))?;
     const CONTAINER: &str = "META-INF/container.xml";
     if names.iter().any(|n| n == CONTAINER) {
-        let container = read_entry(&mut zip, CONTAINER)?;
+        let container = read_entry(path, &mut zip, CONTAINER)?;
         let shown = PathBuf::from(format!("{}:{CONTAINER}", path.display()));
         let text = decode(&shown, &container)?;
         let doc = Document::parse(&text).map_err(|e| xml_error(&shown, &text, &e))?;
@@ -82,7 +59,7 @@ pub(super) fn unzip_root(
                 ))
             })?
             .to_string();
-        let inner = read_entry(&mut zip, &root_file)?;
+        let inner = read_entry(path, &mut zip, &root_file)?;
         return Ok((root_file, inner));
     }
     let fallback = names
@@ -97,8 +74,45 @@ pub(super) fn unzip_root(
     notices.push_text(format!(
         "the archive has no {CONTAINER}; read {fallback}, its first MusicXML file"
     ));
-    let inner = read_entry(&mut zip, &fallback)?;
+    let inner = read_entry(path, &mut zip, &fallback)?;
     Ok((fallback, inner))
+}
+
+/// The bytes of the file `name` in the `.mxl` archive `zip` (read from `path`), read
+/// through a reader that stops one byte past
+/// [`MAX_MXL_ENTRY_BYTES`](crate::base::limits::MAX_MXL_ENTRY_BYTES): an entry that unpacks
+/// to more is refused (a zip bomb), whatever size the archive declares for it.
+fn read_entry(
+    path: &Path,
+    zip: &mut zip::ZipArchive<std::io::Cursor<&[u8]>>,
+    name: &str,
+) -> Result<Vec<u8>, MusicXmlError> {
+    use crate::base::limits::MAX_MXL_ENTRY_BYTES;
+    let archive_err = |message: String| archive_error(path, message);
+    let entry = zip
+        .by_name(name)
+        .map_err(|e| archive_err(format!("cannot open {name}: {e}")))?;
+    // The declared size only sizes the buffer, never past the limit.
+    let mut out = Vec::with_capacity(entry.size().min(MAX_MXL_ENTRY_BYTES + 1) as usize);
+    entry
+        .take(MAX_MXL_ENTRY_BYTES + 1)
+        .read_to_end(&mut out)
+        .map_err(|e| archive_err(format!("corrupt entry {name}: {e}")))?;
+    if out.len() as u64 > MAX_MXL_ENTRY_BYTES {
+        return Err(MusicXmlError::EntryTooLarge {
+            path: path.to_path_buf(),
+            entry: name.to_string(),
+        });
+    }
+    Ok(out)
+}
+
+/// A `.mxl` at `path` that cannot be read as one, and why.
+fn archive_error(path: &Path, message: String) -> MusicXmlError {
+    MusicXmlError::Archive {
+        path: path.to_path_buf(),
+        message,
+    }
 }
 
 /// A parse error with its place (said once: roxmltree's text ends with it too).

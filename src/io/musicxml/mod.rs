@@ -64,8 +64,6 @@ const DEFAULT_BPM: f64 = 120.0;
 const DEFAULT_VELOCITY: f64 = 80.0;
 /// Strokes per quarter note of an unmeasured tremolo (a free roll), as three marks.
 const UNMEASURED_STROKES_PER_QUARTER: u32 = 8;
-/// Largest file read out of an `.mxl` archive, bytes.
-const MAX_ENTRY_BYTES: u64 = 512 << 20;
 /// General MIDI program of the timpani, counted from 1 as MusicXML does.
 const GM_TIMPANI_1: u32 = 48;
 
@@ -119,6 +117,13 @@ pub enum MusicXmlError {
     /// A `.mxl` that is not a readable zip, or lacks its score.
     #[error("{}: not a readable compressed MusicXML (.mxl) file: {message}", path.display())]
     Archive { path: PathBuf, message: String },
+    /// A file inside a `.mxl` that unpacks to more than
+    /// [`MAX_MXL_ENTRY_BYTES`](crate::base::limits::MAX_MXL_ENTRY_BYTES) (a zip bomb).
+    #[error(
+        "{}: {entry} expands past {} MiB: not a score?",
+        path.display(), crate::base::limits::MAX_MXL_ENTRY_BYTES >> 20
+    )]
+    EntryTooLarge { path: PathBuf, entry: String },
     /// The text is not well-formed XML (or not in its declared encoding).
     #[error("{}:{line}:{column}: malformed XML: {message}", path.display())]
     Xml {
