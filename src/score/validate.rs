@@ -86,12 +86,8 @@ pub fn problems(score: &Score, kit: &Kit) -> Vec<Problem> {
         {
             bad(format!("velocity {v} is not between 0 and 1"));
         }
-        if let ImpactLocation::Point { radius, angle_deg } = beat.location
-            && !((0.0..=1.0).contains(&radius) && angle_deg.is_finite())
-        {
-            bad(format!(
-                "impact point radius {radius} must be a fraction 0–1 of the head radius, with a finite angle"
-            ));
+        if let ImpactLocation::Point { radius, angle_deg } = beat.location {
+            point_problems(radius, angle_deg).for_each(&mut bad);
         }
         if let Some(roll) = beat.roll {
             let per_quarter_ok = (1..=32).contains(&roll.strokes_per_quarter)
@@ -163,6 +159,19 @@ pub fn problems(score: &Score, kit: &Kit) -> Vec<Problem> {
     out
 }
 
+/// What is wrong with an impact point `Point(radius: …, angle_deg: …)`, each naming its
+/// field: a radius outside 0–1 of the head's radius, an angle that is not a finite
+/// number of degrees (NaN or infinite).
+fn point_problems(radius: f64, angle_deg: f64) -> impl Iterator<Item = String> {
+    let radius_bad = !(0.0..=1.0).contains(&radius);
+    let angle_bad = !angle_deg.is_finite();
+    let radius = radius_bad
+        .then(|| format!("impact point radius {radius} must be a fraction 0–1 of the head radius"));
+    let angle = angle_bad
+        .then(|| format!("impact point angle_deg {angle_deg} must be a finite angle, degrees"));
+    radius.into_iter().chain(angle)
+}
+
 /// Longest wait before a damping touch, quarter notes (after that the drum has died away).
 pub const MAX_DAMP_QUARTERS: u64 = 16;
 
@@ -225,6 +234,24 @@ mod tests {
         assert!(first_problem(&s).contains("damp 0 ticks"));
         s.beats[0].damp = Some(960);
         assert!(first_problem(&s).is_empty());
+
+        s.beats = vec![beat(0, 0)];
+        s.beats[0].location = ImpactLocation::Point {
+            radius: 0.5,
+            angle_deg: f64::NAN,
+        };
+        assert_eq!(
+            first_problem(&s),
+            "beat 0 (bar 1 beat 1): impact point angle_deg NaN must be a finite angle, degrees"
+        );
+        s.beats[0].location = ImpactLocation::Point {
+            radius: 1.5,
+            angle_deg: 0.0,
+        };
+        assert_eq!(
+            first_problem(&s),
+            "beat 0 (bar 1 beat 1): impact point radius 1.5 must be a fraction 0–1 of the head radius"
+        );
 
         s.beats = vec![beat(0, 0)];
         s.tempo[0].bpm = 2000.0;
