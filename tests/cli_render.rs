@@ -246,6 +246,44 @@ fn cli_render_refuses_bad_scores_cleanly() {
     );
 }
 
+/// The standard error of `timpanist ARGS`, which must fail.
+fn failed(args: &[&std::ffi::OsStr]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_timpanist"))
+        .current_dir(root())
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// `render` names a beat by its place in the file's `beats` list, as `check` does
+/// (`tests/files.rs`), when the file lists them out of time order: the stroke out of
+/// reach, at 960 ticks, is the file's beat 1 (the score's first in time).
+#[test]
+fn cli_render_names_beats_as_the_file_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let wav = dir.path().join("out.wav");
+    let mut score = Score::new("reach");
+    let mut far = Beat::plain(960, 0);
+    far.hand = Hand::Right;
+    far.location = ImpactLocation::Centre;
+    score.beats = vec![Beat::plain(1920, 1), far];
+    let path = dir.path().join("far.ron");
+    score.save(&path).unwrap();
+    let stderr = failed(&[
+        "render".as_ref(),
+        path.as_ref(),
+        "--wav".as_ref(),
+        wav.as_ref(),
+    ]);
+    assert!(
+        stderr.contains("far.ron: beat 1 is out of the right hand's reach"),
+        "{stderr}"
+    );
+    assert!(!wav.exists());
+}
+
 /// Without the `editor` feature, `timpanist edit` fails at once and says how to get the
 /// editor (with it, the editor would open a window: not run here).
 #[cfg(not(feature = "editor"))]
@@ -265,7 +303,7 @@ fn headless_edit_says_how_to_get_the_editor() {
 }
 
 /// A score asking a drum for a second pitch renders, retuning the drum between the two
-/// beats, and says so.
+/// beats, and says so, naming the beat as the file lists it.
 #[test]
 fn cli_render_names_the_pedal_changes() {
     let dir = tempfile::tempdir().unwrap();
@@ -291,8 +329,21 @@ fn cli_render_names_the_pedal_changes() {
             line + "\n"
         })
         .collect();
+    // The first beat (D3, tick 0) listed last: the change, at tick 960, is the file's
+    // beat 0 — `render` and `check` name it so.
+    let mut lines: Vec<&str> = text.lines().collect();
+    let first = lines
+        .iter()
+        .position(|l| l.contains("Beat(tick: 0,"))
+        .unwrap();
+    let last = lines
+        .iter()
+        .rposition(|l| l.trim_start().starts_with("Beat("))
+        .unwrap();
+    let moved = lines.remove(first);
+    lines.insert(last, moved);
     let score = dir.path().join("pedal.ron");
-    std::fs::write(&score, text).unwrap();
+    std::fs::write(&score, lines.join("\n")).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_timpanist"))
         .args(["render"])
         .arg(&score)
@@ -303,7 +354,7 @@ fn cli_render_names_the_pedal_changes() {
     succeeded(&out);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        stderr.contains("beat 1: drum 0 is retuned from D3 to E3 in the"),
+        stderr.contains("beat 0: drum 0 is retuned from D3 to E3 in the"),
         "{stderr}"
     );
     // `check` finds the score valid and says the same.
@@ -314,7 +365,7 @@ fn cli_render_names_the_pedal_changes() {
         .unwrap();
     let stdout = succeeded(&out);
     assert!(
-        stdout.contains("(note: 1 pedal change(s), ") && stdout.contains("; beat 1: drum 0"),
+        stdout.contains("(note: 1 pedal change(s), ") && stdout.contains("; beat 0: drum 0"),
         "{stdout}"
     );
 }

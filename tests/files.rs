@@ -152,6 +152,78 @@ fn content_errors_name_the_place() {
     );
 }
 
+/// A beat's problem names it by its place in the file's `beats` list and gives the line
+/// and column of its entry, whatever order the file lists the beats in; an impact angle
+/// that is no number is named as the angle, not the radius.
+#[test]
+fn beat_problems_name_the_file_number_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut score = Score::new("out of order");
+    let mut nan = timpanist::score::Beat::plain(960, 0);
+    nan.location = timpanist::score::ImpactLocation::Point {
+        radius: 0.5,
+        angle_deg: f64::NAN,
+    };
+    // Listed in the file as ticks 1920, 0 (no such drum), 960 (angle NaN).
+    score.beats = vec![
+        timpanist::score::Beat::plain(1920, 0),
+        timpanist::score::Beat::plain(0, 7),
+        nan,
+    ];
+    let path = dir.path().join("order.ron");
+    score.save(&path).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    let line_of = |needle: &str| text.lines().position(|l| l.contains(needle)).unwrap() + 1;
+    let out = check(&[&path]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(
+        lines[..2],
+        [
+            format!(
+                "{}:{}:9: beat 1 (bar 1 beat 1): drum 7 does not exist: kit \"Standard set (32/29/26/23 inch)\" has drums 0 to 3",
+                path.display(),
+                line_of("drum: 7")
+            ),
+            format!(
+                "{}:{}:9: beat 2 (bar 1 beat 2): impact point angle_deg NaN must be a finite angle, degrees",
+                path.display(),
+                line_of("NaN")
+            ),
+        ],
+        "{err}"
+    );
+}
+
+/// Opening a score that lists its beats out of time order (as the editor and
+/// `timpanist FILE` do) notes that the editor numbers them in time order; a score in
+/// time order opens without that note.
+#[test]
+fn opening_beats_out_of_order_says_how_they_are_numbered() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut score = Score::new("t");
+    score.beats = vec![
+        timpanist::score::Beat::plain(960, 0),
+        timpanist::score::Beat::plain(0, 1),
+    ];
+    let path = dir.path().join("order.ron");
+    score.save(&path).unwrap();
+    let opened = timpanist::io::open::read(&path).unwrap();
+    assert_eq!(opened.loaded.score.beats[0].tick, 0);
+    assert!(
+        opened
+            .notices
+            .iter()
+            .any(|n| n.contains("listed out of time order")),
+        "{:?}",
+        opened.notices
+    );
+    score.sort_beats();
+    score.save(&path).unwrap();
+    assert!(timpanist::io::open::read(&path).unwrap().notices.is_empty());
+}
+
 /// A file from a newer timpanist is refused with a clear message, not misread.
 #[test]
 fn newer_format_is_refused() {

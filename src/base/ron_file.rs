@@ -2,6 +2,8 @@
 //! the file, line and column; saving goes to a temporary file in the same folder that is
 //! synced and then renamed over the target, so a crash never leaves a half-written file.
 
+use super::problem::Problem;
+use ron::error::Position;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 use std::io::Write;
@@ -26,10 +28,12 @@ pub enum FileError {
         col: usize,
         message: String,
     },
-    /// The file parsed but its content is not acceptable (`place` says where, e.g. "beat 3").
-    #[error("{}: {place}: {message}", path.display())]
+    /// The file parsed but its content is not acceptable (`place` says where, e.g. "beat 3";
+    /// `at`, when known, the line and column where that place starts in the file).
+    #[error("{}{}: {place}: {message}", path.display(), at.map(|at| format!(":{at}")).unwrap_or_default())]
     Invalid {
         path: PathBuf,
+        at: Option<Position>,
         place: String,
         message: String,
     },
@@ -56,10 +60,17 @@ impl FileError {
 
     /// A content problem at `place` in the file at `path`.
     pub fn invalid(path: &Path, place: impl Into<String>, message: impl Into<String>) -> Self {
+        FileError::problem(path, Problem::new(place, message))
+    }
+
+    /// A problem found checking the file at `path`, at its line and column when it has
+    /// them: `path:line:col: place: message`, else `path: place: message`.
+    pub fn problem(path: &Path, problem: Problem) -> Self {
         FileError::Invalid {
             path: path.to_path_buf(),
-            place: place.into(),
-            message: message.into(),
+            at: problem.at,
+            place: problem.place,
+            message: problem.message,
         }
     }
 }

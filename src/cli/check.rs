@@ -1,5 +1,7 @@
 //! `timpanist check FILE...`: validate scores and kits, printing every problem as
-//! `path: place: message` (parse errors as `path:line:col: message`).
+//! `path: place: message`, or `path:line:col: place: message` for a beat (parse errors
+//! as `path:line:col: message`). Beats are named by their number in the file's `beats`
+//! list, as `render` names them.
 
 use crate::base::ron_file::{self, FileError};
 use crate::kit::Kit;
@@ -42,14 +44,13 @@ fn check_file(path: &Path) -> Result<String, Vec<String>> {
             kit.mallets.len()
         ));
     }
-    let score = Score::parse(path, &text).map_err(one)?;
+    let (score, places) = Score::parse_placed(path, &text).map_err(one)?;
     let (kit, kit_source, notices) = score.resolve_kit(path).map_err(one)?;
-    let problems = score.problems(&kit);
+    let problems: Vec<String> = (score.problems_placed(&kit, &places).into_iter())
+        .map(|p| FileError::problem(path, p).to_string())
+        .collect();
     if !problems.is_empty() {
-        return Err(problems
-            .iter()
-            .map(|p| format!("{}: {p}", path.display()))
-            .collect());
+        return Err(problems);
     }
     let bars = score
         .meter_map()
@@ -64,7 +65,7 @@ fn check_file(path: &Path) -> Result<String, Vec<String>> {
     for n in notices {
         summary.push_str(&format!(" (note: {n})"));
     }
-    let pedals = score.pedal_changes(&kit);
+    let pedals = score.pedal_changes_placed(&kit, &places);
     if let Some(first) = pedals.iter().find(|c| c.is_quick()).or(pedals.first()) {
         let quick = pedals.iter().filter(|c| c.is_quick()).count();
         summary.push_str(&format!(

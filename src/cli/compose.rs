@@ -14,7 +14,7 @@ use crate::mocap::shipped::{self, DbSource};
 use crate::motion::compose::{ComposeParams, Composition};
 use crate::motion::perform;
 use crate::motion::plan::{self, PlanParams, Substitution};
-use crate::score::LoadedScore;
+use crate::score::{BeatPlaces, LoadedScore};
 use crate::score::{Grip, PlayingMode};
 use std::path::Path;
 
@@ -26,7 +26,7 @@ pub fn run(
     plot: Option<&Path>,
     seed: u64,
 ) -> anyhow::Result<()> {
-    let loaded = LoadedScore::load(score)?;
+    let (loaded, places) = LoadedScore::load_placed(score)?;
     let db = load_db(source)?;
     let started = std::time::Instant::now();
     let comp = perform::trajectories(
@@ -41,7 +41,10 @@ pub fn run(
     )
     .map_err(|e| anyhow::anyhow!("{source}: {e}"))?;
     let took = started.elapsed();
-    print_substitutions(&plan::substitutions(&comp.strokes, &loaded.score, &db));
+    print_substitutions(
+        &plan::substitutions(&comp.strokes, &loaded.score, &db),
+        &places,
+    );
     let csv = tips_csv::to_csv(&comp);
     if let Some(plot) = plot {
         figure(&comp, &loaded.score.title).save_png(plot)?;
@@ -92,10 +95,15 @@ const LISTED_SUBSTITUTIONS: usize = 8;
 
 /// Tell on stderr which beats were played with a unit of other labels than asked
 /// ("note: beat 12 (staccato, right, mf): no such unit; used accent, right, mf"), the
-/// first few one by one and then how many more and of what.
-pub fn print_substitutions(substitutions: &[Substitution]) {
+/// first few one by one and then how many more and of what; each beat named by its
+/// number in the file (`places`).
+pub fn print_substitutions(substitutions: &[Substitution], places: &BeatPlaces) {
     for s in substitutions.iter().take(LISTED_SUBSTITUTIONS) {
-        eprintln!("note: {s}");
+        let named = Substitution {
+            beat: places.number(s.beat),
+            ..s.clone()
+        };
+        eprintln!("note: {named}");
     }
     if substitutions.len() > LISTED_SUBSTITUTIONS {
         eprintln!(

@@ -18,7 +18,7 @@ pub fn run(
 ) -> anyhow::Result<()> {
     // Refuse an occupied folder before the render (the check is made again when writing).
     folder::check(dir, options.replace)?;
-    let (loaded, rendering, wall) = rendered(score, source, choices)?;
+    let (loaded, _, rendering, wall) = rendered(score, source, choices)?;
     let performance = exports::performance(&rendering, &loaded.score);
     let written = pack::write(&performance, dir, options, &mut |step| {
         eprintln!("pack: {step}...");

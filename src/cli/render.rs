@@ -3,7 +3,9 @@
 //! progress bar on stderr and, with `--stats`, where the time went. Everything is computed
 //! before anything is written; each file is written atomically. A database lacking a
 //! playing mode is completed from the shipped synthetic one, and the beats played with a
-//! unit of other labels than asked are told as notes (`super::compose`).
+//! unit of other labels than asked are told as notes (`super::compose`). Every message
+//! names a beat by its number in the file's `beats` list, as `check` does
+//! ([`BeatPlaces`]), whatever order the file lists them in.
 
 use super::args::{
     BvhRateArg, BvhUnitsArg, ControlArg, RoomArg, SoundArg, VideoCameraArg, VideoFpsArg,
@@ -15,8 +17,9 @@ use crate::exports;
 use crate::io::{bvh, figures, video};
 use crate::mocap::shipped::DbSource;
 use crate::motion::plan::{self, PlanParams};
-use crate::render::{Progress, RenderParams, Rendering, render, strikes};
-use crate::score::LoadedScore;
+use crate::render::reach::OutOfReach;
+use crate::render::{Progress, RenderError, RenderParams, Rendering, render, strikes};
+use crate::score::{BeatPlaces, LoadedScore};
 use crate::sound::{Room, SoundModel};
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
@@ -198,9 +201,9 @@ pub struct Choices {
 }
 
 /// The score's pedal changes (`score::tuning`), the first few of them.
-fn pedal_notes(path: &Path, loaded: &LoadedScore) {
+fn pedal_notes(path: &Path, loaded: &LoadedScore, places: &BeatPlaces) {
     const SHOWN: usize = 3;
-    let changes = loaded.score.pedal_changes(&loaded.kit);
+    let changes = loaded.score.pedal_changes_placed(&loaded.kit, places);
     for change in changes.iter().take(SHOWN) {
         eprintln!("note: {}: {change}", path.display());
     }
@@ -215,13 +218,13 @@ fn pedal_notes(path: &Path, loaded: &LoadedScore) {
 }
 
 /// Load and render `score` as `choices` ask, with the progress bar on stderr; the notes
-/// of loading and the substituted motion units printed. The score, its rendering and the
-/// wall time it took.
+/// of loading and the substituted motion units printed. The score, where its beats stood
+/// in the file, its rendering and the wall time it took.
 pub fn rendered(
     score: &Path,
     source: &DbSource,
     choices: &Choices,
-) -> anyhow::Result<(LoadedScore, Rendering, Duration)> {
+) -> anyhow::Result<(LoadedScore, BeatPlaces, Rendering, Duration)> {
     let Choices {
         control,
         sound,
@@ -231,11 +234,11 @@ pub fn rendered(
         joint_limits,
         body_hz,
     } = *choices;
-    let loaded = LoadedScore::load(score)?;
+    let (loaded, places) = LoadedScore::load_placed(score)?;
     for notice in &loaded.notices {
         eprintln!("note: {notice}");
     }
-    pedal_notes(score, &loaded);
+    pedal_notes(score, &loaded, &places);
     let db = super::compose::load_db(source)?;
     if stats {
         println!("database: {source}");
@@ -271,14 +274,30 @@ pub fn rendered(
         true
     });
     bar.finish();
-    let rendering = rendering.map_err(|e| anyhow::anyhow!("{}: {e}", score.display()))?;
+    let rendering = rendering
+        .map_err(|e| anyhow::anyhow!("{}: {}", score.display(), renumbered(e, &places)))?;
     let wall = started.elapsed();
-    super::compose::print_substitutions(&plan::substitutions(
-        &rendering.composition.strokes,
-        &loaded.score,
-        &db,
-    ));
-    Ok((loaded, rendering, wall))
+    super::compose::print_substitutions(
+        &plan::substitutions(&rendering.composition.strokes, &loaded.score, &db),
+        &places,
+    );
+    Ok((loaded, places, rendering, wall))
+}
+
+/// `e` naming its beat by its number in the file (`places`), not in the score's time order.
+fn renumbered(e: RenderError, places: &BeatPlaces) -> RenderError {
+    match e {
+        RenderError::OutOfReach(r) => RenderError::OutOfReach(OutOfReach {
+            beat: places.number(r.beat),
+            ..r
+        }),
+        RenderError::Diverged { time_s, beat, what } => RenderError::Diverged {
+            time_s,
+            beat: beat.map(|b| places.number(b)),
+            what,
+        },
+        e => e,
+    }
 }
 
 /// Render `score` and write `outputs`.
@@ -295,7 +314,7 @@ pub fn run(
         .map(super::osc::connect)
         .transpose()?;
     outputs.exports.check_video()?;
-    let (loaded, rendering, wall) = rendered(score, source, choices)?;
+    let (loaded, places, rendering, wall) = rendered(score, source, choices)?;
     let ex = outputs.exports;
     let performance = exports::performance(&rendering, &loaded.score);
     let hits = performance.hits();
@@ -408,7 +427,7 @@ pub fn run(
         },
         wall.as_secs_f64()
     );
-    warn_of_missed_beats(&rendering);
+    warn_of_missed_beats(&rendering, &places);
     if ex.bvh.is_some() || ex.glb.is_some() {
         println!(
             "motion frame 0 (BVH, glTF) is at {:.3} s of the score, the WAV's start at 0 s",
@@ -417,7 +436,7 @@ pub fn run(
     }
     film(&rendering, &loaded.score, ex)?;
     if choices.stats {
-        print_stats(&rendering);
+        print_stats(&rendering, &places);
     }
     if let Some(socket) = osc {
         let super::osc::Sent { sent, unheard } = super::osc::send(&socket, &hits, ex.osc_realtime)?;
@@ -434,26 +453,31 @@ pub fn run(
 
 /// Name the beats whose strokes found no head (the first [`NAMED_MISSES`]), so a
 /// performance the body could not follow is not taken for a good one.
-fn warn_of_missed_beats(rendering: &Rendering) {
+fn warn_of_missed_beats(rendering: &Rendering, places: &BeatPlaces) {
     let missed = &rendering.missed_beats;
     if missed.is_empty() {
         return;
     }
-    let named: Vec<String> = missed
-        .iter()
-        .take(NAMED_MISSES)
-        .map(|b| b.to_string())
-        .collect();
+    let named = numbers(&missed[..missed.len().min(NAMED_MISSES)], places);
     eprintln!(
         "warning: the strokes of {} beat(s) found no head: beat {}{}; the simulated player could not follow there (a passage too fast or too far for it, or a body that lost its balance after a long run: see README \"Rendering a score\")",
         missed.len(),
-        named.join(", "),
+        named,
         if missed.len() > NAMED_MISSES {
             ", …"
         } else {
             ""
         }
     );
+}
+
+/// The beats `beats` (indices in the score's time order) as the file numbers them,
+/// e.g. "4, 7, 12".
+fn numbers(beats: &[usize], places: &BeatPlaces) -> String {
+    (beats.iter())
+        .map(|&b| places.number(b).to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// How many missed beats [`warn_of_missed_beats`] names.
@@ -501,7 +525,7 @@ fn film(rendering: &Rendering, score: &crate::score::Score, ex: &ExportArgs) -> 
 /// `--stats` lists the strokes whose peak force is off its aim by more than this fraction.
 const FORCE_AIM_TOLERANCE: f64 = 0.2;
 
-fn print_stats(r: &Rendering) {
+fn print_stats(r: &Rendering, places: &BeatPlaces) {
     let s = &r.stats;
     let contact_hz = 1.0 / r.drums.dt_s();
     let body_hz = contact_hz / r.params.sim.contact_substeps.max(1) as f64;
@@ -571,7 +595,7 @@ fn print_stats(r: &Rendering) {
         ),
         None => println!("joint limits: none held"),
     }
-    print_damping(&r.damping);
+    print_damping(&r.damping, places);
     let forces = strikes::forces_by_dynamic(&r.events);
     let recontacts: usize = forces.iter().map(|f| f.recontacts).sum();
     println!("force by dynamic (peak force of each stroke's contact; re-contacts ≥ 5 N after it):");
@@ -601,7 +625,9 @@ fn print_stats(r: &Rendering) {
             ((ratio - 1.0).abs() > FORCE_AIM_TOLERANCE).then(|| {
                 format!(
                     "beat {} {:.0} N for {:.0}",
-                    stroke.beat, e.peak_force_n, aim
+                    places.number(stroke.beat),
+                    e.peak_force_n,
+                    aim
                 )
             })
         })
@@ -664,17 +690,12 @@ impl ProgressBar {
 }
 
 /// The `secco` line of `--stats`: how each damped beat's head was stopped.
-fn print_damping(d: &crate::render::damping::DampReport) {
+fn print_damping(d: &crate::render::damping::DampReport, places: &BeatPlaces) {
     let total = d.by_hand.len() + d.missed.len() + d.without_hand.len();
     if total == 0 {
         return;
     }
-    let beats = |b: &[usize]| {
-        b.iter()
-            .map(|b| b.to_string())
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
+    let beats = |b: &[usize]| numbers(b, places);
     let (early, late) = d
         .by_hand
         .iter()

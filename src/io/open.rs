@@ -3,13 +3,14 @@
 //! recording (`.wav`, `.aiff`, `.flac`, `.mp3`, `.ogg`: transcribed) is imported onto the bundled standard kit as a new,
 //! unsaved score. Used by the editor's
 //! Open, drag and drop, and by `timpanist FILE`; headless, so it is testable without a
-//! window.
+//! window. A score listing its beats out of time order is opened with a note: the editor
+//! holds and saves them in time order, so its beat numbers are not yet the file's.
 
 use super::midi_import::{self, MidiError};
 use super::musicxml::{self, MusicXmlError};
 use crate::base::ron_file::FileError;
 use crate::kit::Kit;
-use crate::score::LoadedScore;
+use crate::score::{BeatPlaces, LoadedScore};
 use crate::sound::recording;
 use crate::transcribe::{self, TranscribeError};
 use std::path::{Path, PathBuf};
@@ -127,7 +128,8 @@ pub enum OpenError {
 pub fn read(path: &Path) -> Result<Opened, OpenError> {
     match kind_of(path) {
         FileKind::Score => {
-            let loaded = LoadedScore::load(path)?;
+            let (mut loaded, places) = LoadedScore::load_placed(path)?;
+            loaded.notices.extend(order_notice(path, &places));
             let mut message = format!("opened {}", path.display());
             if !loaded.notices.is_empty() {
                 message = loaded.notices.join("; ");
@@ -144,6 +146,17 @@ pub fn read(path: &Path) -> Result<Opened, OpenError> {
         FileKind::Audio => import_audio(path),
         FileKind::Other => Err(OpenError::NotAScore(path.to_path_buf())),
     }
+}
+
+/// The note for a score file listing its beats out of time order (`places`): `check`
+/// and `render` number its beats as the file lists them, the editor as it holds them.
+fn order_notice(path: &Path, places: &BeatPlaces) -> Option<String> {
+    (!places.in_time_order()).then(|| {
+        format!(
+            "{}: the beats are listed out of time order; the editor numbers them in time order, as Save writes them (check and render number the file's list)",
+            path.display()
+        )
+    })
 }
 
 /// An import as a new, unsaved document on the bundled standard kit.

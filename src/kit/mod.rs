@@ -238,7 +238,7 @@ impl Kit {
             }
         };
         if let Some(p) = validate::problems(&kit).into_iter().next() {
-            return Err(FileError::invalid(path, p.place, p.message));
+            return Err(FileError::problem(path, p));
         }
         Ok(kit)
     }

@@ -1,12 +1,15 @@
 //! The gesture score: beats in exact musical time (integer ticks) under a tempo map and
 //! time signatures, each with hand, playing mode, dynamic, drum, pitch, impact location and
 //! an optional roll; read from and written to strict, versioned RON files (`scores/*.ron`),
-//! with the editor's view of it (`view`: the 3D camera) when saved from the editor.
+//! with the editor's view of it (`view`: the 3D camera) when saved from the editor, and
+//! where each beat stood in the file it was read from (`places`: messages name beats by
+//! their number in the file and their line).
 
 pub mod demos;
 pub mod edit;
 pub mod meter;
 mod migrate;
+pub mod places;
 pub mod settings;
 pub mod tempo;
 pub mod tuning;
@@ -21,6 +24,7 @@ use std::path::{Path, PathBuf};
 
 pub use crate::base::gesture::{Dynamic, Grip, Hand, ImpactLocation, PlayingMode};
 pub use meter::{BarBeat, MeterChange, MeterMap};
+pub use places::BeatPlaces;
 pub use settings::Settings;
 pub use tempo::{TempoChange, TempoMap, TempoPoint};
 pub use view::{SavedCamera, ViewSettings};
@@ -194,6 +198,17 @@ impl Score {
         tuning::pedal_changes(self, &self.settings.kit(kit))
     }
 
+    /// [`Score::pedal_changes`], each naming its beat as `places` say it stands in the
+    /// file the score was read from (for messages; the numbers are no longer indices).
+    pub fn pedal_changes_placed(&self, kit: &Kit, places: &BeatPlaces) -> Vec<tuning::PedalChange> {
+        (self.pedal_changes(kit).into_iter())
+            .map(|c| tuning::PedalChange {
+                beat: places.number(c.beat),
+                ..c
+            })
+            .collect()
+    }
+
     /// The pitch each beat sounds on `kit` ([`tuning::sounding_pitches`] of its
     /// [`kit`](Score::kit)).
     pub fn sounding_pitches(&self, kit: &Kit) -> Vec<crate::base::pitch::Pitch> {
@@ -234,6 +249,12 @@ impl Score {
     /// Parse score text strictly (unknown or missing fields are errors), migrating older
     /// format versions; beats are put in time order. Does not check against a kit.
     pub fn parse(path: &Path, text: &str) -> Result<Score, FileError> {
+        Score::parse_placed(path, text).map(|(score, _)| score)
+    }
+
+    /// [`Score::parse`], with where each beat stood in the text (its number in the file's
+    /// list and its line and column), which messages about it name.
+    pub fn parse_placed(path: &Path, text: &str) -> Result<(Score, BeatPlaces), FileError> {
         #[derive(Deserialize)]
         #[serde(rename = "Score")]
         struct Probe {
@@ -251,8 +272,8 @@ impl Score {
                 ));
             }
         };
-        score.sort_beats();
-        Ok(score)
+        let places = BeatPlaces::sort(&mut score.beats, text);
+        Ok((score, places))
     }
 
     /// Put beats in time order (stable, so simultaneous beats keep their file order).
@@ -342,9 +363,20 @@ impl Score {
         }
     }
 
-    /// Problems of this score against `kit`, in file order.
+    /// Problems of this score against `kit`, in file order, its beats numbered as it
+    /// holds them.
     pub fn problems(&self, kit: &Kit) -> Vec<crate::base::problem::Problem> {
-        validate::problems(self, kit)
+        self.problems_placed(kit, &BeatPlaces::in_order())
+    }
+
+    /// Problems of this score against `kit`, in file order, its beats named as `places`
+    /// says they stand in the file it was read from.
+    pub fn problems_placed(
+        &self,
+        kit: &Kit,
+        places: &BeatPlaces,
+    ) -> Vec<crate::base::problem::Problem> {
+        validate::problems(self, kit, places)
     }
 }
 
@@ -352,15 +384,26 @@ impl LoadedScore {
     /// Parse score text (with `path` for errors and kit lookup), find its kit and check the
     /// score against it.
     pub fn parse(path: &Path, text: &str) -> Result<LoadedScore, FileError> {
-        LoadedScore::from_score(path, Score::parse(path, text)?)
+        LoadedScore::parse_placed(path, text).map(|(loaded, _)| loaded)
+    }
+
+    /// [`LoadedScore::parse`], with where each beat stood in the text.
+    pub fn parse_placed(path: &Path, text: &str) -> Result<(LoadedScore, BeatPlaces), FileError> {
+        let (score, places) = Score::parse_placed(path, text)?;
+        Ok((LoadedScore::checked(path, score, &places)?, places))
     }
 
     /// `score` (read from `path`, which names it in errors and places its kit) with its
     /// kit found and the score checked against it.
     pub fn from_score(path: &Path, score: Score) -> Result<LoadedScore, FileError> {
+        LoadedScore::checked(path, score, &BeatPlaces::in_order())
+    }
+
+    /// [`LoadedScore::from_score`], a problem naming its beat as `places` say.
+    fn checked(path: &Path, score: Score, places: &BeatPlaces) -> Result<LoadedScore, FileError> {
         let (kit, kit_source, notices) = score.resolve_kit(path)?;
-        if let Some(p) = score.problems(&kit).into_iter().next() {
-            return Err(FileError::invalid(path, p.place, p.message));
+        if let Some(p) = score.problems_placed(&kit, places).into_iter().next() {
+            return Err(FileError::problem(path, p));
         }
         Ok(LoadedScore {
             score,
@@ -372,6 +415,11 @@ impl LoadedScore {
 
     /// Load a score file with its kit, strictly.
     pub fn load(path: &Path) -> Result<LoadedScore, FileError> {
-        LoadedScore::parse(path, &ron_file::read_text(path)?)
+        LoadedScore::load_placed(path).map(|(loaded, _)| loaded)
+    }
+
+    /// [`LoadedScore::load`], with where each beat stood in the file.
+    pub fn load_placed(path: &Path) -> Result<(LoadedScore, BeatPlaces), FileError> {
+        LoadedScore::parse_placed(path, &ron_file::read_text(path)?)
     }
 }

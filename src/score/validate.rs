@@ -1,13 +1,16 @@
 //! Checks a score against its kit: format version, tempo and meter maps, and every beat
 //! (drum exists, pitch in the drum's range, velocity 0–1, location on the head, rolls,
-//! no more simultaneous strokes than hands).
+//! no more simultaneous strokes than hands). A beat is named by its number in the file
+//! and its bar and beat, and placed at its line in the file when read from text
+//! ([`BeatPlaces`]).
 
-use super::{Dynamic, Hand, ImpactLocation, SCORE_FORMAT_VERSION, Score, meter, tempo};
+use super::{BeatPlaces, Dynamic, Hand, ImpactLocation, SCORE_FORMAT_VERSION, Score, meter, tempo};
 use crate::base::problem::Problem;
 use crate::kit::Kit;
 
-/// Every problem in `score` played on `kit`, in file order.
-pub fn problems(score: &Score, kit: &Kit) -> Vec<Problem> {
+/// Every problem in `score` played on `kit`, in file order, its beats named as `places`
+/// says they stand in the file.
+pub fn problems(score: &Score, kit: &Kit, places: &BeatPlaces) -> Vec<Problem> {
     let mut out = Vec::new();
     if score.version != SCORE_FORMAT_VERSION {
         out.push(Problem::new(
@@ -59,12 +62,17 @@ pub fn problems(score: &Score, kit: &Kit) -> Vec<Problem> {
         }
     }
     let bars = meter_ok.then(|| score.meter_map());
-    let place = |i: usize| match &bars {
-        Some(map) => format!("beat {i} ({})", map.position(score.beats[i].tick)),
-        None => format!("beat {i} (tick {})", score.beats[i].tick),
+    // A problem of beat `i` (in time order), named and placed as in the file.
+    let of_beat = |i: usize, message: String| {
+        let tick = score.beats[i].tick;
+        let when = match &bars {
+            Some(map) => map.position(tick).to_string(),
+            None => format!("tick {tick}"),
+        };
+        Problem::new(format!("beat {} ({when})", places.number(i)), message).at(places.position(i))
     };
     for (i, beat) in score.beats.iter().enumerate() {
-        let mut bad = |message: String| out.push(Problem::new(place(i), message));
+        let mut bad = |message: String| out.push(of_beat(i, message));
         match kit.drums.get(beat.drum) {
             None => bad(format!(
                 "drum {} does not exist: kit \"{}\" has drums 0 to {}",
@@ -104,7 +112,8 @@ pub fn problems(score: &Score, kit: &Kit) -> Vec<Problem> {
                 .find(|&j| score.beats[j].tick > beat.tick && score.beats[j].tick < beat.end_tick())
             {
                 bad(format!(
-                    "beat {j} falls inside this roll, which takes both hands"
+                    "beat {} falls inside this roll, which takes both hands",
+                    places.number(j)
                 ));
             }
         }
@@ -141,16 +150,16 @@ pub fn problems(score: &Score, kit: &Kit) -> Vec<Problem> {
             .collect();
         let hands: Vec<Hand> = together.iter().map(|&j| score.beats[j].hand).collect();
         if together.len() > 2 {
-            out.push(Problem::new(
-                place(i),
+            out.push(of_beat(
+                i,
                 format!(
                     "{} strokes at once, but a timpanist has two hands",
                     together.len()
                 ),
             ));
         } else if together.len() == 2 && hands[0] == hands[1] && hands[0] != Hand::Auto {
-            out.push(Problem::new(
-                place(together[1]),
+            out.push(of_beat(
+                together[1],
                 format!("two strokes at once with the same hand ({:?})", hands[0]),
             ));
         }
@@ -185,7 +194,7 @@ mod tests {
     }
 
     fn first_problem(score: &Score) -> String {
-        problems(score, &Kit::standard())
+        problems(score, &Kit::standard(), &BeatPlaces::in_order())
             .first()
             .map(ToString::to_string)
             .unwrap_or_default()
@@ -196,7 +205,7 @@ mod tests {
     fn valid_score() {
         let mut s = Score::new("t");
         s.beats = vec![beat(0, 0), beat(960, 3)];
-        assert!(problems(&s, &Kit::standard()).is_empty());
+        assert!(s.problems(&Kit::standard()).is_empty());
     }
 
     /// Each kind of mistake is found and named with its bar and beat.

@@ -140,7 +140,7 @@ fn log_grid(input: GridInput) -> Vec<GridMark> {
 /// One line naming a strike.
 fn describe(e: &StrikeEvent) -> String {
     let what = match e.beat {
-        Some(b) => format!("beat {}", b + 1),
+        Some(b) => format!("beat {b}"),
         None => "rebound".to_string(),
     };
     format!(
