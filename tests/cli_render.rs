@@ -284,6 +284,30 @@ fn cli_render_names_beats_as_the_file_does() {
     assert!(!wav.exists());
 }
 
+/// A score with no beats is refused by `check` (exit 1) as `render` refuses it, in the
+/// same words.
+#[test]
+fn check_refuses_an_empty_score_as_render_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let wav = dir.path().join("out.wav");
+    let empty = dir.path().join("empty.ron");
+    Score::new("empty").save(&empty).unwrap();
+    let refusal = format!("{}: the score is empty: nothing to render", empty.display());
+    let stderr = failed(&[
+        "render".as_ref(),
+        empty.as_ref(),
+        "--wav".as_ref(),
+        wav.as_ref(),
+    ]);
+    assert!(stderr.contains(&format!("error: {refusal}")), "{stderr}");
+    let stderr = failed(&["check".as_ref(), empty.as_ref()]);
+    assert_eq!(
+        stderr.lines().collect::<Vec<_>>(),
+        [refusal.as_str(), "error: 1 of 1 files have problems"],
+        "{stderr}"
+    );
+}
+
 /// Without the `editor` feature, `timpanist edit` fails at once and says how to get the
 /// editor (with it, the editor would open a window: not run here).
 #[cfg(not(feature = "editor"))]

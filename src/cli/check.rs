@@ -1,10 +1,11 @@
 //! `timpanist check FILE...`: validate scores and kits, printing every problem as
 //! `path: place: message`, or `path:line:col: place: message` for a beat (parse errors
 //! as `path:line:col: message`). Beats are named by their number in the file's `beats`
-//! list, as `render` names them.
+//! list, as `render` names them; a score with no beats is refused as `render` refuses it.
 
 use crate::base::ron_file::{self, FileError};
 use crate::kit::Kit;
+use crate::render::RenderError;
 use crate::score::Score;
 use std::path::Path;
 use std::process::ExitCode;
@@ -46,9 +47,12 @@ fn check_file(path: &Path) -> Result<String, Vec<String>> {
     }
     let (score, places) = Score::parse_placed(path, &text).map_err(one)?;
     let (kit, kit_source, notices) = score.resolve_kit(path).map_err(one)?;
-    let problems: Vec<String> = (score.problems_placed(&kit, &places).into_iter())
+    let mut problems: Vec<String> = (score.problems_placed(&kit, &places).into_iter())
         .map(|p| FileError::problem(path, p).to_string())
         .collect();
+    if score.beats.is_empty() {
+        problems.push(format!("{}: {}", path.display(), RenderError::Empty));
+    }
     if !problems.is_empty() {
         return Err(problems);
     }
