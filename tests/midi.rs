@@ -28,6 +28,49 @@ fn import_ok(bytes: &[u8], options: &ImportOptions) -> (Score, ImportReport) {
     (score, report)
 }
 
+/// The score's title as `export` writes it (the conductor track's name, its bytes) and as
+/// the import reads it back.
+fn title_written_and_read(title: &str) -> (Vec<u8>, String) {
+    let mut score = rich_score();
+    score.title = title.into();
+    let bytes = export(&score, &Kit::standard());
+    let smf = Smf::parse(&bytes).unwrap();
+    let written = (smf.tracks[0].iter())
+        .find_map(|e| match e.kind {
+            TrackEventKind::Meta(MetaMessage::TrackName(name)) => Some(name.to_vec()),
+            _ => None,
+        })
+        .unwrap();
+    (
+        written,
+        import_ok(&bytes, &ImportOptions::default()).0.title,
+    )
+}
+
+/// A title whose every character is Latin-1 is written in Latin-1 (one byte each, as
+/// mido and other readers decode MIDI text), any other transliterated to ASCII; both
+/// read back (the Latin-1 ones as written: "Pièce" is not taken for Shift-JIS).
+#[test]
+fn titles_are_written_in_latin1_or_ascii() {
+    let cases: [(&str, &[u8], &str); 4] = [
+        ("Ouvertüre", b"Ouvert\xfcre", "Ouvertüre"),
+        ("Pièce", b"Pi\xe8ce", "Pièce"),
+        ("àé ½", b"\xe0\xe9 \xbd", "àé ½"),
+        (
+            "Pauken – Tympani ♯",
+            b"Pauken - Tympani #",
+            "Pauken - Tympani #",
+        ),
+    ];
+    for (title, bytes, back) in cases {
+        assert_eq!(
+            title_written_and_read(title),
+            (bytes.to_vec(), back.to_string()),
+            "{title}"
+        );
+    }
+}
+
 /// A score using every kind of beat data, two time signature changes and two beats at once.
 fn rich_score() -> Score {
     let mut score = Score::new("Rich");

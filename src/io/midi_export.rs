@@ -7,6 +7,8 @@
 //! `timpanist:` followed by a compact RON tuple, which other programs ignore and
 //! [`super::midi_import`] reads back. Linear tempo ramps become tempo steps every sixteenth
 //! note, each lasting exactly as long in seconds as the ramp takes over that step.
+//! The title (the conductor track's name) is written in Latin-1, or transliterated to
+//! ASCII when it does not fit ([`super::midi_text`]), as MIDI readers expect.
 
 use crate::kit::Kit;
 use crate::score::{Hand, ImpactLocation, PlayingMode, Roll, Score, TempoChange};
@@ -56,13 +58,14 @@ pub fn export(score: &Score, kit: &Kit) -> Vec<u8> {
         .iter()
         .map(|b| BeatData(b.hand, b.mode, b.drum, b.location, b.roll).to_payload())
         .collect();
+    let title = super::midi_text::encode(&score.title);
     let smf = Smf {
         header: Header::new(
             Format::Parallel,
             Timing::Metrical(u15::new(tpq.min(0x7fff) as u16)),
         ),
         tracks: vec![
-            to_track(conductor_events(score)),
+            to_track(conductor_events(score, &title)),
             to_track(timpani_events(score, kit, &payloads)),
         ],
     };
@@ -106,9 +109,10 @@ pub(crate) fn to_track<'a>(mut events: Vec<Timed<'a>>) -> Track<'a> {
         .collect()
 }
 
-/// Title, tempo and time signatures.
-pub(crate) fn conductor_events(score: &Score) -> Vec<Timed<'_>> {
-    let mut events = vec![(0, 1, meta(MetaMessage::TrackName(score.title.as_bytes())))];
+/// Title (`title`: the score's, as [`super::midi_text::encode`] writes it), tempo and time
+/// signatures.
+pub(crate) fn conductor_events<'a>(score: &Score, title: &'a [u8]) -> Vec<Timed<'a>> {
+    let mut events = vec![(0, 1, meta(MetaMessage::TrackName(title)))];
     events.extend(
         tempo_steps(score)
             .into_iter()

@@ -54,13 +54,14 @@ pub fn export(score: &Score, kit: &Kit, hits: &[Hit], scale: &ForceScale) -> Vec
         .collect();
     notes.sort_by_key(|n| n.0);
     let mut track = track_start(b"Timpani (performed)");
+    let title = super::midi_text::encode(&score.title);
     track.extend(note_events(&notes, u64::from(tpq), |_| None));
     let smf = Smf {
         header: Header::new(
             Format::Parallel,
             Timing::Metrical(u15::new(tpq.min(0x7fff) as u16)),
         ),
-        tracks: vec![to_track(conductor_events(score)), to_track(track)],
+        tracks: vec![to_track(conductor_events(score, &title)), to_track(track)],
     };
     let mut bytes = Vec::new();
     smf.write_std(&mut bytes)

@@ -1,5 +1,5 @@
 //! File adapters over what the layers below make: Standard MIDI Files in and out (the
-//! score, and the performed hits), MusicXML in, opening any score-bearing file (`open`),
+//! score, and the performed hits; their text in Latin-1 or ASCII, `midi_text`), MusicXML in, opening any score-bearing file (`open`),
 //! composed and simulated motion as CSV, C3D and BVH, the scene as glTF (`.glb`; BVH and
 //! glTF share the Y-up axes of `y_up`), OSC messages of the performed hits, PNG and SVG
 //! figures (`plot`, and the performance's own in `figures`), and the lesson pack (`pack`).
@@ -14,6 +14,7 @@ pub mod glb;
 pub mod midi_export;
 pub mod midi_import;
 pub mod midi_performed;
+pub mod midi_text;
 pub mod motion_c3d;
 pub mod motion_csv;
 pub mod musicxml;

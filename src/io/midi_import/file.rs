@@ -123,9 +123,12 @@ pub(super) fn read_file(tracks: &[Vec<TrackEvent<'_>>], clock: &Clock) -> FileIn
 }
 
 /// MIDI text (a track name, the title) as a string: valid UTF-8 as it is, else Shift-JIS
-/// if it decodes without errors and has Japanese letters (kana or kanji), else Latin-1
-/// (Windows-1252); text with control characters in it is taken as undecodable and read as
-/// empty (the title then falls back to the file name).
+/// if it decodes without errors, has Japanese letters (kana or kanji) and a byte
+/// 0x80–0x9F (the lead byte of kana and common kanji: Latin-1 text, as timpanist's
+/// export writes it, has none, and its accented letters pair up into rare kanji —
+/// "Pièce" read "Pi鐵e"), else Latin-1 (Windows-1252); text with control characters in
+/// it is taken as undecodable and read as empty (the title then falls back to the file
+/// name).
 pub fn decode_text(bytes: &[u8]) -> String {
     let readable = |s: &str| !s.chars().any(|c| c.is_control() && c != '\t');
     if let Ok(s) = std::str::from_utf8(bytes) {
@@ -140,8 +143,10 @@ pub fn decode_text(bytes: &[u8]) -> String {
         // capitals and accented letters also decode to.
         matches!(c, '\u{3040}'..='\u{30ff}' | '\u{4e00}'..='\u{9fff}')
     };
-    if let Some(s) =
-        encoding_rs::SHIFT_JIS.decode_without_bom_handling_and_without_replacement(bytes)
+    let shift_jis_lead = bytes.iter().any(|b| (0x80..=0x9f).contains(b));
+    if shift_jis_lead
+        && let Some(s) =
+            encoding_rs::SHIFT_JIS.decode_without_bom_handling_and_without_replacement(bytes)
         && s.chars().any(japanese)
         && readable(&s)
     {
