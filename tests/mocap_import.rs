@@ -696,3 +696,121 @@ fn zeros_are_read_as_gaps() {
     assert!(read.tracks[0].positions[1].is_none());
     assert!(read.notes[0].starts_with("1 sample at"), "{:?}", read.notes);
 }
+
+// ---------------------------------------------------------------- sweep: Vicon blank lines
+
+/// A Vicon Nexus CSV export at 100 Hz: a Devices block, then the Trajectories of a stick
+/// tip and a wrist (mm) for `frames` frames, `inserts` put before the rows of the frames
+/// they name (1-based), then `tail` (the next section, or nothing).
+fn vicon_export(frames: usize, inserts: &[(usize, &str)], tail: &str) -> String {
+    let mut out = String::from(
+        "Devices\n1000\n,,Force Plate #1 - Force,,\nFrame,Sub Frame,Fx,Fy,Fz\n,,N,N,N\n\
+         1,0,0.0,-0.2,701.5\n\nTrajectories\n100\n,,Player:StickR_Tip,,,Player:RWRA,,\n\
+         Frame,Sub Frame,X,Y,Z,X,Y,Z\n,,mm,mm,mm,mm,mm,mm\n",
+    );
+    for f in 1..=frames {
+        for (at, text) in inserts {
+            if *at == f {
+                out.push_str(text);
+            }
+        }
+        let z = 800.0 + 120.0 * (f as f64 * 0.05).sin();
+        out.push_str(&format!(
+            "{f},0,250.000,950.000,{z:.3},310.000,700.000,1050.000\n"
+        ));
+    }
+    out + tail
+}
+
+/// The 1-based line of the first line of `text` that starts with `prefix`.
+fn line_of(text: &str, prefix: &str) -> usize {
+    text.lines().position(|l| l.starts_with(prefix)).unwrap() + 1
+}
+
+/// A blank line inside the Trajectories data is skipped (with a note naming it) when the
+/// frame numbers run on after it; a blank line before the next section ends the data
+/// without a note; anything else after a blank line is noted or refused naming its line.
+#[test]
+fn vicon_blank_lines_inside_the_trajectories_are_skipped_with_a_note() {
+    let path = Path::new("sweep.csv");
+    let read = |text: &str| import::read_bytes(path, text.as_bytes(), Format::Vicon);
+    // The sweep's file: a blank line after frame 895 of 3982, then a Model Outputs block.
+    let tail = "\nModel Outputs\n100\n,,Player:RElbowAngles,,\nFrame,Sub Frame,X,Y,Z\n1,0,1,2,3\n";
+    let text = vicon_export(3982, &[(896, "\n")], tail);
+    let take = read(&text).unwrap();
+    assert_eq!(take.frames, 3982);
+    let tip = take.track("StickR_Tip").unwrap();
+    assert_eq!(seen(tip), 3982);
+    let blank = line_of(&text, "896,0,") - 1;
+    let note = format!("1 blank line inside the Trajectories data was skipped (line {blank})");
+    assert!(
+        take.notes.iter().any(|n| n.starts_with(&note)),
+        "{:?}",
+        take.notes
+    );
+    // Read through the shipped `vicon` capture profile too.
+    let vicon = import::CaptureProfile::shipped("vicon").unwrap();
+    let take = import::table::read(path, text.as_bytes(), &vicon, None).unwrap();
+    assert_eq!(take.frames, 3982);
+    let note = format!("1 blank line inside the data was skipped (line {blank})");
+    assert!(
+        take.notes.iter().any(|n| n.starts_with(&note)),
+        "{:?}",
+        take.notes
+    );
+    // Two runs of blank lines, CRLF endings, a line of commas.
+    let text = vicon_export(500, &[(100, "\n\n"), (300, ",,,,,,,\n")], tail).replace('\n', "\r\n");
+    let take = read(&text).unwrap();
+    assert_eq!(take.frames, 500);
+    assert!(
+        take.notes
+            .iter()
+            .any(|n| n.starts_with("3 blank lines inside the Trajectories data were skipped")),
+        "{:?}",
+        take.notes
+    );
+    // The blank line before the next section (or at the end) is the end: nothing noted.
+    for tail in [
+        tail,
+        "",
+        "\n\n",
+        "\nEvents\nSubject,Context,Name,Time (s)\n",
+    ] {
+        let take = read(&vicon_export(50, &[], tail)).unwrap();
+        assert_eq!(take.frames, 50, "{tail:?}");
+        assert!(take.notes.is_empty(), "{tail:?}: {:?}", take.notes);
+    }
+    // A blank line before a block that is not a section Nexus writes: the data end there,
+    // and the note names the line where the rest was left unread.
+    let text = vicon_export(50, &[], "\nAnalog Gains\n1,2,3\n");
+    let take = read(&text).unwrap();
+    assert_eq!(take.frames, 50);
+    let at = line_of(&text, "Analog Gains");
+    assert!(
+        take.notes.iter().any(|n| n.contains(&format!("line {at}"))
+            && n.contains("Analog Gains")
+            && n.contains("not read")),
+        "{:?}",
+        take.notes
+    );
+    // Frame numbers that do not run on after a blank line (a second block pasted on) and
+    // a row cut short after one are refused naming the line.
+    let text = vicon_export(50, &[], "\n1,0,1,2,3,4,5,6\n2,0,1,2,3,4,5,6\n");
+    let e = read(&text).unwrap_err().to_string();
+    let at = line_of(&text, "1,0,1,2");
+    assert!(
+        e.contains(&format!(
+            "sweep.csv: line {at}, column 1: expected frame 51 after frame 50"
+        )),
+        "{e}"
+    );
+    let text = vicon_export(50, &[(40, "\n")], "").replace("45,0,250.000,950.000", "45,0,250.0");
+    let e = read(&text).unwrap_err().to_string();
+    assert!(
+        e.contains(&format!(
+            "sweep.csv: line {}: expected 8 cells",
+            line_of(&text, "45,0,")
+        )),
+        "{e}"
+    );
+}

@@ -98,8 +98,6 @@ fn windows_1252(b: u8) -> char {
     }
 }
 
-/// Split one line at commas. A cell in double quotes may hold commas; `""` inside quotes
-/// is a quote. Cells are trimmed of spaces and tabs.
 /// The data rows of `rows`: blank lines at the end are skipped, a blank line followed by
 /// more data is an error naming its line.
 pub(super) fn data_rows<'a>(
@@ -123,6 +121,8 @@ pub(super) fn data_rows<'a>(
     })
 }
 
+/// Split one line at commas. A cell in double quotes may hold commas; `""` inside quotes
+/// is a quote. Cells are trimmed of spaces and tabs.
 pub(super) fn split_cells(line: &str) -> Vec<Cow<'_, str>> {
     split_cells_on(line, Some(','))
 }
@@ -162,6 +162,36 @@ pub(super) fn split_cells_on(line: &str, sep: Option<char>) -> Vec<Cow<'_, str>>
 /// "line L, column C" for a 0-based column index.
 pub(super) fn place(line: usize, col: usize) -> String {
     format!("line {line}, column {}", col + 1)
+}
+
+/// Whether a cell reads as a number (with `.` as the decimal point).
+pub(super) fn is_number(cell: &str) -> bool {
+    cell.parse::<f64>().is_ok()
+}
+
+/// The note for blank `lines` skipped between the data rows of `what` ("the data"):
+/// how many, and which (the first five).
+pub(super) fn blank_lines_note(lines: &[usize], what: &str) -> Option<String> {
+    const SHOWN: usize = 5;
+    let n = lines.len();
+    if n == 0 {
+        return None;
+    }
+    let mut list: Vec<String> = lines.iter().take(SHOWN).map(usize::to_string).collect();
+    if n > SHOWN {
+        list.push("…".to_string());
+    }
+    let (lines_word, was) = if n == 1 {
+        ("line", "was")
+    } else {
+        ("lines", "were")
+    };
+    Some(format!(
+        "{n} blank {lines_word} inside {what} {was} skipped ({lines_word} {}): the rows after \
+         {} continue the frames above",
+        list.join(", "),
+        if n == 1 { "it" } else { "them" }
+    ))
 }
 
 /// The number in cell `col` of `row`: `None` for an empty (or absent) cell.

@@ -13,7 +13,7 @@
 //! ,,mm,mm,mm,mm,mm,mm          ← units (mm if the row is absent)
 //! 1,0,123.4,-56.7,890.1,,,     ← empty cells: marker not seen
 //! …
-//!                              ← a blank line (or the next section) ends it
+//!                              ← a blank line before the next section ends it
 //! Model Outputs
 //! …
 //! ```
@@ -21,6 +21,11 @@
 //! Each label's columns run up to the next label; of them, the ones headed exactly `X`,
 //! `Y`, `Z` are its position (velocity and acceleration columns `X'`, `X''` are ignored).
 //! Units may be `mm`, `cm` or `m` per trajectory. Frame numbers must rise by one per row.
+//!
+//! The data end at the next section's name, at a blank line followed by it, or at the
+//! end of the file. Blank lines followed by more data rows (the frame numbers running on)
+//! are skipped with a note; a blank line followed by anything else that is not a number
+//! ends the data with a note naming the line where the unread rest begins.
 
 use super::LengthUnit;
 use super::csv_text::{self, Row};
@@ -46,6 +51,23 @@ pub fn is_section_name(s: &str) -> bool {
 struct Columns {
     label: String,
     xyz: [usize; 3],
+}
+
+/// How the data rows are laid out: each trajectory's columns and unit, the row width.
+struct Layout<'c> {
+    columns: &'c [Columns],
+    scales: &'c [LengthUnit],
+    width: usize,
+}
+
+/// The Trajectories data as read.
+struct Data {
+    /// One track per trajectory, positions in metres.
+    tracks: Vec<Track>,
+    /// The number of frames (1 or more).
+    frames: usize,
+    /// What was skipped, or where the data ended early.
+    notes: Vec<String>,
 }
 
 /// Read the `Trajectories` section of a Vicon Nexus CSV export; `unit` overrides the
@@ -106,14 +128,19 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         .or(unit)
         .unwrap_or(LengthUnit::Millimetre);
     let data = pending.into_iter().chain(rows);
-    let (tracks, frames) = read_data(path, data, &columns, &scales, width, axis_row.line)?;
+    let layout = Layout {
+        columns: &columns,
+        scales: &scales,
+        width,
+    };
+    let data = read_data(path, data, &layout, axis_row.line)?;
     Ok(Take {
         source: path.to_path_buf(),
         rate_hz,
-        frames,
+        frames: data.frames,
         file_unit: file_unit.symbol().to_string(),
-        tracks,
-        notes: Vec::new(),
+        tracks: data.tracks,
+        notes: data.notes,
     })
 }
 
@@ -221,60 +248,126 @@ fn read_units(
     Ok(())
 }
 
-/// Read the data rows up to a blank line or the next section's name into one track per
-/// trajectory (positions in metres from `scales`); also the number of frames (1 or more).
-/// Frame numbers must rise by one per row; `axis_line` is the line of the `Frame` row.
+/// Read the data rows into one track per trajectory, up to the next section's name (with
+/// or without a blank line before it) or the end of the file. Blank lines followed by
+/// more data rows are skipped (noted); a blank line followed by a row that is neither a
+/// section name nor a number ends the data (noted, naming the line). Frame numbers must
+/// rise by one per row, across skipped blank lines too; `axis_line` is the line of the
+/// `Frame` row.
 fn read_data<'a>(
     path: &Path,
     rows: impl Iterator<Item = Row<'a>>,
-    columns: &[Columns],
-    scales: &[LengthUnit],
-    width: usize,
+    layout: &Layout,
     axis_line: usize,
-) -> Result<(Vec<Track>, usize), ImportError> {
-    let mut tracks: Vec<Track> = columns
-        .iter()
-        .map(|c| Track::empty(c.label.clone()))
-        .collect();
+) -> Result<Data, ImportError> {
+    let mut data = Data {
+        tracks: layout
+            .columns
+            .iter()
+            .map(|c| Track::empty(c.label.clone()))
+            .collect(),
+        frames: 0,
+        notes: Vec::new(),
+    };
     let mut prev_frame: Option<f64> = None;
-    let mut frames = 0usize;
+    // Blank lines since the last data row, and those skipped between data rows.
+    let mut blanks: Vec<usize> = Vec::new();
+    let mut skipped: Vec<usize> = Vec::new();
     let mut last_line = axis_line;
     for row in rows {
         last_line = row.line;
-        // A blank line or the next section's name ends the section.
-        if row.is_blank() || is_section_name(row.cell(0)) {
+        if row.is_blank() {
+            blanks.push(row.line);
+            continue;
+        }
+        if is_section_name(row.cell(0)) {
             break;
         }
-        csv_text::check_width(path, &row, width)?;
-        let frame = csv_text::required_number(path, &row, 0, "frame number")?;
-        if let Some(p) = prev_frame
-            && frame != p + 1.0
-        {
-            return Err(ImportError::format(
-                path,
-                csv_text::place(row.line, 0),
-                format!(
-                    "expected frame {} after frame {p} (one row per frame), found {frame}",
-                    p + 1.0
-                ),
-            ));
+        let after_blank = blanks.first().copied();
+        if let Some(blank) = after_blank {
+            if !csv_text::is_number(row.cell(0)) {
+                data.notes.push(unread_rest(blank, &row));
+                break;
+            }
+            if data.frames == 0 {
+                // Between the header and the first data row: not inside the data.
+                blanks.clear();
+            }
+            skipped.append(&mut blanks);
         }
+        let frame = frame_number(path, &row, layout.width, prev_frame, after_blank)?;
         prev_frame = Some(frame);
-        for ((c, track), s) in columns.iter().zip(tracks.iter_mut()).zip(scales) {
-            track
-                .positions
-                .push(csv_text::position(path, &row, c.xyz, s.metres())?);
-        }
-        frames += 1;
+        read_row(path, &row, layout, &mut data.tracks)?;
+        data.frames += 1;
     }
-    if frames == 0 {
+    if data.frames == 0 {
         return Err(ImportError::format(
             path,
             format!("line {}", last_line),
             "expected data rows in the Trajectories section, found none",
         ));
     }
-    Ok((tracks, frames))
+    data.notes.extend(csv_text::blank_lines_note(
+        &skipped,
+        "the Trajectories data",
+    ));
+    Ok(data)
+}
+
+/// A data row's frame number, checked against the row width and the previous frame
+/// (`prev`: it must be one more); `blank`: the first of the blank lines just before it,
+/// for the message when a block after blank lines does not run on.
+fn frame_number(
+    path: &Path,
+    row: &Row,
+    width: usize,
+    prev: Option<f64>,
+    blank: Option<usize>,
+) -> Result<f64, ImportError> {
+    csv_text::check_width(path, row, width)?;
+    let frame = csv_text::required_number(path, row, 0, "frame number")?;
+    if let Some(p) = prev
+        && frame != p + 1.0
+    {
+        let after_blank = blank.map_or(String::new(), |b| {
+            format!(" (the rows after the blank line {b} do not run on from those above it)")
+        });
+        return Err(ImportError::format(
+            path,
+            csv_text::place(row.line, 0),
+            format!(
+                "expected frame {} after frame {p} (one row per frame), found {frame}{after_blank}",
+                p + 1.0
+            ),
+        ));
+    }
+    Ok(frame)
+}
+
+/// Append one data row's position of every trajectory to `tracks`.
+fn read_row(
+    path: &Path,
+    row: &Row,
+    layout: &Layout,
+    tracks: &mut [Track],
+) -> Result<(), ImportError> {
+    for ((c, track), s) in layout.columns.iter().zip(tracks).zip(layout.scales) {
+        track
+            .positions
+            .push(csv_text::position(path, row, c.xyz, s.metres())?);
+    }
+    Ok(())
+}
+
+/// The note for data that end at the blank line `blank` before `row`, which is neither a
+/// data row nor a section name Nexus writes: the rest of the file is not read.
+fn unread_rest(blank: usize, row: &Row) -> String {
+    format!(
+        "the Trajectories data end at the blank line {blank}: line {} (\"{}\") is not a \
+         section Nexus writes nor a data row, so it and the rest of the file are not read",
+        row.line,
+        csv_text::shorten(row.cell(0))
+    )
 }
 
 #[cfg(test)]

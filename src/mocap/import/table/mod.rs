@@ -12,8 +12,9 @@
 //!    are metadata.
 //! 3. Tracks are the profile's explicit `tracks`, then every track its `patterns` find.
 //!    A missing column is an error listing the nearest existing names.
-//! 4. Data rows: blank lines are skipped; after a blank line, a line whose first cell is
-//!    not a number ends the table (the next section of a multi-section export). A cell
+//! 4. Data rows: blank lines are skipped (those between data rows with a note); after a
+//!    blank line, a line whose first cell is not a number ends the table (the next
+//!    section of a multi-section export). A cell
 //!    that is empty, absent (a short row), `NaN` or `-` is a missing value: the position
 //!    is `None` if any coordinate is missing, the rotation `None` if any of its cells is.
 //!    Any other non-number in a used column is an error naming the line and column.

@@ -73,13 +73,15 @@ impl RowReader<'_> {
                 .map(|t| Track::empty(t.label.clone()))
                 .collect(),
         };
-        let mut after_blank = false;
+        // Blank lines since the last data row, and those skipped between data rows.
+        let mut blanks: Vec<usize> = Vec::new();
+        let mut skipped: Vec<usize> = Vec::new();
         for row in &sheet.rows[first..] {
             if row.is_blank() {
-                after_blank = true;
+                blanks.push(row.line);
                 continue;
             }
-            if after_blank && !sheet.numeric(row.cell(0)) {
+            if !blanks.is_empty() && !sheet.numeric(row.cell(0)) {
                 if self.in_section {
                     break;
                 }
@@ -90,7 +92,7 @@ impl RowReader<'_> {
                 ));
                 break;
             }
-            after_blank = false;
+            skipped.append(&mut blanks);
             if let Some((c, _)) = clock {
                 let t = self.number(row, c)?.ok_or_else(|| {
                     ImportError::format(
@@ -113,6 +115,7 @@ impl RowReader<'_> {
                 "expected data rows below the header, found none",
             ));
         }
+        notes.extend(csv_text::blank_lines_note(&skipped, "the data"));
         Ok(rows)
     }
 
