@@ -814,3 +814,104 @@ fn vicon_blank_lines_inside_the_trajectories_are_skipped_with_a_note() {
         "{e}"
     );
 }
+
+// ---------------------------------------------------------------- sweep: Qualisys truncated
+
+/// A QTM 3D TSV export at 200 Hz whose header says `stated` frames, holding `rows` rows of
+/// one stick tip (mm); `cell` writes the tip of frame `f` (1-based).
+fn qualisys_tsv(stated: usize, rows: usize, cell: &dyn Fn(usize) -> String) -> String {
+    let mut out = format!(
+        "NO_OF_FRAMES\t{stated}\nNO_OF_CAMERAS\t8\nNO_OF_MARKERS\t1\nFREQUENCY\t200\n\
+         NO_OF_ANALOG\t0\nANALOG_FREQUENCY\t0\nDESCRIPTION\t--\n\
+         TIME_STAMP\t2024-05-14, 15:12:45.120\t81234.56789012\nDATA_INCLUDED\t3D\n\
+         MARKER_NAMES\tStick R tip\nTRAJECTORY_TYPES\tMeasured\n\
+         Frame\tTime\tStick R tip X\tStick R tip Y\tStick R tip Z\t\n"
+    );
+    for f in 1..=rows {
+        out.push_str(&format!(
+            "{f}\t{:.5}\t{}\n",
+            (f - 1) as f64 / 200.0,
+            cell(f)
+        ));
+    }
+    out
+}
+
+fn tip_cells(f: usize) -> String {
+    format!(
+        "250.000\t950.000\t{:.3}",
+        800.0 + 100.0 * (f as f64 * 0.05).sin()
+    )
+}
+
+/// A QTM export cut short (fewer rows than NO_OF_FRAMES) is read with a note giving the
+/// header's count and the rows found; a complete one has no such note.
+#[test]
+fn qualisys_tsv_shorter_than_no_of_frames_is_noted() {
+    let profile = import::CaptureProfile::shipped("qualisys-3d").unwrap();
+    let path = Path::new("cut.tsv");
+    let read = |text: &str| import::table::read(path, text.as_bytes(), &profile, None).unwrap();
+    let noted = |take: &Take, want: &str| {
+        assert!(
+            take.notes.iter().any(|n| n == want),
+            "{want:?} in {:?}",
+            take.notes
+        );
+    };
+    // Eleven metadata lines and the column row: frame f is on line 12 + f.
+    let take = read(&qualisys_tsv(3982, 895, &tip_cells));
+    assert_eq!(take.frames, 895);
+    assert_eq!(seen(&take.tracks[0]), 895);
+    noted(
+        &take,
+        "NO_OF_FRAMES (line 1) says 3982 frames, the file has 895 rows, the last on line 907: \
+         it is truncated (the rows present are read)",
+    );
+    let take = read(&qualisys_tsv(895, 895, &tip_cells));
+    assert!(
+        take.notes.iter().all(|n| !n.contains("NO_OF_FRAMES")),
+        "{:?}",
+        take.notes
+    );
+    // A row dropped inside (the grid fills it) and a header that says too few.
+    let dropped = qualisys_tsv(895, 895, &tip_cells).replace("\n400\t", "\nX");
+    let dropped: String = dropped
+        .lines()
+        .filter(|l| !l.starts_with('X'))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let take = read(&dropped);
+    assert_eq!(take.frames, 895);
+    noted(
+        &take,
+        "NO_OF_FRAMES (line 1) says 895 frames, the file has 894 rows: the missing rows are \
+         frames dropped inside it",
+    );
+    let take = read(&qualisys_tsv(800, 895, &tip_cells));
+    noted(
+        &take,
+        "NO_OF_FRAMES (line 1) says 800 frames, the file has 895 rows: the header is out of date",
+    );
+    let odd =
+        qualisys_tsv(895, 895, &tip_cells).replacen("NO_OF_FRAMES\t895", "NO_OF_FRAMES\tmany", 1);
+    let e = import::table::read(path, odd.as_bytes(), &profile, None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("cut.tsv: line 1, \"NO_OF_FRAMES\": expected a whole number"),
+        "{e}"
+    );
+    // The 6DOF export too.
+    let six_d = import::CaptureProfile::shipped("qualisys-6d").unwrap();
+    let text = std::fs::read_to_string(fixture("capture/qualisys_6d_100hz.tsv")).unwrap();
+    let cut = text.replacen("NO_OF_FRAMES\t7", "NO_OF_FRAMES\t700", 1);
+    assert_ne!(cut, text);
+    let take = import::table::read(path, cut.as_bytes(), &six_d, None).unwrap();
+    assert!(
+        take.notes
+            .iter()
+            .any(|n| n.contains("NO_OF_FRAMES") && n.contains("700") && n.contains("7 rows")),
+        "{:?}",
+        take.notes
+    );
+}

@@ -21,6 +21,8 @@
 //!     rate_key: Some("FREQUENCY"),// metadata key above the header that gives the rate, Hz
 //!     unit: None,                 // "mm" | "cm" | "m"; else `unit_key`, else the unit row,
 //!     unit_key: None,             //   else metres
+//!     frames_key: Some("NO_OF_FRAMES"), // metadata key giving the number of frames: a
+//!                                 //   file with fewer (or more) data rows gets a note
 //!     zero_is_missing: false,     // a position (quaternion, matrix) of all zeros is unseen
 //!     up: None,                   // Some(Y) | Some(Z) | Some(NegY) …: the capture's up axis
 //!     tracks: [                   // explicit tracks
@@ -63,11 +65,14 @@
 //!   everything above that is metadata. `Line(n)` and `StartsWith(s)` name the header's
 //!   first row (by 1-based line number, or as the first line whose first cell starts with
 //!   `s`, case-insensitively).
-//! * **Metadata** (for `rate_key` and `unit_key`; matched like column names): a key's
-//!   value is the next non-empty cell on its line (the next cell, on a line of
-//!   alternating keys and values like Motive's); on a line of keys only over a line of
-//!   values, or a key alone over a value alone, it is the cell in the same column of the
-//!   next line (TRC, Vicon).
+//! * **Metadata** (for `rate_key`, `unit_key` and `frames_key`; matched like column
+//!   names): a key's value is the next non-empty cell on its line (the next cell, on a
+//!   line of alternating keys and values like Motive's); on a line of keys only over a
+//!   line of values, or a key alone over a value alone, it is the cell in the same column
+//!   of the next line (TRC, Vicon).
+//! * **Frame count**: with `frames_key`, a file holding fewer data rows than its value
+//!   (cut short) or more (a header out of date) is read with a note saying both counts;
+//!   a value that is not a whole number is an error naming its line.
 //! * **Time**: rows go on a uniform grid at the rate (see [`crate::mocap::import::table`]).
 //!   The rate is `rate_hz`, else the `rate_key` value, else 1 / the median time step.
 //! * **Hands**: [`CaptureProfile::hand_of`] gives an explicit track's `hand` (`Left`,
@@ -138,6 +143,10 @@ pub struct CaptureProfile {
     /// The metadata key whose value is the length unit.
     #[serde(default)]
     pub unit_key: Option<String>,
+    /// The metadata key whose value is the number of frames the file holds (Qualisys
+    /// `NO_OF_FRAMES`, TRC `NumFrames`): data rows fewer or more than it give a note.
+    #[serde(default)]
+    pub frames_key: Option<String>,
     /// A position (or quaternion, or matrix) whose cells are all 0 is a missing sample.
     #[serde(default)]
     pub zero_is_missing: bool,
@@ -434,6 +443,7 @@ impl CaptureProfile {
             rate_key: None,
             unit: None,
             unit_key: None,
+            frames_key: None,
             zero_is_missing: false,
             up: None,
             tracks: Vec::new(),

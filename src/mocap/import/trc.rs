@@ -21,11 +21,11 @@
 //!   placed on the frame grid by their `Time` (s), so a missing row is a gap (noted).
 //! * `NumMarkers` must equal the number of marker column groups (name over `Xn Yn Zn`),
 //!   or the file is refused; a `NumFrames` that differs from the rows read (a truncated
-//!   file) gives a note in [`Take::notes`].
+//!   file) gives a note in [`Take::notes`] (the profile's `frames_key`).
 
 use super::LengthUnit;
 use super::profile::CaptureProfile;
-use super::table::{self, MetaEntry};
+use super::table;
 use crate::mocap::take::{ImportError, Take};
 use std::path::Path;
 
@@ -34,8 +34,8 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
     let profile = CaptureProfile::shipped("trc").ok_or_else(|| {
         ImportError::format(path, "TRC profile", "the shipped trc profile did not load")
     })?;
-    let (mut take, info) = table::read_table(path, bytes, &profile, unit)?;
-    if let Some((e, n)) = stated_count(path, &info.metadata, "NumMarkers")?
+    let (take, info) = table::read_table(path, bytes, &profile, unit)?;
+    if let Some((e, n)) = table::stated_count(path, &info.metadata, "NumMarkers")?
         && n != take.tracks.len()
     {
         return Err(ImportError::format(
@@ -48,39 +48,7 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
             ),
         ));
     }
-    if let Some((_, n)) = stated_count(path, &info.metadata, "NumFrames")?
-        && n != info.data_rows
-    {
-        let why = if n > info.data_rows {
-            "it is truncated"
-        } else {
-            "the header is out of date"
-        };
-        take.notes.push(format!(
-            "NumFrames says {n} frames, the file has {} rows: {why}",
-            info.data_rows
-        ));
-    }
     Ok(take)
-}
-
-/// A whole-number header value (`NumMarkers`, `NumFrames`), if the header has the key.
-fn stated_count<'m>(
-    path: &Path,
-    meta: &'m [MetaEntry],
-    key: &str,
-) -> Result<Option<(&'m MetaEntry, usize)>, ImportError> {
-    let Some(e) = table::lookup(meta, key) else {
-        return Ok(None);
-    };
-    let n = e.value.trim().parse::<usize>().map_err(|_| {
-        ImportError::format(
-            path,
-            format!("line {}, \"{}\"", e.line, e.key),
-            format!("expected a whole number below {key}, found \"{}\"", e.value),
-        )
-    })?;
-    Ok(Some((e, n)))
 }
 
 #[cfg(test)]
@@ -143,10 +111,10 @@ mod tests {
         let short = edited("\t8\t3\tmm", "\t12\t3\tmm");
         let take = read(p(), &short, None).unwrap();
         assert!(
-            take.notes
-                .iter()
-                .any(|n| n
-                    .contains("NumFrames says 12 frames, the file has 8 rows: it is truncated")),
+            take.notes.iter().any(|n| n.contains(
+                "NumFrames (line 2) says 12 frames, the file has 8 rows, the last on line 14: \
+                 it is truncated"
+            )),
             "{:?}",
             take.notes
         );

@@ -1,4 +1,5 @@
-//! The length unit, the time or frame column and the rate a table states.
+//! The length unit, the time or frame column, the rate and the frame count a table
+//! states.
 
 use super::*;
 
@@ -153,6 +154,67 @@ pub(super) fn stated_rate(
             None
         }
     }
+}
+
+/// The note when the data rows differ from the frame count the profile's `frames_key`
+/// entry states: a file cut short (`frames`, the rows on the grid, short of the count
+/// too; its rows are still read), rows dropped inside it, or a header out of date.
+pub(super) fn frame_count_note(
+    path: &Path,
+    profile: &CaptureProfile,
+    meta: &[MetaEntry],
+    rows: &Rows,
+    frames: usize,
+) -> Result<Option<String>, ImportError> {
+    let Some(key) = &profile.frames_key else {
+        return Ok(None);
+    };
+    let Some((e, stated)) = stated_count(path, meta, key)? else {
+        return Ok(None);
+    };
+    let found = rows.lines.len();
+    let last = rows.lines.last().copied().unwrap_or(e.line);
+    let says = format!(
+        "{} (line {}) says {stated} frames, the file has {found} rows",
+        e.key, e.line
+    );
+    Ok(if found == stated {
+        None
+    } else if found > stated {
+        Some(format!("{says}: the header is out of date"))
+    } else if frames < stated {
+        Some(format!(
+            "{says}, the last on line {last}: it is truncated (the rows present are read)"
+        ))
+    } else {
+        Some(format!(
+            "{says}: the missing rows are frames dropped inside it"
+        ))
+    })
+}
+
+/// A whole-number metadata value (`NumMarkers`, `NO_OF_FRAMES`), if the file has the
+/// key; an error naming its line when the value is not a whole number.
+pub(in crate::mocap::import) fn stated_count<'m>(
+    path: &Path,
+    meta: &'m [MetaEntry],
+    key: &str,
+) -> Result<Option<(&'m MetaEntry, usize)>, ImportError> {
+    let Some(e) = lookup(meta, key) else {
+        return Ok(None);
+    };
+    let n = e.value.trim().parse::<usize>().map_err(|_| {
+        ImportError::format(
+            path,
+            format!("line {}, \"{}\"", e.line, e.key),
+            format!(
+                "expected a whole number below {}, found \"{}\"",
+                e.key,
+                csv_text::shorten(&e.value)
+            ),
+        )
+    })?;
+    Ok(Some((e, n)))
 }
 
 /// A cell as a number: `None` for a missing value (empty, `NaN`, `-`); an error message

@@ -102,8 +102,6 @@ pub struct FoundTrack {
 /// What [`read_table`] knows besides the take, for format-specific checks.
 pub(super) struct TableInfo {
     pub metadata: Vec<MetaEntry>,
-    /// The number of data rows read (not counting grid gaps).
-    pub data_rows: usize,
 }
 
 /// Read a capture table as `profile` describes it; `unit` overrides every unit source.
@@ -178,6 +176,7 @@ pub(super) fn read_table(
     let rows = reader.read_rows(sheet, found.data, clock, &tracks, &scales, &mut notes)?;
     let stated = stated_rate(profile, &meta, &mut notes);
     let grid = Grid::place(path, &rows, clock.map(|c| c.1), stated, &mut notes)?;
+    notes.extend(frame_count_note(path, profile, &meta, &rows, grid.frames)?);
     let take = Take {
         source: path.to_path_buf(),
         rate_hz: grid.rate_hz,
@@ -186,10 +185,7 @@ pub(super) fn read_table(
         tracks: grid.scatter(rows.tracks),
         notes,
     };
-    let info = TableInfo {
-        metadata: meta,
-        data_rows: rows.lines.len(),
-    };
+    let info = TableInfo { metadata: meta };
     Ok((take, info))
 }
 
@@ -228,6 +224,7 @@ mod rows;
 mod sheet;
 mod tracks;
 
+pub(super) use clock::stated_count;
 use clock::*;
 pub(super) use columns::lookup;
 use columns::*;
