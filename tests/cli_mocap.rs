@@ -295,3 +295,74 @@ fn duplicate_labels_are_refused_when_used() {
         assert!(!db_dir.exists());
     }
 }
+
+/// A take that cannot be aligned (a QTM export cut short before the first stroke) fails
+/// with an error that points at `--unit`, `--up` and `--tips`, after the take's own notes
+/// (the cut, the vertical that could not be told), printed as every note is.
+#[test]
+fn an_unalignable_take_prints_its_notes_before_the_error() {
+    let source = right_hand_legato();
+    let take = &source.takes[0];
+    let first_impact = source.index.units[0].impact;
+    let rows = first_impact / 2;
+    let mut tsv = format!(
+        "NO_OF_FRAMES\t{}\nNO_OF_CAMERAS\t8\nNO_OF_MARKERS\t1\nFREQUENCY\t{}\nNO_OF_ANALOG\t0\n\
+         ANALOG_FREQUENCY\t0\nDESCRIPTION\t--\nTIME_STAMP\t2024-05-14, 15:12:45.120\t81234.5\n\
+         DATA_INCLUDED\t3D\nMARKER_NAMES\tStick R tip\nTRAJECTORY_TYPES\tMeasured\n\
+         Frame\tTime\tStick R tip X\tStick R tip Y\tStick R tip Z\t\n",
+        take.frames(),
+        take.rate_hz
+    );
+    for (f, p) in take.tips[1].iter().take(rows).enumerate() {
+        let p = p.unwrap() * 1000.0;
+        writeln!(
+            tsv,
+            "{}\t{:.5}\t{:.3}\t{:.3}\t{:.3}",
+            f + 1,
+            f as f64 / take.rate_hz,
+            p.x,
+            p.y,
+            p.z
+        )
+        .unwrap();
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("legato_cut.tsv");
+    std::fs::write(&path, tsv).unwrap();
+    let db_dir = dir.path().join("db");
+    let out = timpanist(&[
+        "mocap",
+        "import",
+        path.to_str().unwrap(),
+        "--profile",
+        "qualisys-3d",
+        "--tips",
+        ",Stick R tip",
+        "--align",
+        "auto",
+        "-o",
+        db_dir.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(!db_dir.exists());
+    let shown = path.display().to_string();
+    let cut_note = format!(
+        "note: {shown}: NO_OF_FRAMES (line 1) says {} frames, the file has {rows} rows",
+        take.frames()
+    );
+    let error_at = err.find("error: ").expect("an error line");
+    let note_at = err
+        .find(&cut_note)
+        .unwrap_or_else(|| panic!("{cut_note:?} in {err}"));
+    assert!(note_at < error_at, "{err}");
+    assert!(
+        err[..error_at].contains(&format!("note: {shown}: the vertical")),
+        "{err}"
+    );
+    let error = &err[error_at..];
+    assert!(error.contains("no impacts to align"), "{err}");
+    for flag in ["--unit", "--up", "--tips"] {
+        assert!(error.contains(flag), "{flag} in {err}");
+    }
+}

@@ -258,7 +258,9 @@ pub fn import(args: ImportArgs) -> anyhow::Result<()> {
             segment: Default::default(),
             dynamic_speeds: speeds.clone(),
         };
-        let report = ingest(&mut db, &source.path, &source.take, &options)?;
+        // A take that cannot be imported still has its notes said: they often tell why.
+        let report = ingest(&mut db, &source.path, &source.take, &options)
+            .inspect_err(|_| print_notes(&source.path, &source.take.notes))?;
         print_report(source, &report, &align);
         refuse_if_strokeless(&source.path, &report)?;
         if matches!(align, Alignment::None) {
@@ -722,8 +724,16 @@ fn print_report(source: &Source, report: &IngestReport, align: &Alignment) {
             );
         }
     }
-    for note in source.take.notes.iter().chain(&report.notices) {
-        eprintln!("note: {path}: {note}");
+    print_notes(
+        &source.path,
+        source.take.notes.iter().chain(&report.notices),
+    );
+}
+
+/// Print notes about the take read from `path` on stderr, one `note: FILE: …` line each.
+fn print_notes<'a>(path: &Path, notes: impl IntoIterator<Item = &'a String>) {
+    for note in notes {
+        eprintln!("note: {}: {note}", path.display());
     }
 }
 

@@ -152,7 +152,9 @@ impl Default for Habits {
 /// Why a take could not be aligned.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum AlignError {
-    #[error("no impacts to align")]
+    #[error(
+        "no impacts to align: no stick came down onto a head and rebounded; check the length unit (--unit mm|cm|m), which way is up (--up) and which tracks are the sticks (--tips)"
+    )]
     NoImpacts,
     #[error(
         "cannot tell which way the player faces: the strokes move straight up and down (mean sideways travel {0:.3} m); give --align \"x,y,z,yaw\""
