@@ -915,3 +915,91 @@ fn qualisys_tsv_shorter_than_no_of_frames_is_noted() {
         take.notes
     );
 }
+
+// ---------------------------------------------------------------- sweep: NaN
+
+/// A coordinate written as NaN (any case) is a gap in every text format, as an empty
+/// cell is, and the gap note counts them.
+#[test]
+fn nan_is_a_gap_in_every_text_format() {
+    let nan_note = |take: &Take, n: usize| {
+        let want = format!(
+            "{n} sample{} written as NaN read as gaps",
+            if n == 1 { "" } else { "s" }
+        );
+        assert!(
+            take.notes.iter().any(|note| note.contains(&want)),
+            "{:?}",
+            take.notes
+        );
+    };
+    // Vicon: NaN, nan, a single NaN coordinate, and empty cells (not counted as NaN).
+    let mut text = String::from(
+        "Trajectories\n100\n,,Player:StickR_Tip,,,Player:RWRA,,\n\
+         Frame,Sub Frame,X,Y,Z,X,Y,Z\n,,mm,mm,mm,mm,mm,mm\n",
+    );
+    for f in 1..=60 {
+        let tip = match f {
+            10 => "NaN,NaN,NaN".to_string(),
+            11 => "nan,nan,nan".to_string(),
+            12 => "250.0,NaN,812.0".to_string(),
+            13 => ",,".to_string(),
+            _ => format!("250.0,950.0,{:.3}", 800.0 + f as f64),
+        };
+        text.push_str(&format!("{f},0,{tip},310.0,700.0,1050.0\n"));
+    }
+    let take = import::read_bytes(Path::new("nan.csv"), text.as_bytes(), Format::Vicon).unwrap();
+    let tip = take.track("StickR_Tip").unwrap();
+    assert_eq!(tip.positions[9..13], [None, None, None, None]);
+    assert_eq!(seen(tip), 56);
+    nan_note(&take, 3);
+    // Plain CSV: a NaN position and a NaN rigid body (position and quaternion).
+    let csv = "time_s,TipR_x,TipR_y,TipR_z,B_x,B_y,B_z,B_qx,B_qy,B_qz,B_qw\n\
+               0.00,0.1,0.2,0.8,0.1,0.2,0.8,0,0,0,1\n\
+               0.01,NaN,NaN,NaN,nan,nan,nan,nan,nan,nan,nan\n\
+               0.02,0.1,0.2,0.8,0.1,0.2,0.8,0,0,0,1\n\
+               0.03,,,,0.1,0.2,0.8,NaN,NaN,NaN,NaN\n";
+    let take = import::read_bytes(Path::new("nan.csv"), csv.as_bytes(), Format::Csv).unwrap();
+    assert_eq!(take.tracks[0].positions[1], None);
+    assert_eq!(take.tracks[0].positions[3], None);
+    assert_eq!(
+        (take.tracks[1].positions[1], take.tracks[1].rotations[1]),
+        (None, None)
+    );
+    assert!(take.tracks[1].positions[3].is_some());
+    assert_eq!(take.tracks[1].rotations[3], None);
+    nan_note(&take, 2);
+    // Motive: the left stick lost (NaN) for one frame.
+    let path = fixture("motive/timpani_roll_250hz.csv");
+    let motive = std::fs::read_to_string(&path).unwrap();
+    let lost = motive
+        .lines()
+        .map(|l| match l.strip_prefix("3,0.012000,") {
+            Some(rest) => {
+                let cells: Vec<&str> = rest.split(',').collect();
+                let nans = ["NaN"; 7];
+                format!("3,0.012000,{},{}", nans.join(","), cells[7..].join(","))
+            }
+            None => l.to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let take = import::read_bytes(&path, lost.as_bytes(), Format::Motive).unwrap();
+    let left = take.track("StickL").unwrap();
+    assert_eq!((left.positions[3], left.rotations[3]), (None, None));
+    nan_note(&take, 1);
+    // TRC (through the table reader): its NaN marker is counted too.
+    let take = load("capture/opensim_walk.trc");
+    assert_eq!(take.tracks[1].positions[3], None);
+    nan_note(&take, 1);
+    // Qualisys (a profile): NaN and empty cells are gaps, the NaN counted.
+    let profile = import::CaptureProfile::shipped("qualisys-3d").unwrap();
+    let tsv = qualisys_tsv(40, 40, &|f| match f {
+        5 => "NaN\tNaN\tNaN".to_string(),
+        6 => "\t\t".to_string(),
+        _ => tip_cells(f),
+    });
+    let take = import::table::read(Path::new("nan.tsv"), tsv.as_bytes(), &profile, None).unwrap();
+    assert_eq!(take.tracks[0].positions[4..6], [None, None]);
+    nan_note(&take, 1);
+}

@@ -16,4 +16,4 @@ pub mod take;
 pub mod tip_estimate;
 pub mod vertical;
 
-pub use take::{ImportError, Take, Track};
+pub use take::{ImportError, MarkedGaps, Take, Track};

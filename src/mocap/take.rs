@@ -58,8 +58,10 @@ impl Take {
 
     /// Read every sample exactly at the origin (all three coordinates 0.0) as missing,
     /// as Vicon, Cortex and many C3D writers mark an unseen marker (a rigid body's
-    /// rotation goes with it), with a note; returns how many.
-    pub fn zeros_as_gaps(&mut self) -> usize {
+    /// rotation goes with it), and note them together with `read` (the samples the
+    /// reader has already read as gaps for such a mark, e.g. written as NaN); returns
+    /// how many were at the origin.
+    pub fn zeros_as_gaps(&mut self, read: MarkedGaps) -> usize {
         let mut n = 0;
         for t in &mut self.tracks {
             for (f, p) in t.positions.iter_mut().enumerate() {
@@ -72,12 +74,11 @@ impl Take {
                 }
             }
         }
-        if n > 0 {
-            self.notes.push(format!(
-                "{n} {} at exactly (0, 0, 0) read as gaps (the way Vicon, Cortex and many C3D writers mark an unseen marker)",
-                if n == 1 { "sample" } else { "samples" }
-            ));
-        }
+        let gaps = MarkedGaps {
+            zero: read.zero + n,
+            ..read
+        };
+        self.notes.extend(gaps.note());
         n
     }
 
@@ -109,6 +110,37 @@ impl Take {
     /// All labels, in file order.
     pub fn labels(&self) -> Vec<&str> {
         self.tracks.iter().map(|t| t.label.as_str()).collect()
+    }
+}
+
+/// Samples a file marks unseen instead of leaving their cells empty: a coordinate
+/// written as NaN, or all three exactly 0. Both are read as gaps and counted in one note.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MarkedGaps {
+    /// Samples with a coordinate written as NaN.
+    pub nan: usize,
+    /// Samples at exactly (0, 0, 0).
+    pub zero: usize,
+}
+
+impl MarkedGaps {
+    /// The note counting them (`4 samples at exactly (0, 0, 0) and 2 written as NaN read
+    /// as gaps …`), or `None` when there are none.
+    pub fn note(self) -> Option<String> {
+        let samples = |n: usize| if n == 1 { "sample" } else { "samples" };
+        let at_origin = |n: usize| format!("{n} {} at exactly (0, 0, 0)", samples(n));
+        let counted = match (self.zero, self.nan) {
+            (0, 0) => return None,
+            (0, nan) => format!("{nan} {} written as NaN", samples(nan)),
+            (zero, 0) => at_origin(zero),
+            (zero, nan) => format!("{} and {nan} written as NaN", at_origin(zero)),
+        };
+        let why = if self.zero > 0 {
+            " (the way Vicon, Cortex and many C3D writers mark an unseen marker)"
+        } else {
+            ""
+        };
+        Some(format!("{counted} read as gaps{why}"))
     }
 }
 
@@ -161,5 +193,26 @@ impl ImportError {
             place: place.into(),
             message: message.into(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_note_counts_zeros_and_nans() {
+        let note = |zero, nan| MarkedGaps { nan, zero }.note();
+        assert_eq!(note(0, 0), None);
+        assert_eq!(
+            note(1, 0).unwrap(),
+            "1 sample at exactly (0, 0, 0) read as gaps (the way Vicon, Cortex and many C3D writers mark an unseen marker)"
+        );
+        assert_eq!(note(0, 2).unwrap(), "2 samples written as NaN read as gaps");
+        assert!(
+            note(4, 1)
+                .unwrap()
+                .starts_with("4 samples at exactly (0, 0, 0) and 1 written as NaN read as gaps (")
+        );
     }
 }

@@ -3,8 +3,10 @@
 //! errors that name the line and column.
 //!
 //! Line and column numbers are 1-based; a column is a CSV cell (field), not a character.
+//! A cell that is empty or says `NaN` (any case, as MATLAB, pandas and many lab tools
+//! write an unseen marker) holds no value: a position with one is a gap.
 
-use crate::mocap::take::ImportError;
+use crate::mocap::take::{ImportError, MarkedGaps};
 use glam::DVec3;
 use std::borrow::Cow;
 use std::path::Path;
@@ -194,28 +196,43 @@ pub(super) fn blank_lines_note(lines: &[usize], what: &str) -> Option<String> {
     ))
 }
 
-/// The number in cell `col` of `row`: `None` for an empty (or absent) cell.
-pub(super) fn number(path: &Path, row: &Row, col: usize) -> Result<Option<f64>, ImportError> {
-    let cell = row.cell(col);
-    if cell.is_empty() {
+/// A cell as a number: `None` when it holds no value (empty, or `NaN` in any case); an
+/// error message for anything else that is not a finite number. `decimal_comma`: the
+/// cell may be written `1,25`.
+pub(super) fn parse_number(cell: &str, decimal_comma: bool) -> Result<Option<f64>, String> {
+    let cell = cell.trim();
+    if cell.is_empty() || is_nan(cell) {
         return Ok(None);
     }
-    match cell.parse::<f64>() {
+    let text = if decimal_comma {
+        Cow::Owned(cell.replace(',', "."))
+    } else {
+        Cow::Borrowed(cell)
+    };
+    match text.parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(Some(v)),
-        Ok(_) => Err(ImportError::format(
-            path,
-            place(row.line, col),
-            format!("expected a finite number, found \"{cell}\""),
-        )),
-        Err(_) => Err(ImportError::format(
-            path,
-            place(row.line, col),
-            format!("expected a number, found \"{}\"", shorten(cell)),
-        )),
+        Ok(_) => Err(format!("expected a finite number, found \"{cell}\"")),
+        Err(_) => Err(format!("expected a number, found \"{}\"", shorten(cell))),
     }
 }
 
-/// The number in cell `col` of `row`, which must not be empty; `what` names it.
+/// Whether a cell says "not a number" (`NaN`, `nan`, `-nan`, …).
+pub(super) fn is_nan(cell: &str) -> bool {
+    cell.trim().parse::<f64>().is_ok_and(f64::is_nan)
+}
+
+/// Whether any of the cells `cols` of `row` says NaN.
+pub(super) fn written_nan(row: &Row, cols: &[usize]) -> bool {
+    cols.iter().any(|&c| is_nan(row.cell(c)))
+}
+
+/// The number in cell `col` of `row`: `None` for an empty (or absent) cell or `NaN`.
+pub(super) fn number(path: &Path, row: &Row, col: usize) -> Result<Option<f64>, ImportError> {
+    parse_number(row.cell(col), false)
+        .map_err(|m| ImportError::format(path, place(row.line, col), m))
+}
+
+/// The number in cell `col` of `row`, which must hold one; `what` names it.
 pub(super) fn required_number(
     path: &Path,
     row: &Row,
@@ -223,16 +240,21 @@ pub(super) fn required_number(
     what: &str,
 ) -> Result<f64, ImportError> {
     number(path, row, col)?.ok_or_else(|| {
+        let found = match row.cell(col) {
+            "" => "an empty cell".to_string(),
+            cell => format!("\"{}\"", shorten(cell)),
+        };
         ImportError::format(
             path,
             place(row.line, col),
-            format!("expected a number ({what}), found an empty cell"),
+            format!("expected a number ({what}), found {found}"),
         )
     })
 }
 
 /// The position in cells `cols` (X, Y, Z) of `row`, times `scale` (metres per file
-/// unit): `None` when all three are empty; an error when only some are.
+/// unit): `None` when all three are empty or any says NaN; an error when only some are
+/// empty.
 pub(super) fn position(
     path: &Path,
     row: &Row,
@@ -242,6 +264,9 @@ pub(super) fn position(
     let x = number(path, row, cols[0])?;
     let y = number(path, row, cols[1])?;
     let z = number(path, row, cols[2])?;
+    if written_nan(row, &cols) {
+        return Ok(None);
+    }
     match (x, y, z) {
         (Some(x), Some(y), Some(z)) => Ok(Some(DVec3::new(x, y, z) * scale)),
         (None, None, None) => Ok(None),
@@ -258,6 +283,21 @@ pub(super) fn position(
             ))
         }
     }
+}
+
+/// [`position`], a sample written as NaN counted in `gaps`.
+pub(super) fn sample(
+    path: &Path,
+    row: &Row,
+    cols: [usize; 3],
+    scale: f64,
+    gaps: &mut MarkedGaps,
+) -> Result<Option<DVec3>, ImportError> {
+    let p = position(path, row, cols, scale)?;
+    if written_nan(row, &cols) {
+        gaps.nan += 1;
+    }
+    Ok(p)
 }
 
 /// Check that a data row has the header's `width` cells: fewer means the row was cut
@@ -354,5 +394,33 @@ mod tests {
         assert!(required_number(p, &r, 2, "time").is_err());
         assert!(position(p, &r, [0, 2, 2], 1.0).is_err());
         assert_eq!(position(p, &r, [2, 2, 2], 1.0).unwrap(), None);
+    }
+
+    #[test]
+    fn nan_cells_hold_no_value_and_make_the_position_a_gap() {
+        let r = Row {
+            line: 4,
+            cells: split_cells("NaN,nan,-NaN,1.5,,x"),
+        };
+        let p = Path::new("t.csv");
+        for col in 0..3 {
+            assert!(is_nan(r.cell(col)));
+            assert_eq!(number(p, &r, col).unwrap(), None);
+        }
+        assert!(!is_nan("") && !is_nan("1") && !is_nan("inf"));
+        assert_eq!(
+            required_number(p, &r, 0, "frame number")
+                .unwrap_err()
+                .to_string(),
+            "t.csv: line 4, column 1: expected a number (frame number), found \"NaN\""
+        );
+        let mut gaps = MarkedGaps::default();
+        assert_eq!(sample(p, &r, [0, 1, 2], 1.0, &mut gaps).unwrap(), None);
+        // One NaN coordinate is a gap too; an empty one beside numbers is not.
+        assert_eq!(sample(p, &r, [3, 3, 1], 1.0, &mut gaps).unwrap(), None);
+        assert!(sample(p, &r, [3, 3, 4], 1.0, &mut gaps).is_err());
+        assert_eq!(sample(p, &r, [4, 4, 4], 1.0, &mut gaps).unwrap(), None);
+        assert_eq!(gaps.nan, 2);
+        assert!(sample(p, &r, [0, 1, 5], 1.0, &mut gaps).is_err(), "x");
     }
 }

@@ -3,7 +3,10 @@
 //!
 //! Every importer returns a [`Take`]: labelled tracks at one fixed rate, positions in
 //! metres in the file's own axes (converted from the file's length unit), `None` where a
-//! marker was not seen, and rotations for rigid bodies. A file that is not what it claims
+//! marker was not seen, and rotations for rigid bodies. A sample the file marks unseen
+//! is `None` too: an empty cell, a coordinate written as `NaN` (any case) in every text
+//! format, or (in every format) exactly (0, 0, 0); the last two are counted in one note
+//! ([`crate::mocap::MarkedGaps`]). A file that is not what it claims
 //! to be, or is corrupt or truncated, gives an [`ImportError::Format`] that names the place
 //! (byte offset, C3D parameter, or CSV line and column) and says what was expected; no
 //! file content can make an importer panic.
@@ -216,15 +219,13 @@ pub fn read_bytes_with_unit(
     format: Format,
     unit: Option<LengthUnit>,
 ) -> Result<Take, ImportError> {
-    let mut take = match format {
+    match format {
         Format::C3d => c3d::read(path, bytes, unit),
         Format::Motive => motive::read(path, bytes, unit),
         Format::Vicon => vicon::read(path, bytes, unit),
         Format::Csv => plain_csv::read(path, bytes, unit),
         Format::Trc => trc::read(path, bytes, unit),
-    }?;
-    take.zeros_as_gaps();
-    Ok(take)
+    }
 }
 
 /// Read a column-mapped text capture as `profile` describes it (see [`profile`] and

@@ -30,13 +30,14 @@
 //!   Marker Error`, `Marker Quality`) are ignored. Tracks are labelled by name; a rigid
 //!   body marker (the solved position) whose name is also a measured marker's gets the
 //!   label `<name> (solved)`, and any other repeated label gets ` (2)`, ` (3)`, ….
-//! * Data rows: frame, time in seconds, then values; an empty cell is a missing sample.
+//! * Data rows: frame, time in seconds, then values; an empty cell is a missing sample,
+//!   and so is a position or rotation with a cell written `NaN` (counted in a note).
 //!   The time step must match the rate to 1 %.
 
 use super::LengthUnit;
 use super::csv_text::{self, Row};
 use super::plain_csv::quaternion;
-use crate::mocap::take::{ImportError, Take, Track};
+use crate::mocap::take::{ImportError, MarkedGaps, Take, Track};
 use std::path::Path;
 
 /// What a group of columns is.
@@ -100,7 +101,16 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         .max(header.iter().map(Row::used_width).max().unwrap_or(0));
     let entities = group_columns(path, &head, &frame_row, width)?;
     check_entities(path, &entities, &head, &meta)?;
-    let (tracks, frames) = read_data(path, rows, &entities, width, &meta, frame_row.line)?;
+    let mut gaps = MarkedGaps::default();
+    let (tracks, frames) = read_data(
+        path,
+        rows,
+        &entities,
+        width,
+        &meta,
+        frame_row.line,
+        &mut gaps,
+    )?;
     if let Some(n) = meta.total_frames.filter(|&n| n != frames) {
         return Err(ImportError::format(
             path,
@@ -111,14 +121,16 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
             ),
         ));
     }
-    Ok(Take {
+    let mut take = Take {
         source: path.to_path_buf(),
         rate_hz: meta.rate_hz,
         frames,
         file_unit: meta.unit.symbol().to_string(),
         tracks,
         notes: Vec::new(),
-    })
+    };
+    take.zeros_as_gaps(gaps);
+    Ok(take)
 }
 
 /// Read line 1, `Format Version,…` and key/value pairs: the rate, the length unit
@@ -387,8 +399,8 @@ fn intrinsic(order: [usize; 3], degrees: glam::DVec3) -> glam::DQuat {
 }
 
 /// Read the data rows after the `Frame` row (line `frame_line`) into one track per
-/// entity, checking the time step against the rate; also the number of frames (1 or
-/// more).
+/// entity, checking the time step against the rate and counting the positions written
+/// as NaN in `gaps`; also the number of frames (1 or more).
 fn read_data<'a>(
     path: &'a Path,
     rows: impl Iterator<Item = Row<'a>> + 'a,
@@ -396,6 +408,7 @@ fn read_data<'a>(
     width: usize,
     meta: &Meta,
     frame_line: usize,
+    gaps: &mut MarkedGaps,
 ) -> Result<(Vec<Track>, usize), ImportError> {
     let labels = unique_labels(entities);
     let mut tracks: Vec<Track> = entities
@@ -432,7 +445,7 @@ fn read_data<'a>(
             };
             track
                 .positions
-                .push(csv_text::position(path, &row, [x, y, z], scale)?);
+                .push(csv_text::sample(path, &row, [x, y, z], scale, gaps)?);
             match (e.rotation, meta.euler) {
                 ([Some(qx), Some(qy), Some(qz), Some(qw)], None) => track
                     .rotations

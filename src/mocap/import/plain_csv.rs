@@ -18,7 +18,8 @@
 //!   one label may come in any order; tracks are listed in order of first appearance.
 //! * Every following line is one frame: the time in seconds, then numbers with `.` as
 //!   the decimal point. Positions are in metres. An empty cell means "not seen" and must
-//!   cover the whole position (x, y, z) or the whole quaternion.
+//!   cover the whole position (x, y, z) or the whole quaternion; a cell written `NaN`
+//!   (any case) makes its position or quaternion "not seen" (counted in a note).
 //! * The frame rate is 1 / the median time step. Times must increase and every step must
 //!   be within 1 % of the median, or the file is refused with the line that breaks it.
 //!   At least two frames are needed.
@@ -29,7 +30,7 @@
 
 use super::LengthUnit;
 use super::csv_text::{self, Row};
-use crate::mocap::take::{ImportError, Take, Track};
+use crate::mocap::take::{ImportError, MarkedGaps, Take, Track};
 use glam::DQuat;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -63,6 +64,7 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         .iter()
         .map(|c| Track::empty(c.label.clone()))
         .collect();
+    let mut gaps = MarkedGaps::default();
     for row in csv_text::data_rows(path, rows) {
         let row = row?;
         csv_text::check_width(path, &row, width)?;
@@ -71,7 +73,7 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         for (c, track) in labels.iter().zip(tracks.iter_mut()) {
             let pos = match c.cols {
                 [Some(x), Some(y), Some(z), ..] => {
-                    csv_text::position(path, &row, [x, y, z], scale)?
+                    csv_text::sample(path, &row, [x, y, z], scale, &mut gaps)?
                 }
                 _ => None,
             };
@@ -84,14 +86,16 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         }
     }
     let rate_hz = rate_from_times(path, &times)?;
-    Ok(Take {
+    let mut take = Take {
         source: path.to_path_buf(),
         rate_hz,
         frames: times.len(),
         file_unit: unit.symbol().to_string(),
         tracks,
         notes: Vec::new(),
-    })
+    };
+    take.zeros_as_gaps(gaps);
+    Ok(take)
 }
 
 /// The header's column count and each label's columns.
@@ -170,7 +174,8 @@ fn parse_header(path: &Path, header: &Row) -> Result<(usize, Vec<Columns>), Impo
     Ok((width, labels))
 }
 
-/// A quaternion from cells X, Y, Z, W: all empty gives `None`; it is normalised.
+/// A quaternion from cells X, Y, Z, W: all empty, or any NaN, gives `None`; it is
+/// normalised.
 pub(super) fn quaternion(
     path: &Path,
     row: &Row,
@@ -184,7 +189,7 @@ pub(super) fn quaternion(
             given += 1;
         }
     }
-    if given == 0 {
+    if given == 0 || csv_text::written_nan(row, &cols) {
         return Ok(None);
     }
     let q = DQuat::from_xyzw(v[0], v[1], v[2], v[3]);
@@ -405,7 +410,11 @@ mod tests {
         assert_eq!(back.labels(), take.labels());
         assert_eq!(back.frames, 3);
         assert!((back.rate_hz - 250.0).abs() < 1e-9);
-        assert_eq!(back.tracks[0].positions, take.tracks[0].positions);
+        assert_eq!(back.tracks[0].positions[..2], take.tracks[0].positions[..2]);
+        assert_eq!(
+            back.tracks[0].positions[2], None,
+            "(0, 0, 0) reads as a gap"
+        );
         assert_eq!(back.tracks[1].positions, take.tracks[1].positions);
         let q0 = back.tracks[1].rotations[0].unwrap();
         assert!(q0.abs_diff_eq(DQuat::from_rotation_z(0.3), 1e-12));

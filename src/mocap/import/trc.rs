@@ -15,8 +15,8 @@
 //! ```
 //!
 //! * Cells are tab-separated (a file without tabs is split at whitespace); the data may
-//!   follow a blank line; an empty cell (or `NaN`) is a marker not seen, and a row cut
-//!   short leaves its last markers unseen.
+//!   follow a blank line; an empty cell (or `NaN`, counted in a note) is a marker not
+//!   seen, and a row cut short leaves its last markers unseen.
 //! * `DataRate` is the frame rate, Hz; `Units` the length unit (mm, cm, m); rows are
 //!   placed on the frame grid by their `Time` (s), so a missing row is a gap (noted).
 //! * `NumMarkers` must equal the number of marker column groups (name over `Xn Yn Zn`),
@@ -34,7 +34,7 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
     let profile = CaptureProfile::shipped("trc").ok_or_else(|| {
         ImportError::format(path, "TRC profile", "the shipped trc profile did not load")
     })?;
-    let (take, info) = table::read_table(path, bytes, &profile, unit)?;
+    let (mut take, info) = table::read_table(path, bytes, &profile, unit)?;
     if let Some((e, n)) = table::stated_count(path, &info.metadata, "NumMarkers")?
         && n != take.tracks.len()
     {
@@ -48,6 +48,7 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
             ),
         ));
     }
+    take.zeros_as_gaps(info.gaps);
     Ok(take)
 }
 

@@ -11,7 +11,7 @@
 //! ,,Subject:LASI,,,Subject:RASI,,,
 //! Frame,Sub Frame,X,Y,Z,X,Y,Z
 //! ,,mm,mm,mm,mm,mm,mm          ← units (mm if the row is absent)
-//! 1,0,123.4,-56.7,890.1,,,     ← empty cells: marker not seen
+//! 1,0,123.4,-56.7,890.1,,,     ← empty cells (or NaN): marker not seen
 //! …
 //!                              ← a blank line before the next section ends it
 //! Model Outputs
@@ -29,7 +29,7 @@
 
 use super::LengthUnit;
 use super::csv_text::{self, Row};
-use crate::mocap::take::{ImportError, Take, Track};
+use crate::mocap::take::{ImportError, MarkedGaps, Take, Track};
 use std::path::Path;
 
 /// Section names a Nexus CSV export uses.
@@ -68,6 +68,8 @@ struct Data {
     frames: usize,
     /// What was skipped, or where the data ended early.
     notes: Vec<String>,
+    /// The samples written as NaN.
+    gaps: MarkedGaps,
 }
 
 /// Read the `Trajectories` section of a Vicon Nexus CSV export; `unit` overrides the
@@ -134,14 +136,16 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         width,
     };
     let data = read_data(path, data, &layout, axis_row.line)?;
-    Ok(Take {
+    let mut take = Take {
         source: path.to_path_buf(),
         rate_hz,
         frames: data.frames,
         file_unit: file_unit.symbol().to_string(),
         tracks: data.tracks,
         notes: data.notes,
-    })
+    };
+    take.zeros_as_gaps(data.gaps);
+    Ok(take)
 }
 
 /// The next row, or an error saying `what` was expected after line `after`.
@@ -268,6 +272,7 @@ fn read_data<'a>(
             .collect(),
         frames: 0,
         notes: Vec::new(),
+        gaps: MarkedGaps::default(),
     };
     let mut prev_frame: Option<f64> = None;
     // Blank lines since the last data row, and those skipped between data rows.
@@ -297,7 +302,7 @@ fn read_data<'a>(
         }
         let frame = frame_number(path, &row, layout.width, prev_frame, after_blank)?;
         prev_frame = Some(frame);
-        read_row(path, &row, layout, &mut data.tracks)?;
+        read_row(path, &row, layout, &mut data.tracks, &mut data.gaps)?;
         data.frames += 1;
     }
     if data.frames == 0 {
@@ -344,17 +349,19 @@ fn frame_number(
     Ok(frame)
 }
 
-/// Append one data row's position of every trajectory to `tracks`.
+/// Append one data row's position of every trajectory to `tracks`, counting those
+/// written as NaN in `gaps`.
 fn read_row(
     path: &Path,
     row: &Row,
     layout: &Layout,
     tracks: &mut [Track],
+    gaps: &mut MarkedGaps,
 ) -> Result<(), ImportError> {
     for ((c, track), s) in layout.columns.iter().zip(tracks).zip(layout.scales) {
         track
             .positions
-            .push(csv_text::position(path, row, c.xyz, s.metres())?);
+            .push(csv_text::sample(path, row, c.xyz, s.metres(), gaps)?);
     }
     Ok(())
 }

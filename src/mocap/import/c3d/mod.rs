@@ -51,7 +51,7 @@
 mod layout;
 
 use super::LengthUnit;
-use crate::mocap::take::{ImportError, Take, Track};
+use crate::mocap::take::{ImportError, MarkedGaps, Take, Track};
 use glam::DVec3;
 use std::path::Path;
 
@@ -396,14 +396,16 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
     } else {
         info.frames
     };
-    Ok(Take {
+    let mut take = Take {
         source: path.to_path_buf(),
         rate_hz: info.rate_hz,
         frames,
         file_unit: unit.symbol().to_string(),
         tracks,
         notes,
-    })
+    };
+    take.zeros_as_gaps(MarkedGaps::default());
+    Ok(take)
 }
 
 /// The numbers the header (block 1) holds, in the file's processor format.

@@ -217,24 +217,11 @@ pub(in crate::mocap::import) fn stated_count<'m>(
     Ok(Some((e, n)))
 }
 
-/// A cell as a number: `None` for a missing value (empty, `NaN`, `-`); an error message
+/// A cell as a number: `None` for a missing value (empty, `NaN` or `-`); an error message
 /// for anything else that is not a finite number.
 pub(super) fn parse_number(cell: &str, decimal_comma: bool) -> Result<Option<f64>, String> {
-    let cell = cell.trim();
-    if cell.is_empty() || cell == "-" || cell.eq_ignore_ascii_case("nan") {
+    if cell.trim() == "-" {
         return Ok(None);
     }
-    let text = if decimal_comma {
-        std::borrow::Cow::Owned(cell.replace(',', "."))
-    } else {
-        std::borrow::Cow::Borrowed(cell)
-    };
-    match text.parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(Some(v)),
-        Ok(_) => Err(format!("expected a finite number, found \"{cell}\"")),
-        Err(_) => Err(format!(
-            "expected a number, found \"{}\"",
-            csv_text::shorten(cell)
-        )),
-    }
+    csv_text::parse_number(cell, decimal_comma)
 }

@@ -33,7 +33,7 @@ use super::profile::{
     AngleUnit, CaptureProfile, ColumnRef, Delimiter, EulerFrame, HeaderLocation, Orientation, Part,
     TimeColumn, euler_axes, spec_columns, template_parts,
 };
-use crate::mocap::take::{ImportError, Take, Track};
+use crate::mocap::take::{ImportError, MarkedGaps, Take, Track};
 use glam::{DMat3, DQuat, DVec3};
 use std::collections::HashMap;
 use std::fmt;
@@ -102,16 +102,22 @@ pub struct FoundTrack {
 /// What [`read_table`] knows besides the take, for format-specific checks.
 pub(super) struct TableInfo {
     pub metadata: Vec<MetaEntry>,
+    /// The positions written as NaN or, with `zero_is_missing`, as all zeros (gaps).
+    pub gaps: MarkedGaps,
 }
 
 /// Read a capture table as `profile` describes it; `unit` overrides every unit source.
+/// The positions written as NaN (and, with `zero_is_missing`, as zeros) are gaps,
+/// counted in a note.
 pub fn read(
     path: &Path,
     bytes: &[u8],
     profile: &CaptureProfile,
     unit: Option<LengthUnit>,
 ) -> Result<Take, ImportError> {
-    read_table(path, bytes, profile, unit).map(|(take, _)| take)
+    let (mut take, info) = read_table(path, bytes, profile, unit)?;
+    take.notes.extend(info.gaps.note());
+    Ok(take)
 }
 
 /// Lay out a capture table as `profile` finds it (delimiter, header, columns with their
@@ -146,7 +152,7 @@ pub fn inspect(
     })
 }
 
-/// [`read`], also giving the metadata and the row count.
+/// [`read`] without the gap note, also giving the metadata and the gaps to note.
 pub(super) fn read_table(
     path: &Path,
     bytes: &[u8],
@@ -177,6 +183,10 @@ pub(super) fn read_table(
     let stated = stated_rate(profile, &meta, &mut notes);
     let grid = Grid::place(path, &rows, clock.map(|c| c.1), stated, &mut notes)?;
     notes.extend(frame_count_note(path, profile, &meta, &rows, grid.frames)?);
+    let info = TableInfo {
+        metadata: meta,
+        gaps: rows.gaps,
+    };
     let take = Take {
         source: path.to_path_buf(),
         rate_hz: grid.rate_hz,
@@ -185,7 +195,6 @@ pub(super) fn read_table(
         tracks: grid.scatter(rows.tracks),
         notes,
     };
-    let info = TableInfo { metadata: meta };
     Ok((take, info))
 }
 
@@ -401,6 +410,11 @@ mod tests {
         );
         let l = take.track("Stick L tip").unwrap();
         assert_eq!(l.positions[2], None, "0 0 0 is unseen");
+        assert!(
+            noted(&take, "1 sample at exactly (0, 0, 0) read as gaps"),
+            "{:?}",
+            take.notes
+        );
         assert!(near(l.positions[3], DVec3::new(-0.25, 0.953, 0.8)));
         assert_eq!(l.positions[4], None, "frame 5 dropped");
         assert!(near(

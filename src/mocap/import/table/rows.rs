@@ -19,6 +19,8 @@ pub(super) struct Rows {
     /// The time column's values (seconds or frame numbers), if any.
     pub(super) clock: Vec<f64>,
     pub(super) tracks: Vec<Track>,
+    /// The positions written as NaN or (with `zero_is_missing`) as all zeros.
+    pub(super) gaps: MarkedGaps,
 }
 
 impl RowReader<'_> {
@@ -72,6 +74,7 @@ impl RowReader<'_> {
                 .iter()
                 .map(|t| Track::empty(t.label.clone()))
                 .collect(),
+            gaps: MarkedGaps::default(),
         };
         // Blank lines since the last data row, and those skipped between data rows.
         let mut blanks: Vec<usize> = Vec::new();
@@ -105,7 +108,7 @@ impl RowReader<'_> {
             }
             rows.lines.push(row.line);
             for ((t, out), scale) in tracks.iter().zip(&mut rows.tracks).zip(&scales.per_track) {
-                self.read_sample(row, t, *scale, out)?;
+                self.read_sample(row, t, *scale, out, &mut rows.gaps)?;
             }
         }
         if rows.lines.is_empty() {
@@ -119,15 +122,20 @@ impl RowReader<'_> {
         Ok(rows)
     }
 
-    /// Append one row's position (and rotation) of track `t` to `out`.
+    /// Append one row's position (and rotation) of track `t` to `out`; a position the
+    /// file marks unseen is counted in `gaps`.
     pub(super) fn read_sample(
         &self,
         row: &Row,
         t: &TrackCols,
         scale: [f64; 3],
         out: &mut Track,
+        gaps: &mut MarkedGaps,
     ) -> Result<(), ImportError> {
         let p = self.numbers(row, &t.position, true)?;
+        if p.is_none() {
+            self.count_marked(row, &t.position, gaps);
+        }
         out.positions
             .push(p.map(|[x, y, z]| DVec3::new(x * scale[0], y * scale[1], z * scale[2])));
         let Some(rot) = &t.rotation else {
@@ -153,6 +161,18 @@ impl RowReader<'_> {
         };
         out.rotations.push(q);
         Ok(())
+    }
+
+    /// Count a missing position the file marks unseen: a coordinate written NaN, or
+    /// (with `zero_is_missing`) all three 0. Empty cells are not counted.
+    pub(super) fn count_marked(&self, row: &Row, cols: &[usize; 3], gaps: &mut MarkedGaps) {
+        if csv_text::written_nan(row, cols) {
+            gaps.nan += 1;
+        } else if self.zero_is_missing
+            && matches!(self.numbers(row, cols, false), Ok(Some(v)) if v == [0.0; 3])
+        {
+            gaps.zero += 1;
+        }
     }
 
     pub(super) fn err(&self, row: &Row, col: usize, message: String) -> ImportError {
