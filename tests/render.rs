@@ -5,6 +5,7 @@
 
 use std::path::{Path, PathBuf};
 use timpanist::base::rng::Rng;
+use timpanist::body::control::rotation_error;
 use timpanist::body::sim::{BodyStep, Motion, SimParams};
 use timpanist::drum::ContactEvent;
 use timpanist::kit::Kit;
@@ -889,7 +890,11 @@ fn a_long_fast_passage_plays_to_the_end() {
         let joints = [timpanist::body::Joint::Neck, timpanist::body::Joint::Head];
         (a..b.min(r.motion.poses.len()))
             .flat_map(|k| joints.map(|j| r.motion.poses[k][j.index()]))
-            .map(|q| (2.0 * q.w.abs().min(1.0).acos()).to_degrees())
+            .map(|q| {
+                rotation_error(glam::DQuat::IDENTITY, q)
+                    .length()
+                    .to_degrees()
+            })
             .fold(0.0, f64::max)
     };
     let (first, last) = (turned(2.0, 12.0), turned(63.0, 73.0));

@@ -37,7 +37,8 @@ pub struct ReadError {
     pub message: String,
 }
 
-/// A recording's channels averaged to mono (samples in −1…1), with its rate, Hz.
+/// A recording's channels averaged to mono (samples in −1…1), with its rate, Hz. What
+/// [`read_mono_noted`] would note is dropped: the commands and the transcriber call that.
 pub fn read_mono(path: &Path) -> Result<(Vec<f32>, u32), ReadError> {
     read_mono_noted(path).map(|(samples, rate, _)| (samples, rate))
 }
@@ -90,33 +91,34 @@ fn finish_wav_sizes(bytes: &mut [u8]) -> Option<String> {
     let held = u32::try_from(len - (at + 8)).ok()?;
     let riff = size_at(bytes, 4);
     let riff_held = u32::try_from(len - 8).ok()?;
-    let data_unfinished = UNFINISHED_SIZES.contains(&size) && held > 0 || size > held;
-    let riff_unfinished = UNFINISHED_SIZES.contains(&riff) || riff > riff_held;
-    if !data_unfinished && !riff_unfinished {
+    let unset = |s: u32| UNFINISHED_SIZES.contains(&s);
+    let data_unset = unset(size) && held > 0;
+    let cut_short = !unset(size) && size > held;
+    let data_wrong = data_unset || size > held;
+    let riff_wrong = unset(riff) || riff > riff_held;
+    if !data_wrong && !riff_wrong {
         return None;
     }
     bytes[4..8].copy_from_slice(&riff_held.to_le_bytes());
-    if data_unfinished {
+    if data_wrong {
         bytes[at + 4..at + 8].copy_from_slice(&held.to_le_bytes());
     }
-    Some(
-        if data_unfinished && size > held && !UNFINISHED_SIZES.contains(&size) {
-            format!(
-                "the file is cut short: its header gives {size} bytes of sound, it holds {held} \
-             (read those)"
-            )
-        } else {
-            let (what, said) = if data_unfinished {
-                ("sound data", size)
-            } else {
-                ("file size", riff)
-            };
-            format!(
-                "its header was not finished (it gives the {what} as {said} bytes: a recorder \
+    let unfinished = |what: &str, said: u32| {
+        format!(
+            "its header was not finished (it gives the {what} as {said} bytes: a recorder \
              that stopped before closing the file?): read the {held} bytes of sound it holds"
-            )
-        },
-    )
+        )
+    };
+    Some(if cut_short {
+        format!(
+            "the file is cut short: its header gives {size} bytes of sound, it holds {held} \
+             (read those)"
+        )
+    } else if data_wrong {
+        unfinished("sound data", size)
+    } else {
+        unfinished("file size", riff)
+    })
 }
 
 /// [`read_mono`] of a recording held in memory (`path` names it in errors; its extension,
