@@ -191,10 +191,11 @@ pub fn transcribe(
         })
         .collect();
     // A stroke of a fast run heard by one of the run's upper partials is put back on the
-    // run's drum; a roll (the strokes notation writes as one, by their timing) takes the
-    // pitch heard over the whole roll: each stroke alone is heard through a window of
-    // 60–120 ms, whose 8–16 Hz resolution misplaces a low drum's (1,1) by a semitone or
-    // more (a recorded D2 roll's first stroke reads C♯2) or hears a partial as the (1,1).
+    // run's drum (each stroke alone is heard through a window of 60–120 ms, whose 8–16 Hz
+    // resolution misplaces a low drum's (1,1) by a semitone or more — a recorded D2
+    // roll's first stroke reads C♯2 — or hears a partial as the (1,1)); the rolls among
+    // them take their pitch once the beats are known, below.
+    let heard_alone: Vec<Option<f64>> = strokes.iter().map(|s| s.principal_hz).collect();
     for run in fast_runs(&times) {
         let span = (times[run.start], times[run.end - 1]);
         if let Some(run_hz) = notes::hear_run(samples, rate_hz, span, band) {
@@ -203,14 +204,6 @@ pub fn transcribe(
             }
         }
     }
-    for (a, b) in notate::roll_spans(&times, &|_| false) {
-        if let Some(roll_hz) = notes::hear_run(samples, rate_hz, (times[a], times[b]), band) {
-            for stroke in &mut strokes[a..=b] {
-                stroke.principal_hz = Some(roll_hz);
-            }
-        }
-    }
-
     let mut score = Score::new(options.title.as_deref().unwrap_or("Transcription"));
     score.kit = options.kit_ref.clone();
     let tpq = score.ticks_per_quarter;
@@ -239,6 +232,25 @@ pub fn transcribe(
         denominator: 4,
     }];
     let map = TempoMap::new(&score.tempo, tpq);
+    // A roll (the strokes notation writes as one, by their timing) takes the pitch heard
+    // over the whole roll, moved to where its strokes alone heard it; the note it resolves
+    // to on a beat (`notate::roll_spans`) keeps its own.
+    let levels: Vec<f64> = strokes.iter().map(|s| s.level_db).collect();
+    let on_beat =
+        |k: usize| notate::quantise(&map, tpq, times[k], None).is_multiple_of(u64::from(tpq));
+    for (a, b) in notate::roll_spans(&times, &levels, &|_| false, &on_beat) {
+        if let Some(run_hz) = notes::hear_run(samples, rate_hz, (times[a], times[b]), band) {
+            let gaps = median(times[a..=b].windows(2).map(|w| w[1] - w[0]));
+            let stroke_rate_hz = gaps.map_or(f64::NAN, |g| 1.0 / g);
+            let before_hz = (a > 0 && times[a] - times[a - 1] <= notes::RUN_WINDOW_S)
+                .then(|| heard_alone[a - 1])
+                .flatten();
+            let roll_hz = notes::roll_pitch(run_hz, &heard_alone[a..=b], stroke_rate_hz, before_hz);
+            for stroke in &mut strokes[a..=b] {
+                stroke.principal_hz = Some(roll_hz);
+            }
+        }
+    }
 
     let shift = match options.levels {
         Levels::Absolute => 0.0,

@@ -21,6 +21,10 @@ const ROLL_EVENNESS: f64 = 0.35;
 /// A close run that is not even as a whole may still hold a roll with this many strokes
 /// left out at either end.
 const ROLL_TRIM: usize = 2;
+/// A roll's last stroke at least this much louder than the roll's other strokes (their
+/// median) is the note the roll resolves to, dB: an accent or a chord the roll is tied to,
+/// struck at the roll's own pace.
+const RESOLUTION_DB: f64 = 6.0;
 
 /// One stroke as heard: when, which pitches (two for a chord), how much energy it added.
 #[derive(Clone, Debug, PartialEq)]
@@ -40,6 +44,8 @@ pub struct Placed {
     /// (drum, pitch) per drum struck.
     pub drums: Vec<(usize, Pitch)>,
     pub dynamic: Dynamic,
+    /// Added energy, dB re a full-scale sine (the stroke's [`Stroke::level_db`]).
+    pub level_db: f64,
 }
 
 /// What notation decided that the user should hear about.
@@ -193,26 +199,38 @@ pub fn place(
             tick,
             drums,
             dynamic: dynamic_for(s.level_db, &marks_db(pitch)),
+            level_db: s.level_db,
         });
     }
     (placed, notes)
 }
 
 /// Runs of strokes to write as rolls: (first, last) index, inclusive ([`roll_spans`] of
-/// their times, a chord ending a run).
-pub fn roll_runs(placed: &[Placed]) -> Vec<(usize, usize)> {
+/// their times and levels, a chord ending a run, a beat every `tpq` ticks).
+pub fn roll_runs(placed: &[Placed], tpq: u32) -> Vec<(usize, usize)> {
     let times: Vec<f64> = placed.iter().map(|p| p.time_s).collect();
-    roll_spans(&times, &|k| placed[k].drums.len() > 1)
+    let levels: Vec<f64> = placed.iter().map(|p| p.level_db).collect();
+    roll_spans(&times, &levels, &|k| placed[k].drums.len() > 1, &|k| {
+        placed[k].tick.is_multiple_of(u64::from(tpq))
+    })
 }
 
-/// Which strokes at `times` (s, sorted) are rolls: (first, last) index, inclusive, a
-/// stroke for which `chord` holds ending a run. Judged by timing alone — inside a roll
-/// each stroke adds little to a head already ringing, so its own pitch is unreliable —
-/// a roll is written on one drum, at the pitch heard over the whole roll. Two runs one
-/// missed stroke apart (at the pace of both) are one roll: a roll's soft strokes can
-/// fall under the onset detector, and each half would otherwise be written on the drum
-/// its own first stroke was heard on.
-pub fn roll_spans(times: &[f64], chord: &dyn Fn(usize) -> bool) -> Vec<(usize, usize)> {
+/// Which strokes at `times` (s, sorted; their added energies `levels`, dB) are rolls:
+/// (first, last) index, inclusive, a stroke for which `chord` holds ending a run. Judged
+/// by timing — inside a roll each stroke adds little to a head already ringing, so its
+/// own pitch is unreliable — a roll is written on one drum, at the pitch heard over the
+/// whole roll. Two runs one missed stroke apart (at the pace of both) are one roll: a
+/// roll's soft strokes can fall under the onset detector, and each half would otherwise
+/// be written on the drum its own first stroke was heard on. A roll's last stroke that is
+/// the note it resolves to ([`resolves`]; `on_beat` says which strokes fall on a beat)
+/// is left out of it: a half-note roll tied to an accent, its strokes at the roll's own
+/// pace, was written one stroke longer and the accent lost, and a final chord with it.
+pub fn roll_spans(
+    times: &[f64],
+    levels: &[f64],
+    chord: &dyn Fn(usize) -> bool,
+    on_beat: &dyn Fn(usize) -> bool,
+) -> Vec<(usize, usize)> {
     let mut runs: Vec<(usize, usize)> = Vec::new();
     let mut i = 0;
     while i < times.len() {
@@ -233,8 +251,28 @@ pub fn roll_spans(times: &[f64], chord: &dyn Fn(usize) -> bool) -> Vec<(usize, u
     for r in 0..runs.len() {
         let floor = if r == 0 { 0 } else { runs[r - 1].1 + 1 };
         runs[r].0 = extended_back(times, runs[r], floor, chord);
+        if resolves(levels, runs[r], on_beat(runs[r].1)) {
+            runs[r].1 -= 1;
+        }
     }
     runs
+}
+
+/// Whether the last stroke of the roll `run` is the note it resolves to, the roll keeping
+/// [`ROLL_MIN_STROKES`] without it: struck on a beat (`on_beat`) no softer than the roll's
+/// strokes (their median added energy, from `levels`), or anywhere [`RESOLUTION_DB`]
+/// louder. A roll's strokes fill its length up to, not at, the beat it ends on; a stroke
+/// on that beat is the tied note, an accent added to a ringing head by less than its own
+/// dynamic says (a rendered f accent after a p roll: +3 dB).
+fn resolves(levels: &[f64], (a, b): (usize, usize), on_beat: bool) -> bool {
+    if b - a < ROLL_MIN_STROKES {
+        return false;
+    }
+    let mut roll = levels[a..b].to_vec();
+    roll.sort_by(f64::total_cmp);
+    let median = roll[roll.len() / 2];
+    let margin = if on_beat { 0.0 } else { RESOLUTION_DB };
+    levels[b] >= median + margin
 }
 
 /// Where the roll `run` of `times` starts once the strokes before it that keep its pace
@@ -373,7 +411,7 @@ pub fn roll_of(run: &[Placed], tpq: u32) -> (u64, Roll) {
 /// of each other stroke; the pitch written on the beats of a drum retuned somewhere
 /// (`tuning::drop_needless_pitches`).
 pub fn beats(placed: &[Placed], kit: &Kit, tpq: u32) -> (Vec<Beat>, usize) {
-    let runs = roll_runs(placed);
+    let runs = roll_runs(placed, tpq);
     let mut beats = Vec::new();
     let mut i = 0;
     let mut run = runs.iter().peekable();
@@ -432,6 +470,7 @@ mod tests {
             tick: quantise(m, 960, t, None),
             drums: vec![drum],
             dynamic,
+            level_db: -30.0,
         }
     }
 
@@ -475,7 +514,7 @@ mod tests {
         let placed: Vec<Placed> = (0..10)
             .map(|k| stroke_at(&m, 1.0 + f64::from(k) * 0.0625, (1, Pitch(45)), Dynamic::P))
             .collect();
-        assert_eq!(roll_runs(&placed), vec![(0, 9)]);
+        assert_eq!(roll_runs(&placed, 960), vec![(0, 9)]);
         let (tick, roll) = roll_of(&placed, 960);
         assert_eq!(tick, 960);
         assert_eq!(roll.strokes_per_quarter, 16);
@@ -491,7 +530,7 @@ mod tests {
                 ..p.clone()
             })
             .collect();
-        assert!(roll_runs(&uneven).is_empty());
+        assert!(roll_runs(&uneven, 960).is_empty());
     }
 
     /// A roll of 30 strokes, eighths of a quarter at 96 bpm, whose 12th stroke the onsets
@@ -511,10 +550,11 @@ mod tests {
                     (1, Pitch(52))
                 }],
                 dynamic: Dynamic::Pp,
+                level_db: -40.0,
             }
         };
         let placed: Vec<Placed> = (0..30).filter(|&k| k != 11).map(stroke).collect();
-        assert_eq!(roll_runs(&placed), vec![(0, 28)]);
+        assert_eq!(roll_runs(&placed, 960), vec![(0, 28)]);
         let (beats, rolls) = beats(&placed, &Kit::standard(), 960);
         assert_eq!((beats.len(), rolls), (1, 1));
         assert_eq!(beats[0].drum, 0);
@@ -527,7 +567,7 @@ mod tests {
             .filter(|&k| k != 11 && k != 12)
             .map(stroke)
             .collect();
-        assert_eq!(roll_runs(&rest), vec![(0, 10), (11, 27)]);
+        assert_eq!(roll_runs(&rest, 960), vec![(0, 10), (11, 27)]);
     }
 
     /// Twelve strokes a tenth of a second apart (sixths of a quarter at 100 bpm) with a
@@ -540,7 +580,7 @@ mod tests {
         let at = |t: f64| stroke_at(&m, t, (1, Pitch(45)), Dynamic::P);
         let mut placed: Vec<Placed> = (0..12).map(|k| at(0.6 + f64::from(k) * 0.1)).collect();
         placed.push(at(0.6 + 1.1 + 0.05));
-        assert_eq!(roll_runs(&placed), vec![(0, 11)]);
+        assert_eq!(roll_runs(&placed, 960), vec![(0, 11)]);
         let (beats, rolls) = beats(&placed, &Kit::standard(), 960);
         assert_eq!((beats.len(), rolls), (2, 1));
         assert!(beats[1].roll.is_none());
@@ -568,9 +608,47 @@ mod tests {
                 )
             })
             .collect();
-        assert_eq!(roll_runs(&placed), vec![(0, 13)]);
+        assert_eq!(roll_runs(&placed, 960), vec![(0, 13)]);
         let (tick, roll) = roll_of(&placed, 960);
         assert_eq!((tick, roll.strokes_per_quarter), (1920, 8));
         assert_eq!(roll.length_ticks, 15 * 120);
+    }
+
+    /// A half-note roll at 96 bpm (16 strokes, eighths of a quarter) tied to a note on the
+    /// next beat at the roll's own pace: the roll ends before it and the note is a beat of
+    /// its own when it is no softer than the roll (an accent over a ringing head added 3
+    /// dB), or 6 dB louder off the beat; a stroke dying away on the beat, or 3 dB louder
+    /// off it, stays in the roll.
+    #[test]
+    fn a_roll_ends_before_the_note_it_resolves_to() {
+        let m = map(96.0);
+        let roll_with_last = |last_db: f64, late_s: f64| -> Vec<Placed> {
+            (0..17)
+                .map(|k| {
+                    let t = 1.25 + f64::from(k) * 0.078125 + if k == 16 { late_s } else { 0.0 };
+                    Placed {
+                        level_db: if k == 16 {
+                            last_db
+                        } else {
+                            -24.0 + f64::from(k % 3)
+                        },
+                        ..stroke_at(&m, t, (1, Pitch(50)), Dynamic::P)
+                    }
+                })
+                .collect()
+        };
+        let on_beat = roll_with_last(-20.0, 0.0);
+        assert_eq!(on_beat[16].tick, 4 * 960);
+        assert_eq!(roll_runs(&on_beat, 960), vec![(0, 15)]);
+        let (beats, rolls) = beats(&on_beat, &Kit::standard(), 960);
+        assert_eq!((beats.len(), rolls), (2, 1));
+        assert_eq!(beats[0].roll.map(|r| r.length_ticks), Some(1920));
+        assert_eq!((beats[1].tick, beats[1].roll), (4 * 960, None));
+        assert_eq!(roll_runs(&roll_with_last(-27.0, 0.0), 960), vec![(0, 16)]);
+        // The same strokes a third of a step late: off the beat.
+        let off = roll_with_last(-20.0, 0.026);
+        assert_ne!(off[16].tick % 960, 0);
+        assert_eq!(roll_runs(&off, 960), vec![(0, 16)]);
+        assert_eq!(roll_runs(&roll_with_last(-16.0, 0.026), 960), vec![(0, 15)]);
     }
 }

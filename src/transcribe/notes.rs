@@ -62,7 +62,7 @@ pub const RUN_STROKES: usize = 4;
 /// (1,1) low, see [`hear_run`]).
 const RUN_LOWER: (f64, f64) = (0.1, 0.4);
 /// The longest span of a run heard as a whole, s.
-const RUN_WINDOW_S: f64 = 1.0;
+pub const RUN_WINDOW_S: f64 = 1.0;
 
 /// The (1,1) of a run of close strokes (a roll) from `first_s` to `last_s` (onsets, s),
 /// heard over the whole run: a roll struck evenly can meet the drum's own (1,1) in
@@ -93,6 +93,9 @@ pub fn hear_run(
 /// its run's drum to be heard as that drum: a stroke of a roll is heard through a window of
 /// 60–80 ms, whose 12–16 Hz resolution reads a 166 Hz partial anywhere in 154–171 Hz.
 const RUN_PARTIAL_TOLERANCE: f64 = 0.08;
+/// A roll's (1,1) within this share of its stroke rate from a multiple of it may be a line
+/// of the roll's comb ([`roll_pitch`]).
+const COMB_LINE_SHARE: f64 = 0.15;
 
 /// `heard` (a stroke's (1,1), Hz) put back on the run's (1,1) `run_hz` when it is one of
 /// that drum's upper partials (within [`RUN_PARTIAL_TOLERANCE`] of a kettledrum ratio
@@ -109,6 +112,100 @@ pub fn onto_run(heard: Option<f64>, run_hz: f64) -> Option<f64> {
         }
         other => other,
     }
+}
+
+/// A roll's (1,1): the one heard over the whole roll (`run_hz`, [`hear_run`]) checked
+/// against its strokes' own (1,1)s (`strokes_hz`), each heard between two strokes, where
+/// the head rings at its own frequencies.
+///
+/// - **Another drum ringing under the roll**: when `run_hz` is the pitch of the stroke
+///   just before the roll (`before_hz`: that drum may be what the roll's spectrum holds
+///   most) and a third of the strokes or more are heard at no partial of it (within
+///   [`RUN_PARTIAL_TOLERANCE`]), the pitch that
+///   heard as their (1,1) or (2,1) by most strokes is the roll's, if by more than half of
+///   them (the rendered
+///   D3 roll after a bar of A2 and D3 on the pair kit was heard over the whole roll as the
+///   A2 ringing under it: 110 Hz, while its strokes read 142–154 Hz and the D3's (2,1)).
+/// - **A line of its comb**: a roll struck evenly at `stroke_rate_hz` sounds as lines at
+///   the multiples of that rate, each weighted by the head's resonances, so the whole
+///   roll's spectrum can read the (1,1) on the line nearest it, up to half the rate off (the
+///   same roll on the standard kit read 154.4 Hz, the 12th line at 12.8 strokes a second:
+///   E♭3). When `run_hz` is within [`COMB_LINE_SHARE`] of a spacing from a line, it moves
+///   to the strokes it explains.
+///
+/// Either way the roll's (1,1) is then the median of the strokes it explains, taken back to
+/// the (1,1) (twice: about that median again), if they are a third of the strokes or
+/// more; else `run_hz`. A roll played by
+/// hand, a few per cent uneven, smears its comb, and a low drum's strokes alone are heard
+/// too coarsely to move it (refining every roll so put 4 of the 36 recorded rolls of
+/// `tests/transcribe.rs` a semitone off; letting the strokes overrule a roll with nothing
+/// before it put 4 recorded G2 rolls on E3 and A2, their strokes heard at 150–165 Hz).
+pub fn roll_pitch(
+    run_hz: f64,
+    strokes_hz: &[Option<f64>],
+    stroke_rate_hz: f64,
+    before_hz: Option<f64>,
+) -> f64 {
+    let heard: Vec<f64> = strokes_hz.iter().flatten().copied().collect();
+    let n = strokes_hz.len();
+    let explained =
+        |c: f64| -> Vec<f64> { heard.iter().filter_map(|&f| as_principal(c, f)).collect() };
+    let unexplained: Vec<f64> = heard
+        .iter()
+        .copied()
+        .filter(|&f| as_principal(run_hz, f).is_none())
+        .collect();
+    // Strokes alone are heard at their (1,1) or their (2,1); counting the higher partials
+    // too, a drum an octave or a twelfth lower would explain as many.
+    let first_two = &KETTLEDRUM_RATIOS[..2];
+    let explains = |c: f64| {
+        (heard.iter())
+            .filter(|&&f| {
+                first_two
+                    .iter()
+                    .any(|r| (f / (r * c) - 1.0).abs() <= RUN_PARTIAL_TOLERANCE)
+            })
+            .count()
+    };
+    let ringing_before =
+        before_hz.is_some_and(|f| (run_hz / f - 1.0).abs() <= RUN_PARTIAL_TOLERANCE);
+    let other = (ringing_before && 3 * unexplained.len() >= n)
+        .then(|| {
+            (unexplained.iter())
+                .flat_map(|f| first_two.iter().map(move |r| f / r))
+                .map(|c| (c, explains(c)))
+                .max_by(|a, b| a.1.cmp(&b.1).then(a.0.total_cmp(&b.0)))
+                .filter(|&(_, count)| 2 * count > n)
+        })
+        .flatten();
+    let lines = run_hz / stroke_rate_hz;
+    let on_a_line = stroke_rate_hz.is_finite() && (lines - lines.round()).abs() <= COMB_LINE_SHARE;
+    let centre = match other {
+        Some((c, _)) => c,
+        None if on_a_line => run_hz,
+        None => return run_hz,
+    };
+    // The median of the strokes it explains, taken again about that median (a centre half
+    // a comb line off takes in strokes heard on another drum ringing a semitone beyond).
+    let mut centre = centre;
+    for _ in 0..2 {
+        let mut near = explained(centre);
+        if 3 * near.len() < n {
+            return run_hz;
+        }
+        near.sort_by(f64::total_cmp);
+        centre = near[near.len() / 2];
+    }
+    centre
+}
+
+/// `f` taken back to the (1,1) of a drum whose (1,1) is `c`, when it is within
+/// [`RUN_PARTIAL_TOLERANCE`] of one of that drum's partials.
+fn as_principal(c: f64, f: f64) -> Option<f64> {
+    KETTLEDRUM_RATIOS
+        .iter()
+        .map(|r| f / r)
+        .find(|p| (p / c - 1.0).abs() <= RUN_PARTIAL_TOLERANCE)
 }
 
 /// The stroke's (1,1), Hz: among the frequencies that would put one of their kettledrum
@@ -315,5 +412,35 @@ mod tests {
         note(&mut soft, rate, 0.1, 110.0, 0.2);
         let d = added_level_db(&loud, rate, 0.1) - added_level_db(&soft, rate, 0.1);
         assert!((d - 6.02).abs() < 0.1, "{d}");
+    }
+
+    /// The rendered D3 roll's strokes (142–154 Hz at its (1,1), 211–230 Hz at its (2,1),
+    /// 161–166 Hz where the A2 rang): heard over the whole roll on a line of its comb
+    /// (154.4 Hz at 12.74 strokes a second) it moves to its strokes' median; heard as the
+    /// A2 that was struck just before it, the strokes overrule it, but not with nothing
+    /// before the roll; off the comb's lines and with its strokes, it stays.
+    #[test]
+    fn a_roll_takes_the_pitch_its_strokes_hear() {
+        let heard: Vec<Option<f64>> = [
+            151.0, 230.0, 150.0, 166.0, 212.0, 161.0, 142.0, 154.0, 151.0, 221.0, 148.0, 212.0,
+            145.0, 218.0, 146.0,
+        ]
+        .iter()
+        .map(|&f| Some(f))
+        .chain([None])
+        .collect();
+        let d3 = |f: f64| (f / 148.4 - 1.0).abs() < 0.015;
+        let comb = roll_pitch(154.4, &heard, 12.74, None);
+        assert!(d3(comb), "{comb}");
+        let over_a2 = roll_pitch(110.1, &heard, 12.74, Some(110.0));
+        assert!(d3(over_a2), "{over_a2}");
+        assert_eq!(roll_pitch(110.1, &heard, 12.74, None), 110.1);
+        assert_eq!(roll_pitch(110.1, &heard, 12.74, Some(147.0)), 110.1);
+        // An A2 roll heard at its (1,1) and (2,1) off the comb's lines keeps its pitch.
+        let a2: Vec<Option<f64>> = [110.0, 108.0, 166.0, 111.0, 168.0, 113.0]
+            .iter()
+            .map(|&f| Some(f))
+            .collect();
+        assert_eq!(roll_pitch(111.2, &a2, 12.82, Some(110.0)), 111.2);
     }
 }
