@@ -815,6 +815,189 @@ fn vicon_blank_lines_inside_the_trajectories_are_skipped_with_a_note() {
     );
 }
 
+// ---------------------------------------------------------- sweep: blank lines, Motive, CSV
+
+/// `text` with `inserts` put before the lines they name (1-based, in the original).
+fn insert_lines(text: &str, inserts: &[(usize, &str)]) -> String {
+    let mut out = String::new();
+    for (i, line) in text.lines().enumerate() {
+        for (at, insert) in inserts {
+            if *at == i + 1 {
+                out.push_str(insert);
+            }
+        }
+        out.push_str(line);
+        out.push('\n');
+    }
+    out
+}
+
+/// Whether `a` and `b` hold the same samples (rotations to 1e-12).
+fn same_samples(a: &Take, b: &Take) -> bool {
+    a.labels() == b.labels()
+        && a.frames == b.frames
+        && a.tracks.iter().zip(&b.tracks).all(|(ta, tb)| {
+            ta.positions == tb.positions
+                && ta.rotations.len() == tb.rotations.len()
+                && ta
+                    .rotations
+                    .iter()
+                    .zip(&tb.rotations)
+                    .all(|(x, y)| match (x, y) {
+                        (Some(x), Some(y)) => x.abs_diff_eq(*y, 1e-12),
+                        _ => x == y,
+                    })
+        })
+}
+
+/// The take's note on blank lines inside the data, if any.
+fn blank_note(take: &Take) -> Option<&str> {
+    take.notes
+        .iter()
+        .map(String::as_str)
+        .find(|n| n.contains("blank line"))
+}
+
+/// Check that `text` (LF line endings, blank lines inside its data) reads, with LF or
+/// CRLF endings and with more blank lines at the end, as `want` with the blank-line
+/// `note`.
+fn reads_as_without_blank_lines(
+    read: &dyn Fn(&str) -> Result<Take, ImportError>,
+    text: &str,
+    want: &Take,
+    note: &str,
+) {
+    for (case, text) in [
+        ("LF", text.to_string()),
+        ("CRLF", text.replace('\n', "\r\n")),
+        ("and at the end", format!("{text}\n,,,\r\n \n")),
+    ] {
+        let take = read(&text).unwrap_or_else(|e| panic!("{case}: {e}"));
+        assert!(same_samples(&take, want), "{case}");
+        assert_eq!(blank_note(&take), Some(note), "{case}");
+    }
+}
+
+/// A blank line inside the data of a Motive or plain CSV export (hand-edited, or two
+/// exports pasted together) is skipped with a note naming it, as in Vicon: the take is
+/// the one without it. Lines of commas or spaces count as blank; CRLF endings and other
+/// units read alike; blank lines at the end say nothing; rows after a blank line that do
+/// not run on in time are refused naming the line and the blank line.
+#[test]
+fn blank_lines_inside_motive_and_plain_csv_data_are_skipped_with_a_note() {
+    let path = fixture("motive/timpani_roll_250hz.csv");
+    let motive = std::fs::read_to_string(&path).unwrap();
+    let read_motive =
+        |text: &str| import::read_bytes(Path::new("roll.csv"), text.as_bytes(), Format::Motive);
+    let original = read_motive(&motive).unwrap();
+    assert_eq!(blank_note(&original), None);
+    // The first data row (frame 0) and the rows of frames 20 and 35.
+    let row = |f: usize| line_of(&motive, &format!("{f},0."));
+    let commas = ",".repeat(40) + "\n";
+    let inserts = [
+        (row(20), "\n"),
+        (row(35), commas.as_str()),
+        (row(35), " \t \n"),
+    ];
+    let blank = insert_lines(&motive, &inserts);
+    let (b20, b35) = (row(20), row(35) + 1);
+    let note = format!(
+        "3 blank lines inside the data were skipped (lines {b20}, {b35}, {}): the rows after \
+         them continue the frames above",
+        b35 + 1
+    );
+    reads_as_without_blank_lines(&read_motive, &blank, &original, &note);
+    // In millimetres.
+    let mm = |t: &str| t.replacen("Length Units,Meters", "Length Units,Millimeters", 1);
+    let take = read_motive(&mm(&blank)).unwrap();
+    assert_eq!(take.file_unit, "mm");
+    assert!(same_samples(&take, &read_motive(&mm(&motive)).unwrap()));
+    assert_eq!(blank_note(&take), Some(note.as_str()));
+    // A blank line at the end only, or between the header and the data, says nothing.
+    for text in [
+        motive.clone() + "\n\n",
+        insert_lines(&motive, &[(row(0), "\n")]),
+    ] {
+        let take = read_motive(&text).unwrap();
+        assert!(same_samples(&take, &original));
+        assert_eq!(blank_note(&take), None);
+    }
+    // A second export pasted after a blank line: its times start again.
+    let frames: Vec<&str> = motive.lines().skip(row(0) - 1).collect();
+    let pasted = format!("{motive}\n{}\n", frames[..10].join("\n"));
+    let e = read_motive(&pasted).unwrap_err().to_string();
+    let at = motive.lines().count() + 2;
+    assert!(
+        e.contains(&format!(
+            "roll.csv: line {at}, column 2: expected a time step of 0.004000 s"
+        )) && e.contains(&format!(
+            "(the rows after the blank line {} do not run on from those above it)",
+            at - 1
+        )),
+        "{e}"
+    );
+
+    // Plain CSV: our own export of the same take, blank lines put in by hand.
+    let csv = plain_csv::write(&original);
+    let read_csv =
+        |text: &str| import::read_bytes(Path::new("roll.csv"), text.as_bytes(), Format::Csv);
+    let written = read_csv(&csv).unwrap();
+    let blank = insert_lines(&csv, &[(12, "\n\n"), (40, ",,,,\n")]);
+    reads_as_without_blank_lines(
+        &read_csv,
+        &blank,
+        &written,
+        "3 blank lines inside the data were skipped (lines 12, 13, 42): the rows after them \
+         continue the frames above",
+    );
+    // Centimetres, and a take split in two files pasted together with a blank line
+    // between (its times running on).
+    let cm = "time_s,StickR:Tip_x,StickR:Tip_y,StickR:Tip_z\n\
+              0.000,31.2,-4.0,88.4\n0.005,31.3,-4.1,87.9\n0.010,31.3,-4.1,87.1\n\
+              \n0.015,31.4,-4.2,86.0\n0.020,31.4,-4.2,84.6\n";
+    let cm_unit = Some(import::LengthUnit::Centimetre);
+    let take =
+        import::read_bytes_with_unit(Path::new("cm.csv"), cm.as_bytes(), Format::Csv, cm_unit)
+            .unwrap();
+    assert_eq!(take.frames, 5);
+    assert!((take.rate_hz - 200.0).abs() < 1e-9);
+    assert_near(
+        take.tracks[0].positions[3].unwrap(),
+        DVec3::new(0.314, -0.042, 0.86),
+        1e-12,
+    );
+    assert!(
+        blank_note(&take)
+            .is_some_and(|n| n.starts_with("1 blank line inside the data was skipped (line 5)")),
+        "{:?}",
+        take.notes
+    );
+    // The second file's times start again, or frames are missing across the blank line.
+    for (tail, want) in [
+        (
+            "\n0.000,31.2,-4.0,88.4\n0.005,31.3,-4.1,87.9\n",
+            "line 6, column 1: expected a time after the previous row's 0.01 s, found 0 s",
+        ),
+        (
+            "\n0.100,31.2,-4.0,88.4\n0.105,31.3,-4.1,87.9\n",
+            "line 6, column 1: expected a uniform time step of 0.005",
+        ),
+    ] {
+        let text = format!(
+            "time_s,StickR:Tip_x,StickR:Tip_y,StickR:Tip_z\n\
+             0.000,31.2,-4.0,88.4\n0.005,31.3,-4.1,87.9\n0.010,31.3,-4.1,87.1\n{tail}"
+        );
+        let e = read_csv(&text).unwrap_err().to_string();
+        assert!(
+            e.contains(want)
+                && e.ends_with(
+                    "(the rows after the blank line 5 do not run on from those above it)"
+                ),
+            "{e}"
+        );
+    }
+}
+
 // ---------------------------------------------------------------- sweep: Qualisys truncated
 
 /// A QTM 3D TSV export at 200 Hz whose header says `stated` frames, holding `rows` rows of

@@ -100,26 +100,79 @@ fn windows_1252(b: u8) -> char {
     }
 }
 
-/// The data rows of `rows`: blank lines at the end are skipped, a blank line followed by
-/// more data is an error naming its line.
-pub(super) fn data_rows<'a>(
-    path: &'a Path,
-    rows: impl Iterator<Item = Row<'a>> + 'a,
-) -> impl Iterator<Item = Result<Row<'a>, ImportError>> + 'a {
-    let mut blank_at: Option<usize> = None;
-    rows.filter_map(move |row| {
-        if row.is_blank() {
-            blank_at.get_or_insert(row.line);
-            return None;
+/// The blank lines among a section's data rows (lines with nothing, or only commas and
+/// spaces). Those between two data rows are inside the data: skipped, and counted in a
+/// note naming them. Those before the first data row or after the last are not.
+#[derive(Debug, Default)]
+pub(super) struct BlankLines {
+    /// Blank lines since the last data row.
+    pending: Vec<usize>,
+    /// Blank lines inside the data, in order.
+    inside: Vec<usize>,
+    /// Each run of blank lines inside the data: its first line and the data row after it.
+    runs: Vec<(usize, usize)>,
+    /// Whether a data row has been taken.
+    seen_data: bool,
+}
+
+impl BlankLines {
+    /// Whether `row` is blank; if so it is remembered (and to be skipped).
+    pub fn skip(&mut self, row: &Row) -> bool {
+        let blank = row.is_blank();
+        if blank {
+            self.pending.push(row.line);
         }
-        Some(match blank_at {
-            Some(b) => Err(ImportError::format(
-                path,
-                format!("line {b}"),
-                "expected a data row, found a blank line inside the data",
-            )),
-            None => Ok(row),
-        })
+        blank
+    }
+
+    /// Whether `row` is a data row, for a reader that takes every line that is not blank
+    /// as one: a blank one is remembered ([`BlankLines::skip`]), a data row taken
+    /// ([`BlankLines::data_row`]).
+    pub fn is_data(&mut self, row: &Row) -> bool {
+        if self.skip(row) {
+            return false;
+        }
+        self.data_row(row.line);
+        true
+    }
+
+    /// The first of the blank lines since the last data row, if any.
+    pub fn pending(&self) -> Option<usize> {
+        self.pending.first().copied()
+    }
+
+    /// A data row on `line` is taken: the blank lines just before it are inside the data,
+    /// unless it is the first.
+    pub fn data_row(&mut self, line: usize) {
+        if let Some(&first) = self.pending.first()
+            && self.seen_data
+        {
+            self.runs.push((first, line));
+            self.inside.append(&mut self.pending);
+        }
+        self.pending.clear();
+        self.seen_data = true;
+    }
+
+    /// The first of the blank lines skipped just before the data row on `line`, if any.
+    pub fn run_before(&self, line: usize) -> Option<usize> {
+        self.runs
+            .binary_search_by_key(&line, |&(_, row)| row)
+            .ok()
+            .map(|i| self.runs[i].0)
+    }
+
+    /// The note for the blank lines inside `what` ("the data"), if there were any.
+    pub fn note(&self, what: &str) -> Option<String> {
+        blank_lines_note(&self.inside, what)
+    }
+}
+
+/// What to add to an error about a data row that does not follow on from the row above
+/// it: the first of the blank lines between them, if any ([`BlankLines::run_before`]).
+pub(super) fn not_run_on(blank: Option<usize>) -> String {
+    blank.map_or(String::new(), |b| {
+        format!(" (the rows after the blank line {b} do not run on from those above it)")
     })
 }
 
@@ -173,7 +226,7 @@ pub(super) fn is_number(cell: &str) -> bool {
 
 /// The note for blank `lines` skipped between the data rows of `what` ("the data"):
 /// how many, and which (the first five).
-pub(super) fn blank_lines_note(lines: &[usize], what: &str) -> Option<String> {
+fn blank_lines_note(lines: &[usize], what: &str) -> Option<String> {
     const SHOWN: usize = 5;
     let n = lines.len();
     if n == 0 {
@@ -394,6 +447,36 @@ mod tests {
         assert!(required_number(p, &r, 2, "time").is_err());
         assert!(position(p, &r, [0, 2, 2], 1.0).is_err());
         assert_eq!(position(p, &r, [2, 2, 2], 1.0).unwrap(), None);
+    }
+
+    #[test]
+    fn blank_lines_between_data_rows_are_named_not_those_before_or_after() {
+        let text = "\n1,2\n\n ,\t,\n3,4\n5,6\n,,\n";
+        let mut blanks = BlankLines::default();
+        let data: Vec<usize> = rows(text)
+            .filter(|r| blanks.is_data(r))
+            .map(|r| r.line)
+            .collect();
+        assert_eq!(data, [2, 5, 6]);
+        assert_eq!(
+            [2, 5, 6].map(|line| blanks.run_before(line)),
+            [None, Some(3), None]
+        );
+        assert_eq!(blanks.pending(), Some(7), "the blank line at the end");
+        assert_eq!(
+            blanks.note("the data").unwrap(),
+            "2 blank lines inside the data were skipped (lines 3, 4): the rows after them \
+             continue the frames above"
+        );
+        let many = format!("1\n{}2\n", "\n".repeat(7));
+        let mut blanks = BlankLines::default();
+        assert_eq!(rows(&many).filter(|r| blanks.is_data(r)).count(), 2);
+        assert_eq!(
+            blanks.note("the data").unwrap(),
+            "7 blank lines inside the data were skipped (lines 2, 3, 4, 5, 6, …): the rows \
+             after them continue the frames above"
+        );
+        assert_eq!(BlankLines::default().note("the data"), None);
     }
 
     #[test]

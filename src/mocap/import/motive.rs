@@ -33,6 +33,9 @@
 //! * Data rows: frame, time in seconds, then values; an empty cell is a missing sample,
 //!   and so is a position or rotation with a cell written `NaN` (counted in a note).
 //!   The time step must match the rate to 1 %.
+//! * Blank lines (nothing, or only commas and spaces) between data rows, as hand-edited or
+//!   concatenated exports have, are skipped and named in a note; the rows after them must
+//!   still run on in time. Blank lines at the end are ignored.
 
 use super::LengthUnit;
 use super::csv_text::{self, Row};
@@ -101,16 +104,8 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         .max(header.iter().map(Row::used_width).max().unwrap_or(0));
     let entities = group_columns(path, &head, &frame_row, width)?;
     check_entities(path, &entities, &head, &meta)?;
-    let mut gaps = MarkedGaps::default();
-    let (tracks, frames) = read_data(
-        path,
-        rows,
-        &entities,
-        width,
-        &meta,
-        frame_row.line,
-        &mut gaps,
-    )?;
+    let data = read_data(path, rows, &entities, width, &meta, frame_row.line)?;
+    let frames = data.frames;
     if let Some(n) = meta.total_frames.filter(|&n| n != frames) {
         return Err(ImportError::format(
             path,
@@ -126,10 +121,10 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         rate_hz: meta.rate_hz,
         frames,
         file_unit: meta.unit.symbol().to_string(),
-        tracks,
-        notes: Vec::new(),
+        tracks: data.tracks,
+        notes: data.blanks.note("the data").into_iter().collect(),
     };
-    take.zeros_as_gaps(gaps);
+    take.zeros_as_gaps(data.gaps);
     Ok(take)
 }
 
@@ -398,9 +393,21 @@ fn intrinsic(order: [usize; 3], degrees: glam::DVec3) -> glam::DQuat {
         .normalize()
 }
 
+/// The data rows as read.
+struct Data {
+    /// One track per entity.
+    tracks: Vec<Track>,
+    /// The number of frames (1 or more).
+    frames: usize,
+    /// The positions written as NaN.
+    gaps: MarkedGaps,
+    /// The blank lines skipped.
+    blanks: csv_text::BlankLines,
+}
+
 /// Read the data rows after the `Frame` row (line `frame_line`) into one track per
-/// entity, checking the time step against the rate and counting the positions written
-/// as NaN in `gaps`; also the number of frames (1 or more).
+/// entity, checking the time step against the rate, counting the positions written as
+/// NaN and the blank lines skipped.
 fn read_data<'a>(
     path: &'a Path,
     rows: impl Iterator<Item = Row<'a>> + 'a,
@@ -408,20 +415,23 @@ fn read_data<'a>(
     width: usize,
     meta: &Meta,
     frame_line: usize,
-    gaps: &mut MarkedGaps,
-) -> Result<(Vec<Track>, usize), ImportError> {
+) -> Result<Data, ImportError> {
     let labels = unique_labels(entities);
     let mut tracks: Vec<Track> = entities
         .iter()
         .zip(labels)
         .map(|(_, label)| Track::empty(label))
         .collect();
+    let mut gaps = MarkedGaps::default();
+    let mut blanks = csv_text::BlankLines::default();
     let (rate_hz, scale) = (meta.rate_hz, meta.unit.metres());
     let step = 1.0 / rate_hz;
     let mut prev_time: Option<f64> = None;
     let mut frames = 0usize;
-    for row in csv_text::data_rows(path, rows) {
-        let row = row?;
+    for row in rows {
+        if !blanks.is_data(&row) {
+            continue;
+        }
         csv_text::check_width(path, &row, width)?;
         csv_text::required_number(path, &row, 0, "frame number")?;
         let t = csv_text::required_number(path, &row, 1, "time in seconds")?;
@@ -433,7 +443,8 @@ fn read_data<'a>(
                     csv_text::place(row.line, 1),
                     format!(
                         "expected a time step of {step:.6} s (the export frame rate \
-                         {rate_hz} Hz), found {d:.6} s from the previous row"
+                         {rate_hz} Hz), found {d:.6} s from the previous row{}",
+                        csv_text::not_run_on(blanks.run_before(row.line))
                     ),
                 ));
             }
@@ -445,7 +456,7 @@ fn read_data<'a>(
             };
             track
                 .positions
-                .push(csv_text::sample(path, &row, [x, y, z], scale, gaps)?);
+                .push(csv_text::sample(path, &row, [x, y, z], scale, &mut gaps)?);
             match (e.rotation, meta.euler) {
                 ([Some(qx), Some(qy), Some(qz), Some(qw)], None) => track
                     .rotations
@@ -466,7 +477,12 @@ fn read_data<'a>(
             "expected data rows after the \"Frame\" row, found none",
         ));
     }
-    Ok((tracks, frames))
+    Ok(Data {
+        tracks,
+        frames,
+        gaps,
+        blanks,
+    })
 }
 
 /// Tell the header rows apart: (Type, Name, ID if present, Rotation/Position).
@@ -617,6 +633,39 @@ mod tests {
             assert!(q.dot(want).abs() > 1.0 - 1e-12, "{order}: {q} vs {want}");
             assert_eq!(take.tracks[0].rotations[1], None, "a gap stays a gap");
         }
+    }
+
+    /// Blank lines between data rows are skipped and named, CRLF or not; a blank line
+    /// after the `Frame` row or at the end is not named.
+    #[test]
+    fn blank_lines_inside_the_data_are_skipped_and_named() {
+        let body = ",Type,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Rigid Body,Marker,Marker,Marker\n\
+                    ,Name,A,A,A,A,A,A,A,B,B,B\n\
+                    ,,Rotation,Rotation,Rotation,Rotation,Position,Position,Position,Position,Position,Position\n\
+                    Frame,Time (Seconds),X,Y,Z,W,X,Y,Z,X,Y,Z\n";
+        let rows = "0,0.000000,0,0,0,1,1,2,3,,,\n,,,,,,,,,,,\n\n1,0.010000,0,0,0,1,4,5,6,7,8,9\n\n";
+        let text = format!("{HEAD}{body}{rows}");
+        let after_frame_row =
+            format!("{HEAD}{body}\n0,0,0,0,0,1,1,2,3,,,\n1,0.01,0,0,0,1,4,5,6,7,8,9\n");
+        for text in [text.clone(), text.replace('\n', "\r\n")] {
+            let take = read(p(), text.as_bytes(), None).unwrap();
+            assert_eq!(take.frames, 2);
+            assert_eq!(
+                take.tracks[0].positions[1],
+                Some(glam::DVec3::new(0.004, 0.005, 0.006))
+            );
+            assert_eq!(take.tracks[1].positions[0], None);
+            assert_eq!(
+                take.notes,
+                [
+                    "2 blank lines inside the data were skipped (lines 8, 9): the rows after them \
+                  continue the frames above"
+                ]
+            );
+        }
+        let take = read(p(), after_frame_row.as_bytes(), None).unwrap();
+        assert_eq!(take.frames, 2);
+        assert!(take.notes.is_empty(), "{:?}", take.notes);
     }
 
     #[test]

@@ -23,8 +23,11 @@
 //! * The frame rate is 1 / the median time step. Times must increase and every step must
 //!   be within 1 % of the median, or the file is refused with the line that breaks it.
 //!   At least two frames are needed.
-//! * Lines may end in CRLF and have a trailing comma; blank lines at the end are ignored;
-//!   a UTF-8 byte-order mark is skipped. Quaternions are normalised on reading.
+//! * Lines may end in CRLF and have a trailing comma; a UTF-8 byte-order mark is skipped.
+//!   Quaternions are normalised on reading.
+//! * Blank lines (nothing, or only commas and spaces) between data rows, as hand-edited or
+//!   concatenated files have, are skipped and named in a note; the rows after them must
+//!   still run on in time. Blank lines before the first data row or at the end are ignored.
 //!
 //! A unit override (`mm`, `cm`) can be given for files written in another unit.
 
@@ -65,8 +68,8 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         .map(|c| Track::empty(c.label.clone()))
         .collect();
     let mut gaps = MarkedGaps::default();
-    for row in csv_text::data_rows(path, rows) {
-        let row = row?;
+    let mut blanks = csv_text::BlankLines::default();
+    for row in rows.filter(|row| blanks.is_data(row)) {
         csv_text::check_width(path, &row, width)?;
         let t = csv_text::required_number(path, &row, 0, "time in seconds")?;
         times.push((row.line, t));
@@ -85,14 +88,14 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
             }
         }
     }
-    let rate_hz = rate_from_times(path, &times)?;
+    let rate_hz = rate_from_times(path, &times, &blanks)?;
     let mut take = Take {
         source: path.to_path_buf(),
         rate_hz,
         frames: times.len(),
         file_unit: unit.symbol().to_string(),
         tracks,
-        notes: Vec::new(),
+        notes: blanks.note("the data").into_iter().collect(),
     };
     take.zeros_as_gaps(gaps);
     Ok(take)
@@ -212,7 +215,13 @@ pub(super) fn quaternion(
 }
 
 /// The frame rate from the rows' times: 1 / median step; steps must be uniform to 1 %.
-fn rate_from_times(path: &Path, times: &[(usize, f64)]) -> Result<f64, ImportError> {
+/// `blanks`: the blank lines skipped among the rows, named when a step across them is
+/// wrong.
+fn rate_from_times(
+    path: &Path,
+    times: &[(usize, f64)],
+    blanks: &csv_text::BlankLines,
+) -> Result<f64, ImportError> {
     if times.len() < 2 {
         return Err(ImportError::format(
             path,
@@ -230,7 +239,10 @@ fn rate_from_times(path: &Path, times: &[(usize, f64)]) -> Result<f64, ImportErr
             return Err(ImportError::format(
                 path,
                 csv_text::place(line, 0),
-                format!("expected a time after the previous row's {t0} s, found {t1} s"),
+                format!(
+                    "expected a time after the previous row's {t0} s, found {t1} s{}",
+                    csv_text::not_run_on(blanks.run_before(line))
+                ),
             ));
         }
         steps.push(t1 - t0);
@@ -243,7 +255,8 @@ fn rate_from_times(path: &Path, times: &[(usize, f64)]) -> Result<f64, ImportErr
                 csv_text::place(w[1].0, 0),
                 format!(
                     "expected a uniform time step of {median} s (within 1 %), found a step of \
-                     {step} s from the previous row"
+                     {step} s from the previous row{}",
+                    csv_text::not_run_on(blanks.run_before(w[1].0))
                 ),
             ));
         }
@@ -362,8 +375,9 @@ mod tests {
                 "line 3, column 3",
             ),
             (
-                "time_s,a_x,a_y,a_z\n0,1,2,3\n\n0.1,1,2,3\n",
-                "line 3: expected a data row",
+                "time_s,a_x,a_y,a_z\n0,1,2,3\n0.1,1,2,3\n\n0,1,2,3\n",
+                "line 5, column 1: expected a time after the previous row's 0.1 s, found 0 s \
+                 (the rows after the blank line 4 do not run on from those above it)",
             ),
             (
                 "time_s,a_x,a_y,a_z\n0,1,2,3\n0.1,1,2\n",
@@ -378,6 +392,39 @@ mod tests {
         for (text, want) in cases {
             let e = read(p(), text.as_bytes(), None).unwrap_err().to_string();
             assert!(e.contains(want), "{text:?}: {e}");
+        }
+    }
+
+    /// Blank lines between data rows (empty, commas only, spaces and tabs) are skipped
+    /// and named; those at the end are not.
+    #[test]
+    fn blank_lines_inside_the_data_are_skipped_and_named() {
+        let text = "time_s,a_x,a_y,a_z,rb_x,rb_y,rb_z,rb_qx,rb_qy,rb_qz,rb_qw\n\
+                    0.00,1000,0,0,0,0,500,0,0,0,1\n\
+                    \n\
+                    0.01,1250,0,0,0,0,750,0,0,0,1\n\
+                    ,,,,,,,,,,\n\
+                    \x20\t, ,\n\
+                    0.02,,,,0,0,1000,,,,\n\
+                    0.03,1500,0,0,0,0,1250,0,0,0,1\n\n\n";
+        for text in [text.to_string(), text.replace('\n', "\r\n")] {
+            let take = read(p(), text.as_bytes(), Some(LengthUnit::Millimetre)).unwrap();
+            assert_eq!(take.frames, 4);
+            assert!((take.rate_hz - 100.0).abs() < 1e-9);
+            let a = &take.tracks[0].positions;
+            assert_eq!(a[1], Some(DVec3::new(1.25, 0.0, 0.0)));
+            assert_eq!(a[2], None);
+            assert_eq!(a[3], Some(DVec3::new(1.5, 0.0, 0.0)));
+            assert_eq!(take.tracks[1].positions[2], Some(DVec3::new(0.0, 0.0, 1.0)));
+            assert_eq!(take.tracks[1].rotations[2], None);
+            assert_eq!(take.tracks[1].rotations[3], Some(DQuat::IDENTITY));
+            assert_eq!(
+                take.notes,
+                [
+                    "3 blank lines inside the data were skipped (lines 3, 5, 6): the rows after \
+                  them continue the frames above"
+                ]
+            );
         }
     }
 

@@ -275,31 +275,24 @@ fn read_data<'a>(
         gaps: MarkedGaps::default(),
     };
     let mut prev_frame: Option<f64> = None;
-    // Blank lines since the last data row, and those skipped between data rows.
-    let mut blanks: Vec<usize> = Vec::new();
-    let mut skipped: Vec<usize> = Vec::new();
+    let mut blanks = csv_text::BlankLines::default();
     let mut last_line = axis_line;
     for row in rows {
         last_line = row.line;
-        if row.is_blank() {
-            blanks.push(row.line);
+        if blanks.skip(&row) {
             continue;
         }
         if is_section_name(row.cell(0)) {
             break;
         }
-        let after_blank = blanks.first().copied();
-        if let Some(blank) = after_blank {
-            if !csv_text::is_number(row.cell(0)) {
-                data.notes.push(unread_rest(blank, &row));
-                break;
-            }
-            if data.frames == 0 {
-                // Between the header and the first data row: not inside the data.
-                blanks.clear();
-            }
-            skipped.append(&mut blanks);
+        if let Some(blank) = blanks.pending()
+            && !csv_text::is_number(row.cell(0))
+        {
+            data.notes.push(unread_rest(blank, &row));
+            break;
         }
+        blanks.data_row(row.line);
+        let after_blank = blanks.run_before(row.line);
         let frame = frame_number(path, &row, layout.width, prev_frame, after_blank)?;
         prev_frame = Some(frame);
         read_row(path, &row, layout, &mut data.tracks, &mut data.gaps)?;
@@ -312,10 +305,7 @@ fn read_data<'a>(
             "expected data rows in the Trajectories section, found none",
         ));
     }
-    data.notes.extend(csv_text::blank_lines_note(
-        &skipped,
-        "the Trajectories data",
-    ));
+    data.notes.extend(blanks.note("the Trajectories data"));
     Ok(data)
 }
 
@@ -334,15 +324,13 @@ fn frame_number(
     if let Some(p) = prev
         && frame != p + 1.0
     {
-        let after_blank = blank.map_or(String::new(), |b| {
-            format!(" (the rows after the blank line {b} do not run on from those above it)")
-        });
         return Err(ImportError::format(
             path,
             csv_text::place(row.line, 0),
             format!(
-                "expected frame {} after frame {p} (one row per frame), found {frame}{after_blank}",
-                p + 1.0
+                "expected frame {} after frame {p} (one row per frame), found {frame}{}",
+                p + 1.0,
+                csv_text::not_run_on(blank)
             ),
         ));
     }

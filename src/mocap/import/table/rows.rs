@@ -76,15 +76,12 @@ impl RowReader<'_> {
                 .collect(),
             gaps: MarkedGaps::default(),
         };
-        // Blank lines since the last data row, and those skipped between data rows.
-        let mut blanks: Vec<usize> = Vec::new();
-        let mut skipped: Vec<usize> = Vec::new();
+        let mut blanks = csv_text::BlankLines::default();
         for row in &sheet.rows[first..] {
-            if row.is_blank() {
-                blanks.push(row.line);
+            if blanks.skip(row) {
                 continue;
             }
-            if !blanks.is_empty() && !sheet.numeric(row.cell(0)) {
+            if blanks.pending().is_some() && !sheet.numeric(row.cell(0)) {
                 if self.in_section {
                     break;
                 }
@@ -95,7 +92,7 @@ impl RowReader<'_> {
                 ));
                 break;
             }
-            skipped.append(&mut blanks);
+            blanks.data_row(row.line);
             if let Some((c, _)) = clock {
                 let t = self.number(row, c)?.ok_or_else(|| {
                     ImportError::format(
@@ -118,7 +115,7 @@ impl RowReader<'_> {
                 "expected data rows below the header, found none",
             ));
         }
-        notes.extend(csv_text::blank_lines_note(&skipped, "the data"));
+        notes.extend(blanks.note("the data"));
         Ok(rows)
     }
 
