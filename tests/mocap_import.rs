@@ -381,6 +381,86 @@ fn c3d_over_65535_frames_without_a_long_count_is_read_whole() {
     assert!(back.notes.is_empty(), "{:?}", back.notes);
 }
 
+// ---------------------------------------------------------------- C3D: NaN and infinity
+
+/// Overwrite point `point` of frame `frame` (0-based) of an Intel float C3D: its X, Y, Z
+/// and, when given, its residual.
+fn set_c3d_point(
+    bytes: &mut [u8],
+    frame: usize,
+    point: usize,
+    xyz: [f32; 3],
+    residual: Option<f32>,
+) {
+    let info = c3d::inspect(Path::new("x.c3d"), bytes).unwrap();
+    assert!(info.float_data && info.analog_values_per_frame == 0);
+    let at = info.data_offset + (frame * info.points + point) * 16;
+    for (i, v) in xyz.into_iter().chain(residual).enumerate() {
+        bytes[at + 4 * i..at + 4 * i + 4].copy_from_slice(&v.to_le_bytes());
+    }
+}
+
+/// A C3D point whose coordinates are NaN or ±infinity while its residual says it was
+/// seen (as some exporters mark an unseen marker instead of a negative residual) is a
+/// gap, counted in the gap note with the samples at exactly (0, 0, 0); a point the
+/// residual already marks invalid is not counted, whatever its coordinates.
+#[test]
+fn c3d_nan_and_infinite_coordinates_are_counted_gaps() {
+    let mut take = counting_take(40);
+    take.tracks.push(Track {
+        label: "Wrist".into(),
+        ..take.tracks[0].clone()
+    });
+    take.tracks[0].positions[9] = Some(DVec3::ZERO);
+    let mut bytes = write_c3d(&take);
+    let (nan, inf) = (f32::NAN, f32::INFINITY);
+    let negative_nan = f32::from_bits(0xffc0_0000);
+    let marked = [
+        (2, 0, [nan, nan, nan]),
+        (3, 0, [12.0, negative_nan, 800.0]),
+        (4, 1, [inf, inf, inf]),
+        (5, 1, [12.0, 100.0, -inf]),
+        (6, 1, [nan, inf, 0.0]),
+    ];
+    for (frame, point, xyz) in marked {
+        set_c3d_point(&mut bytes, frame, point, xyz, None);
+    }
+    // Invalid by its residual, NaN as well: an ordinary gap.
+    set_c3d_point(&mut bytes, 7, 0, [nan; 3], Some(-1.0));
+    let note = "1 sample at exactly (0, 0, 0), 3 written as NaN and 2 written as ±infinity \
+                read as gaps (the way Vicon, Cortex and many C3D writers mark an unseen marker)";
+    for unit in [None, Some(import::LengthUnit::Metre)] {
+        let back =
+            import::read_bytes_with_unit(Path::new("nan.c3d"), &bytes, Format::C3d, unit).unwrap();
+        assert_eq!(back.frames, 40);
+        assert_eq!(back.notes, [note], "{unit:?}");
+        let gaps: Vec<(usize, usize)> = (0..40)
+            .flat_map(|f| (0..2).map(move |p| (f, p)))
+            .filter(|&(f, p)| back.tracks[p].positions[f].is_none())
+            .collect();
+        assert_eq!(
+            gaps,
+            [(2, 0), (3, 0), (4, 1), (5, 1), (6, 1), (7, 0), (9, 0)]
+        );
+        let scale = if unit.is_some() { 1000.0 } else { 1.0 };
+        assert_near(
+            back.tracks[1].positions[3].unwrap(),
+            DVec3::new(0.003, 0.1, 0.8) * scale,
+            1e-6 * scale,
+        );
+    }
+    // Without them, only the zero is noted, as before.
+    let plain = write_c3d(&take);
+    let back = import::read_bytes(Path::new("zero.c3d"), &plain, Format::C3d).unwrap();
+    assert_eq!(
+        back.notes,
+        [
+            "1 sample at exactly (0, 0, 0) read as gaps (the way Vicon, Cortex and many C3D \
+          writers mark an unseen marker)"
+        ]
+    );
+}
+
 // ---------------------------------------------------------------- Motive
 
 #[test]

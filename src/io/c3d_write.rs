@@ -382,6 +382,30 @@ mod tests {
         }
     }
 
+    /// A big-endian (MIPS) file's NaN and infinite coordinates are gaps, counted in the
+    /// take's gap note, as in an Intel one (tests/mocap_import.rs).
+    #[test]
+    fn non_finite_big_endian_floats_are_counted_gaps() {
+        let take = sample(12);
+        let mut bytes = encode(&take, Processor::Mips, Storage::Float);
+        let info = inspect(Path::new("x"), &bytes).unwrap();
+        let mut mark = |frame: usize, point: usize, axis: usize, v: f32| {
+            let at = info.data_offset + (frame * info.points + point) * 16 + 4 * axis;
+            bytes[at..at + 4].copy_from_slice(&v.to_be_bytes());
+        };
+        mark(0, 0, 0, f32::NAN);
+        mark(1, 2, 2, f32::NEG_INFINITY);
+        mark(2, 1, 1, f32::INFINITY);
+        let back = read(Path::new("x"), &bytes, None).unwrap();
+        let missing = |f: usize, p: usize| back.tracks[p].positions[f].is_none();
+        assert!(missing(0, 0) && missing(1, 2) && missing(2, 1));
+        assert!(!missing(0, 1) && !missing(1, 0));
+        assert_eq!(
+            back.notes,
+            ["1 sample written as NaN and 2 written as ±infinity read as gaps"]
+        );
+    }
+
     #[test]
     fn many_labels_and_long_takes() {
         let mut take = sample(3);

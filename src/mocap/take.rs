@@ -114,26 +114,40 @@ impl Take {
 }
 
 /// Samples a file marks unseen instead of leaving their cells empty: a coordinate
-/// written as NaN, or all three exactly 0. Both are read as gaps and counted in one note.
+/// written as NaN or (in a binary file) ±infinity, or all three exactly 0. All are read
+/// as gaps and counted in one note.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct MarkedGaps {
     /// Samples with a coordinate written as NaN.
     pub nan: usize,
     /// Samples at exactly (0, 0, 0).
     pub zero: usize,
+    /// Samples with a coordinate written as +infinity or −infinity (and none as NaN).
+    pub infinite: usize,
 }
 
 impl MarkedGaps {
-    /// The note counting them (`4 samples at exactly (0, 0, 0) and 2 written as NaN read
-    /// as gaps …`), or `None` when there are none.
+    /// The note counting them (`4 samples at exactly (0, 0, 0), 2 written as NaN and 1
+    /// written as ±infinity read as gaps …`), or `None` when there are none.
     pub fn note(self) -> Option<String> {
         let samples = |n: usize| if n == 1 { "sample" } else { "samples" };
-        let at_origin = |n: usize| format!("{n} {} at exactly (0, 0, 0)", samples(n));
-        let counted = match (self.zero, self.nan) {
-            (0, 0) => return None,
-            (0, nan) => format!("{nan} {} written as NaN", samples(nan)),
-            (zero, 0) => at_origin(zero),
-            (zero, nan) => format!("{} and {nan} written as NaN", at_origin(zero)),
+        let kinds = [
+            (self.zero, "at exactly (0, 0, 0)"),
+            (self.nan, "written as NaN"),
+            (self.infinite, "written as ±infinity"),
+        ];
+        let mut parts: Vec<String> = Vec::new();
+        for (n, how) in kinds.into_iter().filter(|&(n, _)| n > 0) {
+            let first = parts.is_empty();
+            parts.push(if first {
+                format!("{n} {} {how}", samples(n))
+            } else {
+                format!("{n} {how}")
+            });
+        }
+        let counted = match parts.split_last()? {
+            (last, []) => last.clone(),
+            (last, rest) => format!("{} and {last}", rest.join(", ")),
         };
         let why = if self.zero > 0 {
             " (the way Vicon, Cortex and many C3D writers mark an unseen marker)"
@@ -202,7 +216,14 @@ mod tests {
 
     #[test]
     fn one_note_counts_zeros_and_nans() {
-        let note = |zero, nan| MarkedGaps { nan, zero }.note();
+        let note = |zero, nan| {
+            MarkedGaps {
+                nan,
+                zero,
+                infinite: 0,
+            }
+            .note()
+        };
         assert_eq!(note(0, 0), None);
         assert_eq!(
             note(1, 0).unwrap(),
@@ -214,5 +235,27 @@ mod tests {
                 .unwrap()
                 .starts_with("4 samples at exactly (0, 0, 0) and 1 written as NaN read as gaps (")
         );
+        let infinite = |nan, infinite| {
+            MarkedGaps {
+                nan,
+                zero: 0,
+                infinite,
+            }
+            .note()
+            .unwrap()
+        };
+        assert_eq!(infinite(0, 1), "1 sample written as ±infinity read as gaps");
+        assert_eq!(
+            infinite(2, 3),
+            "2 samples written as NaN and 3 written as ±infinity read as gaps"
+        );
+        let all = MarkedGaps {
+            nan: 2,
+            zero: 1,
+            infinite: 1,
+        };
+        assert!(all.note().unwrap().starts_with(
+            "1 sample at exactly (0, 0, 0), 2 written as NaN and 1 written as ±infinity read as gaps ("
+        ));
     }
 }

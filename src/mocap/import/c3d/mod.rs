@@ -21,7 +21,9 @@
 //! * **Data**: for each frame, for each point X, Y, Z and a residual word (int16 times
 //!   |scale|, or float32), then the frame's analog values (int16 or float32), which are
 //!   skipped here. A negative residual marks the point invalid (not seen): it is read as
-//!   `None`; non-finite coordinates are also `None`.
+//!   `None`. A point whose residual says valid but whose float coordinates are NaN or
+//!   ±infinity (some exporters mark an unseen marker so) is `None` too, counted in the
+//!   take's gap note with those at exactly (0, 0, 0).
 //!
 //! Parameters used: `POINT:USED`, `RATE`, `SCALE`, `UNITS` (default mm), `LABELS`
 //! (`LABELS2`, `LABELS3`, … for more than 255 points; a missing or blank label becomes
@@ -340,6 +342,7 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
             rotations: Vec::new(),
         })
         .collect();
+    let mut gaps = MarkedGaps::default();
     for f in 0..info.frames {
         let base = info.data_offset + f * frame_size;
         for (p, track) in tracks.iter_mut().enumerate() {
@@ -362,10 +365,20 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
                 ];
                 (xyz, bin.i16(o + 6, what)? < 0)
             };
-            let v = DVec3::from_array(xyz) * metres;
-            track
-                .positions
-                .push((!invalid && v.is_finite()).then_some(v));
+            // A point the residual calls valid with a coordinate NaN or infinite: a
+            // gap marked the way some exporters mark one, counted.
+            let position = if invalid {
+                None
+            } else if xyz.iter().any(|c| c.is_nan()) {
+                gaps.nan += 1;
+                None
+            } else if xyz.iter().any(|c| c.is_infinite()) {
+                gaps.infinite += 1;
+                None
+            } else {
+                Some(DVec3::from_array(xyz) * metres)
+            };
+            track.positions.push(position);
         }
     }
     let mut notes = info.notes.clone();
@@ -404,7 +417,7 @@ pub fn read(path: &Path, bytes: &[u8], unit: Option<LengthUnit>) -> Result<Take,
         tracks,
         notes,
     };
-    take.zeros_as_gaps(MarkedGaps::default());
+    take.zeros_as_gaps(gaps);
     Ok(take)
 }
 
