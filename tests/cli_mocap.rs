@@ -1,7 +1,8 @@
 //! `timpanist mocap import` end to end: a Motive-style CSV export with one rigid body per
 //! stick (Y up, metres, 250 Hz), written from a synthetic take whose impacts are known,
 //! is cut into the right units; bad input, or a take with no strokes on the tracks
-//! taken as sticks, leaves the database untouched.
+//! taken as sticks, leaves the database untouched; a file imported again replaces its
+//! take.
 
 use glam::{DQuat, DVec3};
 use std::fmt::Write as _;
@@ -9,7 +10,7 @@ use std::path::Path;
 use std::process::Command;
 use timpanist::body::{Joint, Skeleton};
 use timpanist::kit::Side;
-use timpanist::mocap::db::MotionDb;
+use timpanist::mocap::db::{MotionDb, file_sha256};
 use timpanist::mocap::synth::{SynthConfig, synthesize};
 use timpanist::score::{Dynamic, Grip, ImpactLocation, PlayingMode};
 
@@ -365,4 +366,112 @@ fn an_unalignable_take_prints_its_notes_before_the_error() {
     for flag in ["--unit", "--up", "--tips"] {
         assert!(error.contains(flag), "{flag} in {err}");
     }
+}
+
+/// Importing a take again into a database that holds it — the same file, or its copy in
+/// another folder: same name, same bytes — replaces it, with a note, and the database
+/// reads as after the first import; another file of the same name (other bytes: the
+/// export with CRLF line endings) is added beside it under a sample file of its own, and
+/// a copy under another name is another take. A pair of files is known again by both.
+#[test]
+fn importing_the_same_take_again_replaces_it() {
+    let source = right_hand_legato();
+    let dir = tempfile::tempdir().unwrap();
+    let name = "legato_spot_f_french.csv";
+    let text = motive_csv(&source);
+    let put = |folder: &str, name: &str, text: &str| {
+        let folder = dir.path().join(folder);
+        std::fs::create_dir_all(&folder).unwrap();
+        let path = folder.join(name);
+        std::fs::write(&path, text).unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    let csv = put("session", name, &text);
+    let offset = format!("0,0,-{}", Skeleton::default().stick_length_m);
+    let import = |files: &[&str], extra: &[&str], db: &Path| {
+        let mut args = vec!["mocap", "import"];
+        args.extend_from_slice(files);
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["--format", "motive", "--tip-offset", &offset, "-o"]);
+        args.push(db.to_str().unwrap());
+        let out = timpanist(&args);
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(out.status.success(), "{err}");
+        err
+    };
+    let db_dir = dir.path().join("db");
+    let both = ["--tips", "StickL,StickR"];
+    let err = import(&[&csv], &both, &db_dir);
+    assert!(!err.contains("already in the database"), "{err}");
+    let first = MotionDb::load(&db_dir).unwrap();
+    assert_eq!(first.index.takes.len(), 1);
+    assert!(!first.index.units.is_empty());
+    let sha = file_sha256(text.as_bytes());
+    assert_eq!(
+        first.index.takes[0].source_sha256.as_deref(),
+        Some(sha.as_str())
+    );
+    let tmot = "takes/legato_spot_f_french.tmot";
+
+    // The same file again, then its copy in another folder: replaced.
+    let copy = put("backup", name, &text);
+    for file in [&csv, &copy] {
+        let err = import(&[file], &both, &db_dir);
+        let note = format!(
+            "note: {file}: take {tmot} already in the database (the same bytes, imported from \
+             {csv}): replaced"
+        );
+        assert!(err.contains(&note), "{note:?} in {err}");
+        let db = MotionDb::load(&db_dir).unwrap();
+        assert_eq!(db.index.takes.len(), 1);
+        assert_eq!(db.index.takes[0].file, tmot);
+        assert_eq!(db.index.units, first.index.units);
+        assert_eq!(db.takes, first.takes);
+    }
+    assert!(!db_dir.join("takes/legato_spot_f_french-2.tmot").exists());
+
+    // Another file of that name, other bytes: kept beside it, and replaced in turn.
+    let crlf = put("day2", name, &text.replace('\n', "\r\n"));
+    let err = import(&[&crlf], &both, &db_dir);
+    let note = format!(
+        "note: {crlf}: another file named {name} is already in the database (take {tmot}, \
+         from {copy}, with other bytes): this one is added beside it as take \
+         takes/legato_spot_f_french-2.tmot"
+    );
+    assert!(err.contains(&note), "{note:?} in {err}");
+    let err = import(&[&crlf], &both, &db_dir);
+    assert!(
+        err.contains("take takes/legato_spot_f_french-2.tmot already in the database"),
+        "{err}"
+    );
+    let db = MotionDb::load(&db_dir).unwrap();
+    assert_eq!(db.index.takes.len(), 2);
+    assert_eq!(db.index.units.len(), 2 * first.index.units.len());
+    assert_ne!(
+        db.index.takes[0].source_sha256,
+        db.index.takes[1].source_sha256
+    );
+    // The same bytes under another name: another take.
+    let renamed = put("session", "legato_spot_f_french_again.csv", &text);
+    let err = import(&[&renamed], &both, &db_dir);
+    assert!(!err.contains("already in the database"), "{err}");
+    assert_eq!(MotionDb::load(&db_dir).unwrap().index.takes.len(), 3);
+
+    // A pair of files (left stick's, right stick's), imported twice: one take.
+    let pair_db = dir.path().join("pair-db");
+    let right = put("session", "legato_spot_f_french_right.csv", &text);
+    for round in 0..2 {
+        let err = import(
+            &[&csv, &right],
+            &["--pair", "--tips", "StickL,StickR"],
+            &pair_db,
+        );
+        assert_eq!(err.contains("already in the database"), round == 1, "{err}");
+    }
+    let pair = MotionDb::load(&pair_db).unwrap();
+    assert_eq!(pair.index.takes.len(), 1);
+    assert_eq!(
+        pair.index.takes[0].source_sha256,
+        Some(format!("{sha}+{sha}"))
+    );
 }

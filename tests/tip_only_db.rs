@@ -116,6 +116,7 @@ fn lab_db(shipped: &MotionDb, rate_hz: f64) -> MotionDb {
             rate_hz,
             performer: "lab".into(),
             source: entry.file.clone(),
+            source_sha256: None,
         });
         db.takes.push(data);
     }

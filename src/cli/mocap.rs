@@ -190,6 +190,8 @@ pub struct ImportArgs {
 /// One take to ingest: read from one file, or two paired ones.
 struct Source {
     path: PathBuf,
+    /// The SHA-256 of the file's bytes (of a pair: the left's and the right's, `+`).
+    sha256: String,
     take: Take,
     tips: [Option<String>; 2],
     up: UpAxis,
@@ -198,7 +200,8 @@ struct Source {
 
 /// Import captures into the database at `args.output` (created if absent). Every file
 /// is read, cut and aligned before anything is written, so a bad file leaves the database
-/// as it was.
+/// as it was. A take from a file of the same name and bytes as one the database holds
+/// replaces it; one from another file of the same name is added beside it.
 pub fn import(args: ImportArgs) -> anyhow::Result<()> {
     let mut db = if args.output.join("index.ron").exists() {
         MotionDb::load(&args.output)?
@@ -259,8 +262,11 @@ pub fn import(args: ImportArgs) -> anyhow::Result<()> {
             dynamic_speeds: speeds.clone(),
         };
         // A take that cannot be imported still has its notes said: they often tell why.
-        let report = ingest(&mut db, &source.path, &source.take, &options)
+        let mut report = ingest(&mut db, &source.path, &source.take, &options)
             .inspect_err(|_| print_notes(&source.path, &source.take.notes))?;
+        report
+            .notices
+            .extend(db.settle_import(&source.path, &source.sha256));
         print_report(source, &report, &align);
         refuse_if_strokeless(&source.path, &report)?;
         if matches!(align, Alignment::None) {
@@ -403,6 +409,7 @@ fn single_source(
     only: Option<Side>,
 ) -> anyhow::Result<Source> {
     let (mut take, format) = read_take(path, args, profile)?;
+    let bytes = std::fs::read(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let tips = resolve_tips(path, &take, args, profile, only)?;
     let used: Vec<String> = tips
         .iter()
@@ -414,6 +421,7 @@ fn single_source(
     let up = up_axis(args, profile, format, &mut take, &tips);
     Ok(Source {
         path: path.to_path_buf(),
+        sha256: crate::mocap::db::file_sha256(&bytes),
         up,
         tip_offset_m: args
             .tip_offset_m
@@ -467,6 +475,7 @@ fn paired_source(
         l.tips[0].take().map(|t| prefixed("left", t)),
         r.tips[1].clone().map(|t| prefixed("right", t)),
     ];
+    l.sha256 = format!("{}+{}", l.sha256, r.sha256);
     l.take = Take {
         source: left.to_path_buf(),
         rate_hz: l.take.rate_hz,

@@ -31,6 +31,15 @@ const MAGIC: &[u8; 8] = b"TMOTION1";
 const POSITION_STEP_M: f64 = 1e-5;
 const QUATERNION_STEP: f64 = 1e-6;
 
+/// The SHA-256 of a capture file's bytes in lowercase hex, as `sha256sum` prints it.
+pub fn file_sha256(bytes: &[u8]) -> String {
+    use sha2::Digest as _;
+    sha2::Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
 /// `index.ron`: what the database holds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename = "MotionDb", deny_unknown_fields)]
@@ -56,6 +65,13 @@ pub struct TakeEntry {
     pub performer: String,
     /// The capture file it was imported from (or "synthetic").
     pub source: String,
+    /// The SHA-256 of the capture file's bytes, in hex ([`file_sha256`]; for a take read
+    /// from a pair of files, the left file's and the right file's joined by `+`): a take
+    /// imported again from a file of the same name and bytes replaces this one
+    /// ([`MotionDb::settle_import`]). Absent for synthetic takes and those imported
+    /// before it was kept.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source_sha256: Option<String>,
 }
 
 /// One motion unit: a single stroke from the end of the previous stroke's rebound to the
@@ -372,6 +388,52 @@ impl MotionDb {
         db
     }
 
+    /// Settle the last take, just imported from `path` (a capture whose bytes hash to
+    /// `sha256`, [`file_sha256`]): record the hash, and if an earlier take was imported
+    /// from a file of the same name with the same bytes, put the new take in its place
+    /// (same sample file; its units replaced by the new take's). A file of the same name
+    /// with other bytes is kept beside it (its sample file already named apart, `NAME-2`).
+    /// Returns the note saying which of these happened, if either did.
+    pub fn settle_import(&mut self, path: &Path, sha256: &str) -> Option<String> {
+        let last = self.index.takes.len().checked_sub(1)?;
+        self.index.takes[last].source_sha256 = Some(sha256.to_string());
+        let name = path.file_name()?;
+        let named_alike = |t: &TakeEntry| Path::new(&t.source).file_name() == Some(name);
+        let earlier = &self.index.takes[..last];
+        let same = earlier
+            .iter()
+            .position(|t| named_alike(t) && t.source_sha256.as_deref() == Some(sha256));
+        let other = earlier.iter().position(named_alike);
+        let shown = name.to_string_lossy();
+        let Some(old) = same else {
+            let other = &self.index.takes[other?];
+            let bytes = match other.source_sha256 {
+                Some(_) => "with other bytes",
+                None => "its bytes unrecorded (imported before they were kept)",
+            };
+            return Some(format!(
+                "another file named {shown} is already in the database (take {}, from {}, \
+                 {bytes}): this one is added beside it as take {}",
+                other.file, other.source, self.index.takes[last].file
+            ));
+        };
+        let entry = self.index.takes.pop()?;
+        let data = self.takes.pop()?;
+        let file = self.index.takes[old].file.clone();
+        let was = std::mem::replace(&mut self.index.takes[old], TakeEntry { file, ..entry });
+        self.takes[old] = data;
+        self.index.units.retain(|u| u.take != old);
+        for u in &mut self.index.units {
+            if u.take == last {
+                u.take = old;
+            }
+        }
+        Some(format!(
+            "take {} already in the database (the same bytes, imported from {}): replaced",
+            was.file, was.source
+        ))
+    }
+
     /// The tip samples of unit `u` for its own hand, from start to end.
     pub fn unit_tip(&self, u: &UnitEntry) -> &[Option<DVec3>] {
         &self.takes[u.take].tip(u.hand)[u.start..=u.end]
@@ -647,6 +709,80 @@ mod tests {
             tips: [tip(-1.0), tip(1.0)],
             joints: Some(poses),
         }
+    }
+
+    /// Add a take imported from `source` (sample file `takes/<file>.tmot`) with one unit
+    /// per hand, as `ingest` does.
+    fn add_take(db: &mut MotionDb, source: &str, file: &str, phase: f64) {
+        let take = db.index.takes.len();
+        let mut data = sample_take();
+        data.tips[0][0] = Some(DVec3::splat(phase));
+        db.index.takes.push(TakeEntry {
+            file: format!("takes/{file}.tmot"),
+            frames: data.frames(),
+            rate_hz: data.rate_hz,
+            performer: "p".into(),
+            source: source.into(),
+            source_sha256: None,
+        });
+        db.takes.push(data);
+        for hand in SIDES {
+            db.index.units.push(UnitEntry {
+                take,
+                start: 10,
+                impact: 20,
+                end: 30,
+                hand,
+                mode: PlayingMode::Legato,
+                location: ImpactLocation::PlayingSpot,
+                dynamic: Dynamic::F,
+                grip: Grip::French,
+            });
+        }
+    }
+
+    /// A take imported again from a file of the same name and bytes takes the earlier
+    /// one's place (its units re-pointed, the other takes' left alone); a take imported
+    /// before hashes were kept is never taken for the same file.
+    #[test]
+    fn a_take_imported_again_replaces_the_earlier_one() {
+        assert_eq!(
+            file_sha256(b"abc"),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+        );
+        let mut db = MotionDb::empty("t");
+        add_take(&mut db, "old/roll.csv", "roll", 1.0);
+        add_take(&mut db, "lab/other.c3d", "other", 2.0);
+        add_take(&mut db, "lab/roll.csv", "roll-2", 3.0);
+        let note = db.settle_import(Path::new("lab/roll.csv"), "aa").unwrap();
+        assert!(
+            note.contains("(take takes/roll.tmot, from old/roll.csv, its bytes unrecorded"),
+            "{note}"
+        );
+        assert_eq!(db.index.takes.len(), 3);
+        add_take(&mut db, "lab/other.c3d", "other-2", 4.0);
+        let note = db.settle_import(Path::new("lab/other.c3d"), "bb");
+        assert!(note.unwrap().ends_with(
+            "its bytes unrecorded (imported before they were kept)): this one is added beside \
+             it as take takes/other-2.tmot"
+        ));
+        assert_eq!(db.index.takes.len(), 4);
+        add_take(&mut db, "/copy/roll.csv", "roll-3", 5.0);
+        let note = db.settle_import(Path::new("/copy/roll.csv"), "aa").unwrap();
+        assert_eq!(
+            note,
+            "take takes/roll-2.tmot already in the database (the same bytes, imported from \
+             lab/roll.csv): replaced"
+        );
+        assert_eq!(db.index.takes.len(), 4);
+        let replaced = &db.index.takes[2];
+        assert_eq!(
+            (replaced.file.as_str(), replaced.source.as_str()),
+            ("takes/roll-2.tmot", "/copy/roll.csv")
+        );
+        assert_eq!(db.takes[2].tips[0][0], Some(DVec3::splat(5.0)));
+        let takes: Vec<usize> = db.index.units.iter().map(|u| u.take).collect();
+        assert_eq!(takes, [0, 0, 1, 1, 3, 3, 2, 2]);
     }
 
     /// Encoding then decoding keeps positions to 10 µm, rotations to 1e-5 and gaps as gaps.

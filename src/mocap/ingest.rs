@@ -368,6 +368,7 @@ pub fn ingest(
         rate_hz: take.rate_hz,
         performer: options.performer.clone(),
         source: path.display().to_string(),
+        source_sha256: None,
     });
     db.takes.push(TakeData {
         rate_hz: take.rate_hz,

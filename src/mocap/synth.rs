@@ -498,6 +498,7 @@ impl Performer {
                             rate_hz: config.rate_hz,
                             performer: "synthetic".into(),
                             source: "synthetic".into(),
+                            source_sha256: None,
                         });
                         takes.push(synth.data);
                     }

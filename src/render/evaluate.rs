@@ -599,6 +599,7 @@ mod tests {
             rate_hz,
             performer: "test".into(),
             source: "test".into(),
+            source_sha256: None,
         });
         db.takes.push(TakeData {
             rate_hz,
