@@ -356,6 +356,20 @@ pub(super) fn sample(
 /// Check that a data row has the header's `width` cells: fewer means the row was cut
 /// short; more is allowed only as empty cells (a trailing comma).
 pub(super) fn check_width(path: &Path, row: &Row, width: usize) -> Result<(), ImportError> {
+    let first = row.cell(0);
+    if row.cells.len() < width && !first.is_empty() && first.parse::<f64>().is_err() {
+        return Err(ImportError::format(
+            path,
+            format!("line {}", row.line),
+            format!(
+                "expected a data row, found one starting with \"{}\" ({} cells against the \
+                 header's {width}): another export pasted after this one? Import each take \
+                 from its own file",
+                shorten(first),
+                row.cells.len()
+            ),
+        ));
+    }
     if row.cells.len() < width {
         return Err(ImportError::format(
             path,
@@ -405,6 +419,17 @@ mod tests {
         assert!(check_width(Path::new("f"), &r, 3).is_ok());
         assert!(check_width(Path::new("f"), &r, 5).is_err());
         assert!(check_width(Path::new("f"), &r, 1).is_err());
+        let pasted = Row {
+            line: 56,
+            cells: split_cells("Format Version,1.23,Take Name,roll"),
+        };
+        let e = check_width(Path::new("f"), &pasted, 63)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("line 56") && e.contains("another export pasted"),
+            "{e}"
+        );
         assert_eq!(shorten("abc"), "abc");
         assert_eq!(shorten(&"é".repeat(50)).chars().count(), 41);
     }
