@@ -1266,3 +1266,42 @@ fn nan_is_a_gap_in_every_text_format() {
     assert_eq!(take.tracks[0].positions[4..6], [None, None]);
     nan_note(&take, 1);
 }
+
+/// A spreadsheet set to a European locale saves "CSV" with semicolons between cells and
+/// decimal commas: the Motive, Vicon and plain CSV fixtures so rewritten (CRLF line ends
+/// for one) read the same tracks and samples as the originals, with a note saying how they
+/// were read.
+#[test]
+fn european_csv_reads_as_the_same_export() {
+    let dir = std::env::temp_dir().join(format!("timpanist-euro-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for (rel, crlf) in [
+        ("motive/timpani_roll_250hz.csv", false),
+        ("vicon/timpani_strokes_100hz.csv", true),
+        ("csv/two_sticks_250hz.csv", false),
+    ] {
+        let original = load(rel);
+        let text = std::fs::read_to_string(fixture(rel)).unwrap();
+        let mut euro = text.replace(',', ";").replace('.', ",");
+        if crlf {
+            euro = euro.replace("\r\n", "\n").replace('\n', "\r\n");
+        }
+        let path = dir.join(Path::new(rel).file_name().unwrap());
+        std::fs::write(&path, euro).unwrap();
+        let read = import::read(&path, None).unwrap_or_else(|e| panic!("{rel}: {e}"));
+        assert_eq!(read.rate_hz, original.rate_hz, "{rel}");
+        assert_eq!(read.tracks.len(), original.tracks.len(), "{rel}");
+        for (a, b) in read.tracks.iter().zip(&original.tracks) {
+            assert_eq!(a.label, b.label, "{rel}");
+            assert_eq!(a.positions, b.positions, "{rel}: {}", a.label);
+            assert_eq!(a.rotations, b.rotations, "{rel}: {}", a.label);
+        }
+        assert!(
+            read.notes.iter().any(|n| n.contains("semicolons")),
+            "{rel}: {:?}",
+            read.notes
+        );
+        assert!(!original.notes.iter().any(|n| n.contains("semicolons")));
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

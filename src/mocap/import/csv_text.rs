@@ -11,6 +11,17 @@ use glam::DVec3;
 use std::borrow::Cow;
 use std::path::Path;
 
+/// A text capture written with semicolons between cells and decimal commas (what a
+/// spreadsheet set to a European locale saves as "CSV"), rewritten with commas between
+/// cells and decimal points; `None` for any other text (or bytes that are no UTF-8 text).
+/// Told by the first line holding either mark: more semicolons than commas there.
+pub(super) fn from_semicolons(bytes: &[u8]) -> Option<Vec<u8>> {
+    let text = std::str::from_utf8(bytes).ok()?;
+    let first = text.lines().find(|l| l.contains([';', ',']))?;
+    (first.matches(';').count() > first.matches(',').count())
+        .then(|| text.replace(',', ".").replace(';', ",").into_bytes())
+}
+
 /// One line of a CSV file split into cells.
 pub(super) struct Row<'a> {
     /// 1-based line number.

@@ -190,9 +190,16 @@ pub fn read_detecting(
     unit: Option<&str>,
 ) -> Result<(Take, Format), ImportError> {
     let (bytes, unit) = read_file(path, unit)?;
+    // A spreadsheet's European "CSV" (semicolons, decimal commas) is read as the same
+    // export written with commas.
+    let semicolons = (format != Some(Format::C3d)
+        && Format::guess(path, &bytes) != Some(Format::C3d))
+    .then(|| csv_text::from_semicolons(&bytes))
+    .flatten();
+    let bytes = semicolons.as_deref().unwrap_or(&bytes);
     let format = match format {
         Some(f) => f,
-        None => Format::guess(path, &bytes).ok_or_else(|| {
+        None => Format::guess(path, bytes).ok_or_else(|| {
             ImportError::format(
                 path,
                 "start of file",
@@ -204,7 +211,15 @@ pub fn read_detecting(
             )
         })?,
     };
-    Ok((read_bytes_with_unit(path, &bytes, format, unit)?, format))
+    let mut take = read_bytes_with_unit(path, bytes, format, unit)?;
+    if semicolons.is_some() {
+        take.notes.push(
+            "read with semicolons between cells and decimal commas (a spreadsheet's \
+             European CSV)"
+                .to_string(),
+        );
+    }
+    Ok((take, format))
 }
 
 /// Read a capture held in memory; `path` is only used for [`Take::source`] and errors.
