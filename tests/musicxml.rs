@@ -799,6 +799,279 @@ fn stopped_and_stickings() {
     );
 }
 
+// ---- trills ----
+
+/// A beat's tick, roll and damping.
+type Stroke = (u64, Option<Roll>, Option<u64>);
+
+/// The (tick, roll, damping) of every beat of `measures` and the import's notices.
+fn trills(measures: &[&str]) -> (Vec<Stroke>, Vec<String>) {
+    let (score, report) = run(&doc(measures));
+    let beats = (score.beats.iter())
+        .map(|b| (b.tick, b.roll, b.damp))
+        .collect();
+    (beats, report.notices)
+}
+
+/// A roll of 8 strokes per quarter (the unmeasured tremolo's) lasting `length_ticks`.
+fn free_roll(length_ticks: u64) -> Option<Roll> {
+    Some(Roll {
+        length_ticks,
+        strokes_per_quarter: 8,
+    })
+}
+
+/// `<tie>` and `<tied>` of these types, then `<type>` and the `<notations>` holding
+/// `ornaments` and `more`, in the order notation programs write them.
+fn tied(ties: &str, kind: &str, ornaments: &str, more: &str) -> String {
+    let tie: String = (ties.split(',').filter(|t| !t.is_empty()))
+        .map(|t| format!("<tie type=\"{t}\"/>"))
+        .collect();
+    let tied: String = (ties.split(',').filter(|t| !t.is_empty()))
+        .map(|t| format!("<tied type=\"{t}\"/>"))
+        .collect();
+    let ornaments = if ornaments.is_empty() {
+        String::new()
+    } else {
+        format!("<ornaments>{ornaments}</ornaments>")
+    };
+    format!(
+        "{tie}<voice>1</voice><type>{kind}</type><notations>{tied}{ornaments}{more}</notations>"
+    )
+}
+
+/// A `<wavy-line>` of this type, number 1.
+fn wavy(kind: &str) -> String {
+    format!("<wavy-line type=\"{kind}\" number=\"1\"/>")
+}
+
+/// A first measure (in 4/4, 2 divisions) holding a whole D3 with `ornaments`, tied on.
+fn trilled_whole_d3(ornaments: &str) -> String {
+    format!(
+        "{}{}",
+        attrs(2),
+        note("D3", 8, &tied("start", "whole", ornaments, ""))
+    )
+}
+
+/// A trill mark is a roll at the unmeasured tremolo's rate for the note's tied length:
+/// with its wavy line starting on a whole note and stopping on the half note it is tied
+/// to over the bar line; alone on the first of three tied notes; with an accidental mark
+/// (the trill's upper note, nothing to a timpanist) on a quarter; alone on a quarter, and
+/// with its wavy line starting and stopping on that one quarter.
+#[test]
+fn trill_marks_are_rolls() {
+    let start = format!("<trill-mark placement=\"above\"/>{}", wavy("start"));
+    // Over the bar line: a whole note tied to a half, the line stopping on the half.
+    let (beats, notices) = trills(&[
+        &trilled_whole_d3(&start),
+        &format!(
+            "{}{}",
+            note("D3", 4, &tied("stop", "half", &wavy("stop"), "")),
+            rest(4)
+        ),
+    ]);
+    assert_eq!(beats, vec![(0, free_roll(5760), None)]);
+    assert!(
+        !notices
+            .iter()
+            .any(|n| n.contains("trill") || n.contains("wavy")),
+        "{notices:?}"
+    );
+    // The mark on the first note only, no line: the roll lasts all three tied notes.
+    let (beats, _) = trills(&[
+        &format!(
+            "{}{}{}",
+            attrs(2),
+            rest(4),
+            note("A2", 4, &tied("start", "half", "<trill-mark/>", ""))
+        ),
+        &note("A2", 8, &tied("stop,start", "whole", "", "")),
+        &format!(
+            "{}{}",
+            note("A2", 2, &tied("stop", "quarter", "", "")),
+            rest(6)
+        ),
+    ]);
+    assert_eq!(beats, vec![(1920, free_roll(6720), None)]);
+    // A trill with an accidental mark, a trill alone, a trill with its line on one
+    // quarter, then a plain quarter: three one-quarter rolls and a stroke.
+    let (beats, notices) = trills(&[&format!(
+        "{}{}{}{}{}",
+        attrs(2),
+        note(
+            "F3",
+            2,
+            &tied(
+                "",
+                "quarter",
+                "<trill-mark/><accidental-mark>flat</accidental-mark>",
+                ""
+            )
+        ),
+        note("D3", 2, &tied("", "quarter", "<trill-mark/>", "")),
+        note(
+            "A2",
+            2,
+            &tied("", "quarter", &format!("{start}{}", wavy("stop")), "")
+        ),
+        note("D3", 2, "<voice>1</voice><type>quarter</type>"),
+    )]);
+    assert_eq!(
+        beats,
+        vec![
+            (0, free_roll(960), None),
+            (960, free_roll(960), None),
+            (1920, free_roll(960), None),
+            (2880, None, None)
+        ]
+    );
+    assert!(
+        !notices
+            .iter()
+            .any(|n| n.contains("trill") || n.contains("wavy")),
+        "{notices:?}"
+    );
+}
+
+/// A wavy line stopping on the middle of three tied notes ends the roll there (the last
+/// note rings on, here damped when it ends); a line stopping on the next note after the
+/// roll is the roll's end, silently; one running on over later notes ends the roll with
+/// its tied notes, the notes under the rest of the line read as written, and says so.
+#[test]
+fn trill_wavy_lines_stop() {
+    let start = format!("<trill-mark/>{}", wavy("start"));
+    let (beats, notices) = trills(&[
+        &trilled_whole_d3(&start),
+        &note("D3", 8, &tied("stop,start", "whole", &wavy("stop"), "")),
+        &format!(
+            "{}{}",
+            note(
+                "D3",
+                4,
+                &tied("stop", "half", "", "<technical><stopped/></technical>")
+            ),
+            rest(4)
+        ),
+    ]);
+    assert_eq!(beats, vec![(0, free_roll(7680), Some(1920))]);
+    assert!(!notices.iter().any(|n| n.contains("wavy")), "{notices:?}");
+    let (beats, notices) = trills(&[&format!(
+        "{}{}{}{}{}",
+        attrs(2),
+        note("A2", 2, &tied("", "quarter", &start, "")),
+        note("D3", 2, &tied("", "quarter", &wavy("stop"), "")),
+        note("A2", 2, &tied("", "quarter", &start, "")),
+        note("D3", 4, &tied("", "half", &wavy("stop"), "")),
+    )]);
+    assert_eq!(
+        beats,
+        vec![
+            (0, free_roll(960), None),
+            (960, None, None),
+            (1920, free_roll(960), None),
+            (2880, None, None)
+        ]
+    );
+    assert!(!notices.iter().any(|n| n.contains("wavy")), "{notices:?}");
+    let (beats, notices) = trills(&[&format!(
+        "{}{}{}{}",
+        attrs(2),
+        note("A2", 2, &tied("", "quarter", &start, "")),
+        note("D3", 2, "<voice>1</voice><type>quarter</type>"),
+        note("F3", 4, &tied("", "half", &wavy("stop"), "")),
+    )]);
+    assert_eq!(
+        beats,
+        vec![
+            (0, free_roll(960), None),
+            (960, None, None),
+            (1920, None, None)
+        ]
+    );
+    let all = notices.join("\n");
+    assert!(
+        all.contains(
+            "a trill's wavy line runs on past the notes tied to its trilled note: the roll ends with them, the notes under the rest of the line are played as written (measure 1)"
+        ),
+        "{all}"
+    );
+}
+
+/// A wavy line whose stop never comes: the roll lasts the trilled note's tied notes, and
+/// a note says so.
+#[test]
+fn trill_wavy_line_never_stopping() {
+    let start = "<trill-mark/><wavy-line type=\"start\" number=\"1\"/>";
+    let (beats, notices) = trills(&[
+        &format!(
+            "{}{}{}",
+            attrs(2),
+            rest(4),
+            note("F3", 4, &tied("start", "half", start, ""))
+        ),
+        &format!(
+            "{}{}{}",
+            note("F3", 2, &tied("stop", "quarter", "", "")),
+            note("F3", 2, "<voice>1</voice><type>quarter</type>"),
+            rest(4)
+        ),
+    ]);
+    assert_eq!(
+        beats,
+        vec![(1920, free_roll(2880), None), (4800, None, None)]
+    );
+    let all = notices.join("\n");
+    assert!(
+        all.contains(
+            "a trill's wavy line never stops: the roll ends with the notes tied to its trilled note (measure 1)"
+        ),
+        "{all}"
+    );
+}
+
+/// The test suite's trills: 32aa's `tr` on a quarter (its unmeasured tremolo a roll as
+/// before); 33a's trill on a quarter whose wavy line runs on over two more, untied, of the
+/// same pitch (they stay strokes, reported); 33f's on a sixteenth whose line runs on over a
+/// dotted quarter to a grace note after it.
+#[test]
+fn test_suite_trills() {
+    let kit = Kit::standard();
+    let dir = Path::new(DATA).join("musicxml-testsuite/xmlFiles");
+    let rolls = |name: &str| {
+        let opts = ImportOptions {
+            part: Some("P1".into()),
+            ..ImportOptions::default()
+        };
+        let (score, report) = import_file(&dir.join(name), &kit, &opts).unwrap();
+        assert!(score.problems(&kit).is_empty(), "{name}");
+        let tpq = u64::from(score.ticks_per_quarter);
+        let rolls: Vec<(u64, u64, u32)> = (score.beats.iter())
+            .filter_map(|b| {
+                let r = b.roll?;
+                Some((
+                    b.tick * 960 / tpq,
+                    r.length_ticks * 960 / tpq,
+                    r.strokes_per_quarter,
+                ))
+            })
+            .collect();
+        (rolls, report.notices.join("\n"))
+    };
+    let (got, notices) = rolls("32aa-Notations2_Ornaments.xml");
+    assert_eq!(got, vec![(0, 960, 8), (10560, 960, 8)], "{notices}");
+    assert!(!notices.contains("trill-mark"), "{notices}");
+    let (got, notices) = rolls("33a-Spanners.xml");
+    assert_eq!(got, vec![(14400, 960, 8)], "{notices}");
+    assert!(
+        notices.contains("runs on past") && !notices.contains("trill-mark"),
+        "{notices}"
+    );
+    let (got, notices) = rolls("33f-Trill-EndingOnGraceNote.xml");
+    assert_eq!(got, vec![(1200, 240, 8)], "{notices}");
+    assert!(notices.contains("runs on past"), "{notices}");
+}
+
 // ---- choosing the part ----
 
 fn two_parts(first: &str, second: &str) -> String {

@@ -12,7 +12,9 @@
 //! as [`super::midi_import`] does (a drum tuned to the pitch, else the one idle longest;
 //! out-of-range pitches move by octaves). Measures play in performed order, repeats and
 //! volta endings expanded ([`repeats`]). Tremolo marks become rolls (a
-//! two-note tremolo: strokes alternating between its two notes), dynamics and hairpins
+//! two-note tremolo: strokes alternating between its two notes), and so do trill marks
+//! (at an unmeasured tremolo's rate, over the tied notes up to their wavy line's stop),
+//! dynamics and hairpins
 //! per-beat dynamics, articulations playing modes, `<stopped/>` damping when the note
 //! ends, `<other-technical>` R/L the hand, `<sound tempo>` and `<metronome>` — of every
 //! part, since tempo is the whole score's — the tempo map (quarter notes per minute),
@@ -62,7 +64,8 @@ const MAX_TICKS_PER_QUARTER: u64 = 960 * 3 * 5 * 7 * 11 * 13;
 const DEFAULT_BPM: f64 = 120.0;
 /// Dynamic before the first marking (MIDI velocity of mf).
 const DEFAULT_VELOCITY: f64 = 80.0;
-/// Strokes per quarter note of an unmeasured tremolo (a free roll), as three marks.
+/// Strokes per quarter note of an unmeasured tremolo or a trill (a free roll), as three
+/// marks.
 const UNMEASURED_STROKES_PER_QUARTER: u32 = 8;
 /// General MIDI program of the timpani, counted from 1 as MusicXML does.
 const GM_TIMPANI_1: u32 = 48;

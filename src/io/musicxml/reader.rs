@@ -1,7 +1,8 @@
 //! Reading the chosen part, measure by measure in performed order: its sounding notes
-//! (ties joined, grace and cue notes left out), tremolos as rolls, articulations as
-//! playing modes, dynamics and hairpins, hands, damping, tempo marks and measure lengths,
-//! with everything read but not performed reported.
+//! (ties joined, grace and cue notes left out), tremolos and trills as rolls (a trill's
+//! wavy line ending it), articulations as playing modes, dynamics and hairpins, hands,
+//! damping, tempo marks and measure lengths, with everything read but not performed
+//! reported.
 
 use super::*;
 
@@ -17,8 +18,10 @@ pub(super) struct XNote {
     /// Strokes per quarter of a tremolo; the roll's length is the note's.
     pub(super) strokes: Option<u32>,
     /// The end of the last tied note that carries the tremolo (a damped roll's tremolo
-    /// may stop before its tied notes do).
+    /// may stop before its tied notes do), or that a trill's wavy line reaches.
     pub(super) roll_end: u64,
+    /// A trill mark, read as a roll.
+    pub(super) trill: Option<Trill>,
     /// Marked `<stopped/>`: the hand damps the head when the (tied) note ends.
     pub(super) damped: bool,
     /// Half of a two-note tremolo.
@@ -26,6 +29,36 @@ pub(super) struct XNote {
     pub(super) roll: Option<Roll>,
     /// Ticks from the last stroke to the damping touch.
     pub(super) damp: Option<u64>,
+}
+
+/// How far a trill's roll reaches over the notes tied to its note.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Trill {
+    /// Over every tied note: no wavy line, or one not stopped yet.
+    Tied,
+    /// Its wavy line stopped: to `roll_end`, the end of the note it stopped on.
+    Stopped,
+}
+
+/// A trill's wavy line waiting for its stop.
+pub(super) struct TrillLine {
+    /// The line's `number` ("1" when there is none).
+    number: String,
+    /// The trilled note (an index into the notes read).
+    note: usize,
+    /// Where it starts ("measure 3").
+    place: String,
+}
+
+/// What a written note is to the sounding notes, for its wavy lines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Written {
+    /// A grace note: no time, no sounding note.
+    Grace,
+    /// A later note of a tie, lengthening the sounding note at this index.
+    Tied(usize),
+    /// A new sounding note at this index, with a trill mark or not.
+    New(usize, bool),
 }
 
 /// A note's part in a two-note tremolo.
@@ -43,6 +76,8 @@ pub(super) struct NoteMarks {
     pub(super) hand: Hand,
     pub(super) damped: bool,
     pub(super) two_note: Option<TwoNote>,
+    /// A `<trill-mark>`: a roll at the unmeasured tremolo's rate unless a tremolo says.
+    pub(super) trill: bool,
 }
 
 /// A measure as read: where it starts, how long it is, its written time signature.
@@ -91,6 +126,8 @@ pub(super) struct PartReader<'a, 'd> {
     pub(super) notices: Notices,
     /// Open ties: (pitch, note index).
     pub(super) ties: Vec<(u8, usize)>,
+    /// Trills' wavy lines not stopped yet.
+    pub(super) trill_lines: Vec<TrillLine>,
     pub(super) rounded: bool,
     /// The time signature in force.
     pub(super) signature: Option<(u32, u32)>,
@@ -161,6 +198,7 @@ impl<'a, 'd> PartReader<'a, 'd> {
             dynamics: Vec::new(),
             notices: Notices::default(),
             ties: Vec::new(),
+            trill_lines: Vec::new(),
             rounded: false,
             signature: None,
         }
@@ -278,11 +316,22 @@ impl<'a, 'd> PartReader<'a, 'd> {
                 implicit: m.attribute("implicit") == Some("yes"),
             });
         }
+        for line in std::mem::take(&mut self.trill_lines) {
+            self.notices.add(
+                "a trill's wavy line never stops: the roll ends with the notes tied to its trilled note",
+                &line.place,
+            );
+        }
         self.notes = two_note_tremolos(std::mem::take(&mut self.notes), self.tpq);
         let max_damp = crate::score::validate::MAX_DAMP_QUARTERS * self.tpq;
         for n in &mut self.notes {
-            // A damped roll's tremolo may stop before its tied notes do.
-            let roll_end = if n.damped { n.roll_end } else { n.end };
+            // A damped roll's tremolo may stop before its tied notes do, a trill where
+            // its wavy line stops.
+            let roll_end = if n.damped || n.trill.is_some() {
+                n.roll_end
+            } else {
+                n.end
+            };
             n.roll = n.strokes.and_then(|spq| {
                 (roll_end > n.tick).then_some(Roll {
                     length_ticks: roll_end - n.tick,
@@ -318,6 +367,8 @@ impl<'a, 'd> PartReader<'a, 'd> {
                     if grace {
                         self.notices
                             .add("grace note: skipped (grace notes take no time)", &place);
+                        // A trill's wavy line may stop on a grace note after it.
+                        self.wavy_lines(el, at(note_start), Written::Grace, &place);
                         continue;
                     }
                     if !chord {
@@ -534,13 +585,15 @@ impl<'a, 'd> PartReader<'a, 'd> {
                 let i = self.ties[k].1;
                 self.notes[i].end = self.notes[i].end.max(tick + duration);
                 let rolled = has_mark(el, "ornaments", "tremolo");
-                if rolled && self.notes[i].strokes.is_some() {
+                let trilled = self.notes[i].trill == Some(Trill::Tied);
+                if (rolled || trilled) && self.notes[i].strokes.is_some() {
                     self.notes[i].roll_end = self.notes[i].end;
                 }
                 self.notes[i].damped |= has_mark(el, "technical", "stopped");
                 if !tie_start {
                     self.ties.remove(k);
                 }
+                self.wavy_lines(el, tick, Written::Tied(i), &place);
                 return Ok(());
             }
             self.notices.add(
@@ -558,14 +611,17 @@ impl<'a, 'd> PartReader<'a, 'd> {
             hand: marks.hand,
             strokes: marks.strokes,
             roll_end: tick + duration,
+            trill: marks.trill.then_some(Trill::Tied),
             damped: marks.damped,
             two_note: marks.two_note,
             roll: None,
             damp: None,
         });
+        let index = self.notes.len() - 1;
         if tie_start {
-            self.ties.push((pitch, self.notes.len() - 1));
+            self.ties.push((pitch, index));
         }
+        self.wavy_lines(el, tick, Written::New(index, marks.trill), &place);
         Ok(())
     }
 
@@ -653,7 +709,7 @@ impl<'a, 'd> PartReader<'a, 'd> {
         let mut marks: Vec<PlayingMode> = Vec::new();
         let mut strokes = None;
         let mut two_note = None;
-        let (mut hand, mut damped) = (Hand::Auto, false);
+        let (mut hand, mut damped, mut trill) = (Hand::Auto, false, false);
         for notations in el.children().filter(|c| c.has_tag_name("notations")) {
             for n in notations.children().filter(Node::is_element) {
                 match n.tag_name().name() {
@@ -683,7 +739,11 @@ impl<'a, 'd> PartReader<'a, 'd> {
                                     Some("stop") => two_note = Some(TwoNote::Stop),
                                     _ => strokes = self.tremolo(o, place).or(strokes),
                                 }
-                            } else if !o.has_tag_name("accidental-mark") {
+                            } else if o.has_tag_name("trill-mark") {
+                                trill = true;
+                            } else if !o.has_tag_name("accidental-mark")
+                                && !o.has_tag_name("wavy-line")
+                            {
                                 self.notices.add(
                                     format!("ornament <{}>: not performed", o.tag_name().name()),
                                     place,
@@ -726,12 +786,73 @@ impl<'a, 'd> PartReader<'a, 'd> {
             .into_iter()
             .min_by_key(rank)
             .unwrap_or(PlayingMode::Legato);
+        // A trill is a free roll: the unmeasured tremolo's.
+        if trill {
+            strokes = strokes.or(Some(free_roll_strokes()));
+        }
         NoteMarks {
             mode,
             strokes,
             hand,
             damped,
             two_note,
+            trill,
+        }
+    }
+
+    /// The `<wavy-line>`s of the written note `el` at `tick`, in the order written (a stop
+    /// and a start of the same number on one note end one line and begin the next). A
+    /// line starting on a trilled note is the trill's: its stop on the same note or a note
+    /// tied to it ends the roll with that note; a stop on the note (or grace note) right
+    /// after the tied notes is their end; a stop on a later note ends the roll with the
+    /// tied notes too, and is reported. A line on a new note without a trill mark is
+    /// reported as not performed.
+    fn wavy_lines(&mut self, el: Node, tick: u64, written: Written, place: &str) {
+        let lines = el
+            .children()
+            .filter(|c| c.has_tag_name("notations"))
+            .flat_map(|n| n.children().filter(|c| c.has_tag_name("ornaments")))
+            .flat_map(|o| o.children().filter(|c| c.has_tag_name("wavy-line")));
+        for w in lines {
+            let number = w.attribute("number").unwrap_or("1").to_string();
+            let open = self.trill_lines.iter().position(|l| l.number == number);
+            match (w.attribute("type"), written, open) {
+                (Some("start"), Written::New(note, true), _) => {
+                    self.trill_lines.retain(|l| l.number != number);
+                    self.trill_lines.push(TrillLine {
+                        number,
+                        note,
+                        place: place.to_string(),
+                    });
+                }
+                (Some("stop"), _, Some(k)) => {
+                    let line = self.trill_lines.remove(k);
+                    let on = match written {
+                        Written::Tied(i) | Written::New(i, _) => Some(i),
+                        Written::Grace => None,
+                    };
+                    self.end_trill(line, tick, on);
+                }
+                (Some("start" | "stop"), Written::New(..), _) => self
+                    .notices
+                    .add("ornament <wavy-line>: not performed", place),
+                _ => {}
+            }
+        }
+    }
+
+    /// A trill's wavy line stops on a written note at `tick`, part of the sounding note
+    /// `on` (none: a grace note).
+    fn end_trill(&mut self, line: TrillLine, tick: u64, on: Option<usize>) {
+        let n = &mut self.notes[line.note];
+        n.trill = Some(Trill::Stopped);
+        if on == Some(line.note) {
+            n.roll_end = n.end;
+        } else if tick > n.roll_end {
+            self.notices.add(
+                "a trill's wavy line runs on past the notes tied to its trilled note: the roll ends with them, the notes under the rest of the line are played as written",
+                &line.place,
+            );
         }
     }
 
@@ -746,11 +867,11 @@ impl<'a, 'd> PartReader<'a, 'd> {
                         format!("tremolo with {marks} marks: read as an unmeasured roll"),
                         place,
                     );
-                    return Some(UNMEASURED_STROKES_PER_QUARTER);
+                    return Some(free_roll_strokes());
                 }
                 Some(1 << marks)
             }
-            "unmeasured" => Some(UNMEASURED_STROKES_PER_QUARTER),
+            "unmeasured" => Some(free_roll_strokes()),
             _ => None,
         }
     }
@@ -914,6 +1035,11 @@ impl<'a, 'd> PartReader<'a, 'd> {
     }
 }
 
+/// Strokes per quarter of a free roll: an unmeasured tremolo, or a trill.
+pub(super) fn free_roll_strokes() -> u32 {
+    UNMEASURED_STROKES_PER_QUARTER
+}
+
 /// Whether `note` has the notation `<notations><group><name>` (e.g. technical, stopped).
 pub(super) fn has_mark(note: Node, group: &str, name: &str) -> bool {
     note.children()
@@ -980,6 +1106,7 @@ pub(super) fn alternate(a: &XNote, b: &XNote, spq: u32, tpq: u64) -> Vec<XNote> 
                 hand: if first { from.hand } else { Hand::Auto },
                 strokes: None,
                 roll_end: tick,
+                trill: None,
                 damped: false,
                 two_note: None,
                 roll: None,
