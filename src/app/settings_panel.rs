@@ -129,7 +129,7 @@ pub fn show(ui: &mut egui::Ui, doc: &LoadedScore, out: &mut Vec<Command>) {
                 &mut after.room,
                 &[
                     (Room::Dry, "dry (the heads alone)"),
-                    (Room::Studio, "studio (T60 0.7 s)"),
+                    (Room::Studio, "studio (T60 0.5 s, close microphones)"),
                     (Room::Hall, "concert hall (T60 2.2 s)"),
                 ],
             );

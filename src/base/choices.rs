@@ -174,7 +174,8 @@ pub enum Room {
     /// The direct sound alone.
     #[default]
     Dry,
-    /// A small recording studio (T60 0.7 s at low frequencies), microphones at 1.5 m.
+    /// A recording studio (T60 0.52 s at low frequencies), spot microphones 0.5 m from
+    /// the heads.
     Studio,
     /// A concert hall (T60 2.2 s at low frequencies), microphones at 3 m.
     Hall,

@@ -64,12 +64,12 @@ impl Acoustics {
     pub fn of(room: Room) -> Option<Acoustics> {
         match room {
             Room::Dry => None,
-            // A small recording studio, the microphones close.
+            // A recording studio's live room, spot microphones 0.5 m over the heads.
             Room::Studio => Some(Acoustics {
                 volume_m3: 400.0,
-                t60_low_s: 0.7,
+                t60_low_s: 0.52,
                 t60_high_s: 0.15,
-                microphone_m: 1.5,
+                microphone_m: 0.5,
                 delays_s: (0.015, 0.050),
             }),
             // A concert hall, the microphones 3 m in front of the timpani.
@@ -147,21 +147,28 @@ fn hadamard_row(r: usize) -> [f32; LINES] {
     })
 }
 
+/// One stage of the fast Walsh–Hadamard transform: the butterflies `H` apart (a constant,
+/// so each stage unrolls into whole-register additions).
+#[inline(always)]
+fn butterflies<const H: usize>(x: &mut [f32; LINES]) {
+    for group in x.chunks_exact_mut(2 * H) {
+        let (a, b) = group.split_at_mut(H);
+        for (a, b) in a.iter_mut().zip(b) {
+            (*a, *b) = (*a + *b, *a - *b);
+        }
+    }
+}
+
 /// In place: the [`LINES`]-point Walsh–Hadamard transform scaled by 1/√[`LINES`]
-/// (orthogonal).
+/// (orthogonal). The stages act on different bits of the index, so their order is free.
 #[inline]
 fn hadamard(x: &mut [f32; LINES]) {
-    let mut h = 1;
-    while h < LINES {
-        for i in (0..LINES).step_by(2 * h) {
-            for j in i..i + h {
-                let (a, b) = (x[j], x[j + h]);
-                x[j] = a + b;
-                x[j + h] = a - b;
-            }
-        }
-        h *= 2;
-    }
+    const { assert!(LINES == 32) };
+    butterflies::<16>(x);
+    butterflies::<8>(x);
+    butterflies::<4>(x);
+    butterflies::<2>(x);
+    butterflies::<1>(x);
     let scale = 1.0 / (LINES as f32).sqrt();
     for v in x {
         *v *= scale;
@@ -180,43 +187,23 @@ struct Line {
 }
 
 impl Line {
-    /// The next `out.len()` samples out of the line into `out[k][i]`; the position stays
-    /// where they were read, for [`Line::write`].
-    fn read(&self, out: &mut [[f32; LINES]], i: usize) {
-        let mut at = self.position;
-        for frame in out.iter_mut() {
-            frame[i] = self.ring[at];
-            at += 1;
-            if at == self.ring.len() {
-                at = 0;
-            }
-        }
+    /// The next `out.len()` samples out of the line; the position stays where they were
+    /// read, for [`Line::write`].
+    fn read(&self, out: &mut [f32]) {
+        let first = out.len().min(self.ring.len() - self.position);
+        let (head, tail) = out.split_at_mut(first);
+        head.copy_from_slice(&self.ring[self.position..self.position + first]);
+        tail.copy_from_slice(&self.ring[..tail.len()]);
     }
 
-    /// Write `into[k][i]` into the line where the block was read, and move on.
-    fn write(&mut self, into: &[[f32; LINES]], i: usize) {
-        for frame in into {
-            self.ring[self.position] = frame[i];
-            self.position += 1;
-            if self.position == self.ring.len() {
-                self.position = 0;
-            }
-        }
+    /// Write `samples` into the line where the block was read, and move on.
+    fn write(&mut self, samples: &[f32]) {
+        let first = samples.len().min(self.ring.len() - self.position);
+        let (head, tail) = samples.split_at(first);
+        self.ring[self.position..self.position + first].copy_from_slice(head);
+        self.ring[..tail.len()].copy_from_slice(tail);
+        self.position = (self.position + samples.len()) % self.ring.len();
     }
-}
-
-/// Σ row·values over the lines, in eight partial sums (a sum taken in order would
-/// chain every addition on the last one).
-#[inline]
-fn dot(row: &[f32; LINES], values: &[f32; LINES]) -> f32 {
-    let mut lanes = [0.0f32; 8];
-    for (r, v) in row.chunks_exact(8).zip(values.chunks_exact(8)) {
-        for j in 0..8 {
-            lanes[j] += r[j] * v[j];
-        }
-    }
-    ((lanes[0] + lanes[4]) + (lanes[1] + lanes[5]))
-        + ((lanes[2] + lanes[6]) + (lanes[3] + lanes[7]))
 }
 
 /// The feedback delay network's coefficients and state.
@@ -227,10 +214,13 @@ struct Network {
     b0: [f32; LINES],
     a1: [f32; LINES],
     filtered: [f32; LINES],
-    /// How the left and right inputs enter the lines, and how the lines make the left and
-    /// right outputs (rows of the Hadamard matrix, scaled).
+    /// How the left and right inputs enter the lines: rows 3 and 5 of the Hadamard
+    /// matrix, scaled by 1/√[`LINES`].
     input: [[f32; LINES]; 2],
-    output: [[f32; LINES]; 2],
+    /// The output scale: the left output is row 1 of the Hadamard matrix over the lines'
+    /// filtered samples, the right row 2, each scaled by this and 1/√[`LINES`] — which
+    /// are elements 1 and 2 of the feedback's transform, times this.
+    wet: f32,
 }
 
 impl Network {
@@ -244,7 +234,7 @@ impl Network {
             (b0[i], a1[i]) = (b as f32, a as f32);
         }
         let norm = 1.0 / (LINES as f64).sqrt();
-        let scaled = |row: usize, by: f64| hadamard_row(row).map(|v| v * (by * norm) as f32);
+        let scaled = |row: usize| hadamard_row(row).map(|v| v * norm as f32);
         Network {
             lines: lengths
                 .iter()
@@ -256,36 +246,37 @@ impl Network {
             b0,
             a1,
             filtered: [0.0; LINES],
-            input: [scaled(3, 1.0), scaled(5, 1.0)],
-            output: [scaled(1, wet), scaled(2, wet)],
+            input: [scaled(3), scaled(5)],
+            wet: wet as f32,
         }
     }
 
     /// Run the network over `stereo` (interleaved), adding its reverberation to it, a
-    /// block at a time.
+    /// block at a time: each line's block read out whole, every frame's loss filters,
+    /// feedback transform and inputs across the lines at once, the block written back.
     fn run(&mut self, stereo: &mut [f32]) {
-        let mut frames = [[0.0f32; LINES]; BLOCK];
+        let mut blocks = vec![[0.0f32; BLOCK]; LINES];
         for block in stereo.chunks_mut(2 * BLOCK) {
-            let frames = &mut frames[..block.len() / 2];
-            for (i, line) in self.lines.iter().enumerate() {
-                line.read(frames, i);
+            let n = block.len() / 2;
+            for (line, out) in self.lines.iter().zip(blocks.iter_mut()) {
+                line.read(&mut out[..n]);
             }
-            for (frame, io) in frames.iter_mut().zip(block.chunks_exact_mut(2)) {
+            for (k, io) in block.chunks_exact_mut(2).enumerate() {
                 let (left, right) = (io[0], io[1]);
                 let (b0, a1) = (&self.b0, &self.a1);
-                for (((f, x), b), a) in self.filtered.iter_mut().zip(&*frame).zip(b0).zip(a1) {
-                    *f = b * x + a * *f;
+                for (i, f) in self.filtered.iter_mut().enumerate() {
+                    *f = b0[i] * blocks[i][k] + a1[i] * *f;
                 }
-                *frame = self.filtered;
-                io[0] += dot(&self.output[0], frame);
-                io[1] += dot(&self.output[1], frame);
-                hadamard(frame);
-                for ((y, l), r) in frame.iter_mut().zip(&self.input[0]).zip(&self.input[1]) {
-                    *y += l * left + r * right;
+                let mut frame = self.filtered;
+                hadamard(&mut frame);
+                io[0] += self.wet * frame[1];
+                io[1] += self.wet * frame[2];
+                for (i, y) in frame.iter().enumerate() {
+                    blocks[i][k] = y + self.input[0][i] * left + self.input[1][i] * right;
                 }
             }
-            for (i, line) in self.lines.iter_mut().enumerate() {
-                line.write(frames, i);
+            for (line, samples) in self.lines.iter_mut().zip(&blocks) {
+                line.write(&samples[..n]);
             }
         }
     }
