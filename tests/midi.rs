@@ -353,6 +353,99 @@ fn type_0_picks_the_timpani_channel() {
     );
 }
 
+/// A channel that changes program mid-track is the timpani part only while it is on
+/// program 48: the notes it plays on another program are left out and reported (how
+/// many, on which program, where the first is), in a type 0 file and in a type 1 file
+/// whose program changes are in another track than the notes; a channel that only
+/// switches to the timpani later is found too; `--track` keeps every note.
+#[test]
+fn programs_changed_mid_track() {
+    // Channel 4: timpani for bars 1-2 (8 quarters), a piano for bar 3 (4 notes), the
+    // timpani again for bar 4 (2 notes); channel 1 a busier piano throughout.
+    let mut all = vec![(0, program(0, 0)), (0, program(3, 47))];
+    all.extend(notes(0, 72, 0, 20));
+    all.extend(notes(3, 38, 0, 8));
+    all.push((3840, program(3, 0)));
+    all.extend(notes(3, 60, 3840, 4));
+    all.push((5760, program(3, 47)));
+    all.extend(notes(3, 45, 5760, 2));
+    let (score, report) = import_ok(
+        &smf(Format::SingleTrack, vec![all.clone()]),
+        &ImportOptions::default(),
+    );
+    assert!(
+        report.source.contains("channel 4") && report.source.contains("for 10 of its 14 notes"),
+        "{}",
+        report.source
+    );
+    assert_eq!((report.notes, score.beats.len()), (10, 10));
+    let left_out = report
+        .warnings
+        .iter()
+        .find(|w| w.contains("left out"))
+        .unwrap_or_else(|| panic!("{:?}", report.warnings));
+    for part in [
+        "4 notes of track 0 (no name), channel 4 were played on program 1",
+        "(the first at bar 3 beat 1)",
+        "--track 0",
+    ] {
+        assert!(left_out.contains(part), "{left_out}");
+    }
+    let kit = Kit::standard();
+    let pitches: Vec<u8> = (score.beats.iter())
+        .map(|b| b.sounding_pitch(&kit).0)
+        .collect();
+    assert_eq!(pitches, [vec![38; 8], vec![45; 2]].concat());
+
+    // The program changes in the conductor track, the notes in their own track.
+    let (changes, played): (Events, Events) = all.iter().cloned().partition(|(_, e)| {
+        matches!(
+            e,
+            TrackEventKind::Midi {
+                message: MidiMessage::ProgramChange { .. },
+                ..
+            }
+        )
+    });
+    let mut conductor = conductor();
+    conductor.extend(changes);
+    let (score, report) = import_ok(
+        &smf(Format::Parallel, vec![conductor, played]),
+        &ImportOptions::default(),
+    );
+    assert_eq!(score.beats.len(), 10, "{report:?}");
+    assert!(report.source.contains("track 1"), "{}", report.source);
+
+    // A channel on a piano that switches to the timpani at bar 2 is the part from there.
+    let mut late = vec![(0, program(2, 0))];
+    late.extend(notes(2, 60, 0, 4));
+    late.push((1920, program(2, 47)));
+    late.extend(notes(2, 43, 1920, 6));
+    let (score, report) = import_ok(
+        &smf(Format::SingleTrack, vec![late]),
+        &ImportOptions::default(),
+    );
+    assert!(report.source.contains("channel 3"), "{}", report.source);
+    assert_eq!(score.beats.len(), 6);
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("4 notes") && w.contains("bar 1 beat 1")),
+        "{:?}",
+        report.warnings
+    );
+
+    // --track reads the whole track, every program.
+    let options = ImportOptions {
+        track: Some(TrackChoice::Index(0)),
+        ..ImportOptions::default()
+    };
+    let (_, report) = import_ok(&smf(Format::SingleTrack, vec![all]), &options);
+    assert_eq!(report.notes, 34);
+    assert!(!report.warnings.iter().any(|w| w.contains("left out")));
+}
+
 /// With no timpani program or name, percussion keys on channel 10 are spread over the
 /// drums: the lower key on the lowest drum's tuning, the higher on the highest's.
 #[test]

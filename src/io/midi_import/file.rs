@@ -1,5 +1,5 @@
 //! The MIDI file's events as the import reads them: how it counts time ([`Clock`]), each
-//! track's name, notes and programs, the tempo and time-signature events of every track,
+//! track's name, notes and program changes, the tempo and time-signature events of every track,
 //! and timpanist data made fit for a score.
 
 use super::*;
@@ -53,8 +53,8 @@ pub(super) struct TrackInfo {
     /// The first instrument name (meta event FF 04).
     pub(super) instrument: String,
     pub(super) notes: Vec<Note>,
-    /// The first program change on each channel.
-    pub(super) programs: [Option<u8>; 16],
+    /// Every program change: (score tick, channel, program), in the track's order.
+    pub(super) program_changes: Vec<(u64, u8, u8)>,
 }
 
 /// The parts of a file the import uses.
@@ -109,8 +109,7 @@ pub(super) fn read_file(tracks: &[Vec<TrackEvent<'_>>], clock: &Clock) -> FileIn
                         });
                     }
                     MidiMessage::ProgramChange { program } => {
-                        let slot = &mut info.programs[usize::from(channel.as_int())];
-                        slot.get_or_insert(program.as_int());
+                        (info.program_changes).push((tick, channel.as_int(), program.as_int()));
                     }
                     _ => {}
                 },

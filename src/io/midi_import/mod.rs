@@ -2,7 +2,7 @@
 //! its notes into a score that a timpanist can play on a given kit.
 //!
 //! The part is the track (or, in a type 0 file, the channel) with General MIDI program 48
-//! "Timpani", else a track whose name or instrument name (meta event FF 04) names the
+//! "Timpani" (the notes it plays while on that program), else a track whose name or instrument name (meta event FF 04) names the
 //! timpani (`crate::base::instrument_name`, shared with MusicXML), else the percussion channel 10;
 //! `--track` overrides. Every distinct note becomes a beat on a drum whose range holds its
 //! pitch, chosen as a timpanist would (a drum already tuned to the pitch, else the one idle
@@ -227,12 +227,7 @@ pub fn import(
     let (source, chosen) =
         choose(path, &file, options).map_err(|e| damaged_instead(path, &file, &damage, e))?;
     let mut warnings: Vec<String> = damage.iter().map(|d| damage_text(&file, d)).collect();
-    let notes: Vec<Note> = file.tracks[chosen.track]
-        .notes
-        .iter()
-        .filter(|n| chosen.channel.is_none_or(|c| n.channel == c))
-        .cloned()
-        .collect();
+    let (notes, left_out) = part_notes(&file, &chosen);
     let note_count = notes.len();
     let tpq = clock.ticks_per_quarter();
     let mut notes = skip_roll_strokes(notes);
@@ -265,6 +260,9 @@ pub fn import(
     score.meter = meter_changes(&file.meters, tpq, &mut warnings);
     let meter = MeterMap::new(&score.meter, tpq);
     score.tempo = tempo_points(&file.tempos, &clock, &meter, &mut warnings);
+    if let Some(left_out) = left_out {
+        warnings.push(left_out.warning(&file, &chosen, &meter));
+    }
     score.beats = beats;
     score.sort_beats();
     trim_rolls(&mut score.beats);

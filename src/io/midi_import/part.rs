@@ -12,6 +12,9 @@ pub(super) struct Chosen {
     pub(super) channel: Option<u8>,
     /// Percussion keys (channel 10) rather than pitches.
     pub(super) percussion: bool,
+    /// Chosen for its program 48 "Timpani": only the notes played while the channel is
+    /// on that program are the part.
+    pub(super) timpani_program: bool,
 }
 
 /// Notes per channel of a track.
@@ -23,10 +26,48 @@ pub(super) fn channel_counts(track: &TrackInfo) -> BTreeMap<u8, usize> {
     counts
 }
 
-/// The program of `channel` in `track`, else the first set for it in any track.
-pub(super) fn program(file: &FileInfo, track: usize, channel: u8) -> Option<u8> {
-    let ch = usize::from(channel);
-    file.tracks[track].programs[ch].or_else(|| file.tracks.iter().find_map(|t| t.programs[ch]))
+/// When `channel` plays which program, as `track` hears it: (score tick, program) of each
+/// program change on that channel in `track`, else in every track (a file's tracks share
+/// its sixteen channels), in time order.
+pub(super) fn program_timeline(file: &FileInfo, track: usize, channel: u8) -> Vec<(u64, u8)> {
+    let on = |t: &TrackInfo| -> Vec<(u64, u8)> {
+        (t.program_changes.iter())
+            .filter(|c| c.1 == channel)
+            .map(|c| (c.0, c.2))
+            .collect()
+    };
+    let own = on(&file.tracks[track]);
+    if !own.is_empty() {
+        return own;
+    }
+    let mut all: Vec<(u64, u8)> = file.tracks.iter().flat_map(on).collect();
+    all.sort_by_key(|c| c.0);
+    all
+}
+
+/// The program a note at score `tick` plays on a channel with this `timeline`: the last
+/// change at or before it (one at the note's own tick is meant for it), else the first
+/// (files often set their programs just after their first notes); none if never set.
+pub(super) fn program_at(timeline: &[(u64, u8)], tick: u64) -> Option<u8> {
+    let i = timeline.partition_point(|c| c.0 <= tick);
+    timeline.get(i.saturating_sub(1)).map(|c| c.1)
+}
+
+/// "program 48", or "programs 48, 1" for a channel that changes (counted from 1), or "no
+/// program".
+fn programs_text(timeline: &[(u64, u8)]) -> String {
+    let mut programs: Vec<u8> = Vec::new();
+    for &(_, p) in timeline {
+        if programs.last() != Some(&p) {
+            programs.push(p);
+        }
+    }
+    let listed: Vec<String> = programs.iter().map(|p| (p + 1).to_string()).collect();
+    match listed.len() {
+        0 => "no program".into(),
+        1 => format!("program {}", listed[0]),
+        _ => format!("programs {}", listed.join(", ")),
+    }
 }
 
 /// "track 3 \"Timpani\"", or "track 0 (no name)".
@@ -53,8 +94,7 @@ pub(super) fn track_listing(file: &FileInfo) -> String {
         let parts: Vec<String> = counts
             .iter()
             .map(|(&ch, &n)| {
-                let prog = program(file, i, ch)
-                    .map_or_else(|| "no program".into(), |p| format!("program {}", p + 1));
+                let prog = programs_text(&program_timeline(file, i, ch));
                 format!("{n} notes on channel {} ({prog})", ch + 1)
             })
             .collect();
@@ -75,6 +115,7 @@ pub(super) fn choose(
         track,
         channel: None,
         percussion: false,
+        timpani_program: false,
     };
     if file.tracks.is_empty() {
         return Err(MidiError::NoTracks {
@@ -123,19 +164,33 @@ pub(super) fn choose(
     for (i, t) in file.tracks.iter().enumerate() {
         for (&ch, &n) in &channel_counts(t) {
             let label = format!("{}, channel {}", track_label(file, i), ch + 1);
-            let on = |percussion| Chosen {
+            let on = |percussion, timpani_program| Chosen {
                 track: i,
                 channel: Some(ch),
                 percussion,
+                timpani_program,
             };
             if ch == PERCUSSION_CHANNEL {
                 let why = format!(
                     "{label}: no timpani part, so the percussion keys are spread over the drums from low to high"
                 );
-                percussion.push((n, why, on(true)));
-            } else if program(file, i, ch) == Some(GM_TIMPANI) {
+                percussion.push((n, why, on(true, false)));
+                continue;
+            }
+            let timeline = program_timeline(file, i, ch);
+            let timpani = (t.notes.iter())
+                .filter(|note| note.channel == ch)
+                .filter(|note| program_at(&timeline, note.tick) == Some(GM_TIMPANI))
+                .count();
+            if timpani == n {
                 let why = format!("{label}: General MIDI program 48 \"Timpani\"");
-                by_program.push((n, why, on(false)));
+                by_program.push((n, why, on(false, true)));
+            } else if timpani > 0 {
+                let why = format!(
+                    "{label}: General MIDI program 48 \"Timpani\" for {timpani} of its {n} notes \
+                     (the channel changes program)"
+                );
+                by_program.push((timpani, why, on(false, true)));
             }
         }
         let named = [&t.name, &t.instrument]
@@ -202,4 +257,72 @@ pub(super) fn damaged_instead(
         damage: damage_text(file, first),
         choices,
     }
+}
+
+/// Notes of the chosen channel played while it was on another program than 48
+/// "Timpani", left out of a part chosen for that program.
+pub(super) struct LeftOut {
+    count: usize,
+    /// Score tick of the first.
+    first_tick: u64,
+    /// The programs they were played on, counted from 0, in order of first use.
+    programs: Vec<u8>,
+}
+
+impl LeftOut {
+    /// "12 notes of track 2 \"Perc\", channel 3 were played on program 10, not 48
+    /// \"Timpani\", and are left out (the first at bar 5 beat 1); --track 2 imports the
+    /// whole track".
+    pub(super) fn warning(&self, file: &FileInfo, chosen: &Chosen, meter: &MeterMap) -> String {
+        let programs: Vec<String> = self.programs.iter().map(|p| (p + 1).to_string()).collect();
+        let channel = chosen
+            .channel
+            .map_or(String::new(), |c| format!(", channel {}", c + 1));
+        format!(
+            "{} note{} of {}{channel} {} played on program {}, not 48 \"Timpani\", and {} left \
+             out (the first at {}); --track {} imports the whole track",
+            self.count,
+            if self.count == 1 { "" } else { "s" },
+            track_label(file, chosen.track),
+            if self.count == 1 { "was" } else { "were" },
+            programs.join(", "),
+            if self.count == 1 { "is" } else { "are" },
+            meter.position(self.first_tick),
+            chosen.track,
+        )
+    }
+}
+
+/// The chosen part's notes, and those of its channel left out because they were played
+/// on another program (a part chosen for its program 48 "Timpani" only).
+pub(super) fn part_notes(file: &FileInfo, chosen: &Chosen) -> (Vec<Note>, Option<LeftOut>) {
+    let track = &file.tracks[chosen.track];
+    let of_part = track
+        .notes
+        .iter()
+        .filter(|n| chosen.channel.is_none_or(|c| n.channel == c));
+    let (Some(channel), true) = (chosen.channel, chosen.timpani_program) else {
+        return (of_part.cloned().collect(), None);
+    };
+    let timeline = program_timeline(file, chosen.track, channel);
+    let mut left_out: Option<LeftOut> = None;
+    let mut notes = Vec::new();
+    for n in of_part {
+        // Never unset: the channel was chosen for a program change to 48.
+        match program_at(&timeline, n.tick) {
+            Some(GM_TIMPANI) | None => notes.push(n.clone()),
+            Some(program) => {
+                let out = left_out.get_or_insert(LeftOut {
+                    count: 0,
+                    first_tick: n.tick,
+                    programs: Vec::new(),
+                });
+                out.count += 1;
+                if !out.programs.contains(&program) {
+                    out.programs.push(program);
+                }
+            }
+        }
+    }
+    (notes, left_out)
 }
