@@ -13,7 +13,7 @@
 //! out-of-range pitches move by octaves). Measures play in performed order, repeats and
 //! volta endings expanded ([`repeats`]). Tremolo marks become rolls (a
 //! two-note tremolo: strokes alternating between its two notes), and so do trill marks
-//! (at an unmeasured tremolo's rate, over the tied notes up to their wavy line's stop),
+//! (at an unmeasured tremolo's rate, over the notes up to their wavy line's stop),
 //! dynamics and hairpins
 //! per-beat dynamics, articulations playing modes, `<stopped/>` damping when the note
 //! ends, `<other-technical>` R/L the hand, `<sound tempo>` and `<metronome>` — of every

@@ -45,7 +45,14 @@ pub(super) struct TrillLine {
     /// The line's `number` ("1" when there is none).
     number: String,
     /// The trilled note (an index into the notes read).
-    note: usize,
+    trilled: usize,
+    /// The last note under it so far, rolled: the trilled note, then each new note of its
+    /// voice under the line.
+    last: usize,
+    /// The new notes rolled because they are under the line.
+    under: Vec<usize>,
+    /// The trilled note's `<voice>` ("1" when there is none).
+    voice: String,
     /// Where it starts ("measure 3").
     place: String,
 }
@@ -317,6 +324,9 @@ impl<'a, 'd> PartReader<'a, 'd> {
             });
         }
         for line in std::mem::take(&mut self.trill_lines) {
+            for &j in &line.under {
+                self.unroll(j);
+            }
             self.notices.add(
                 "a trill's wavy line never stops: the roll ends with the notes tied to its trilled note",
                 &line.place,
@@ -802,12 +812,26 @@ impl<'a, 'd> PartReader<'a, 'd> {
 
     /// The `<wavy-line>`s of the written note `el` at `tick`, in the order written (a stop
     /// and a start of the same number on one note end one line and begin the next). A
-    /// line starting on a trilled note is the trill's: its stop on the same note or a note
-    /// tied to it ends the roll with that note; a stop on the note (or grace note) right
-    /// after the tied notes is their end; a stop on a later note ends the roll with the
-    /// tied notes too, and is reported. A line on a new note without a trill mark is
-    /// reported as not performed.
+    /// line starting on a trilled note is the trill's, and every new note of the trilled
+    /// note's voice under it is rolled too, at the trill's rate (each re-struck, as a
+    /// timpanist plays a roll over untied notes), unless it has a tremolo of its own: the
+    /// line's stop on the last of them or a note tied to it ends the roll with that note;
+    /// a stop on the note (or grace note) right after its tied notes is their end. A line
+    /// on a new note without a trill mark is reported as not performed.
     fn wavy_lines(&mut self, el: Node, tick: u64, written: Written, place: &str) {
+        if let Written::New(note, _) = written {
+            let voice = voice_of(el);
+            for line in &mut self.trill_lines {
+                if line.voice == voice {
+                    line.last = note;
+                    let n = &mut self.notes[note];
+                    if n.strokes.is_none() {
+                        (n.strokes, n.trill) = (Some(free_roll_strokes()), Some(Trill::Tied));
+                        line.under.push(note);
+                    }
+                }
+            }
+        }
         let lines = el
             .children()
             .filter(|c| c.has_tag_name("notations"))
@@ -821,17 +845,16 @@ impl<'a, 'd> PartReader<'a, 'd> {
                     self.trill_lines.retain(|l| l.number != number);
                     self.trill_lines.push(TrillLine {
                         number,
-                        note,
+                        trilled: note,
+                        last: note,
+                        under: Vec::new(),
+                        voice: voice_of(el),
                         place: place.to_string(),
                     });
                 }
                 (Some("stop"), _, Some(k)) => {
                     let line = self.trill_lines.remove(k);
-                    let on = match written {
-                        Written::Tied(i) | Written::New(i, _) => Some(i),
-                        Written::Grace => None,
-                    };
-                    self.end_trill(line, tick, on);
+                    self.end_trill(line, tick, written);
                 }
                 (Some("start" | "stop"), Written::New(..), _) => self
                     .notices
@@ -841,12 +864,27 @@ impl<'a, 'd> PartReader<'a, 'd> {
         }
     }
 
-    /// A trill's wavy line stops on a written note at `tick`, part of the sounding note
-    /// `on` (none: a grace note).
-    fn end_trill(&mut self, line: TrillLine, tick: u64, on: Option<usize>) {
-        let n = &mut self.notes[line.note];
+    /// A trill's wavy line stops on the `written` note at `tick`. On a new note after the
+    /// trilled one, the stop marks where the line ends: that note is not rolled for it (as
+    /// notation programs write a trill's stop on the note after it).
+    fn end_trill(&mut self, line: TrillLine, tick: u64, written: Written) {
+        let on = match written {
+            Written::New(j, _) if j != line.trilled => {
+                if line.under.last() == Some(&j) {
+                    self.unroll(j);
+                }
+                return;
+            }
+            Written::Tied(i) | Written::New(i, _) => Some(i),
+            Written::Grace => None,
+        };
+        let n = &mut self.notes[line.last];
+        if n.trill.is_none() {
+            // Its own tremolo, not the trill, sets how far its roll reaches.
+            return;
+        }
         n.trill = Some(Trill::Stopped);
-        if on == Some(line.note) {
+        if on == Some(line.last) {
             n.roll_end = n.end;
         } else if tick > n.roll_end {
             self.notices.add(
@@ -854,6 +892,12 @@ impl<'a, 'd> PartReader<'a, 'd> {
                 &line.place,
             );
         }
+    }
+
+    /// Note `j` is not rolled after all.
+    fn unroll(&mut self, j: usize) {
+        let n = &mut self.notes[j];
+        (n.strokes, n.trill) = (None, None);
     }
 
     /// A `<tremolo>`: single with n marks is 2^n strokes per quarter (1 mark eighths, 3
@@ -1033,6 +1077,14 @@ impl<'a, 'd> PartReader<'a, 'd> {
             }
         }
     }
+}
+
+/// The `<voice>` of the written note `el` ("1" when it has none).
+fn voice_of(el: Node) -> String {
+    (el.children().find(|c| c.has_tag_name("voice")))
+        .and_then(|v| v.text())
+        .map_or("1", str::trim)
+        .to_string()
 }
 
 /// Strokes per quarter of a free roll: an unmeasured tremolo, or a trill.
