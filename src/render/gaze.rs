@@ -25,7 +25,11 @@ const TOGETHER_S: f64 = 0.01;
 
 /// The point looked at per composition sample (m, performer frame).
 pub fn gaze_points(comp: &Composition) -> Vec<DVec3> {
-    let looks = looks(comp);
+    gaze_points_at(&looks(comp), comp)
+}
+
+/// [`gaze_points`] of the [`looks`] of `comp`.
+pub fn gaze_points_at(looks: &[(f64, DVec3)], comp: &Composition) -> Vec<DVec3> {
     if looks.is_empty() {
         return vec![DVec3::new(0.0, 0.7, 0.8); comp.len()];
     }
@@ -87,7 +91,7 @@ fn moving_average(values: &[DVec3], half: usize) -> Vec<DVec3> {
 
 /// The points to look at and when they are struck (score s), in time order: each stroke's
 /// point on its head, strokes struck together merged into their mean.
-fn looks(comp: &Composition) -> Vec<(f64, DVec3)> {
+pub fn looks(comp: &Composition) -> Vec<(f64, DVec3)> {
     let mut strokes: Vec<(f64, DVec3)> =
         comp.strokes.iter().map(|s| (s.time_s, s.target)).collect();
     strokes.sort_by(|a, b| a.0.total_cmp(&b.0));

@@ -447,7 +447,8 @@ pub fn render_composition(
         lead_s: params.strike_lead_s,
         release: params.release,
     };
-    let mut targets = Targets::new(&composition, &shape, params.strike_depth_m);
+    let earlier = resume.as_ref().map(|r| &r.performance.targets);
+    let mut targets = Targets::after(&composition, &shape, params.strike_depth_m, earlier);
     targets.lean_for(&skeleton, &composition);
     let run = Run {
         kit,
