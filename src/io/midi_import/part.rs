@@ -271,16 +271,17 @@ pub(super) struct LeftOut {
 
 impl LeftOut {
     /// "12 notes of track 2 \"Perc\", channel 3 were played on program 10, not 48
-    /// \"Timpani\", and are left out (the first at bar 5 beat 1); --track 2 imports the
-    /// whole track".
+    /// \"Timpani\", and are left out (the first at bar 5 beat 1); --track 2 imports them
+    /// too" (", with every other channel of the track" when it has notes on others).
     pub(super) fn warning(&self, file: &FileInfo, chosen: &Chosen, meter: &MeterMap) -> String {
         let programs: Vec<String> = self.programs.iter().map(|p| (p + 1).to_string()).collect();
         let channel = chosen
             .channel
             .map_or(String::new(), |c| format!(", channel {}", c + 1));
+        let others = channel_counts(&file.tracks[chosen.track]).len() > 1;
         format!(
             "{} note{} of {}{channel} {} played on program {}, not 48 \"Timpani\", and {} left \
-             out (the first at {}); --track {} imports the whole track",
+             out (the first at {}); --track {} imports them too{}",
             self.count,
             if self.count == 1 { "" } else { "s" },
             track_label(file, chosen.track),
@@ -289,6 +290,11 @@ impl LeftOut {
             if self.count == 1 { "is" } else { "are" },
             meter.position(self.first_tick),
             chosen.track,
+            if others {
+                ", with every other channel of the track"
+            } else {
+                ""
+            },
         )
     }
 }
