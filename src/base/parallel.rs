@@ -20,10 +20,15 @@ pub fn each<T: Send, R: Send>(
     })
 }
 
+/// The cores this process may run on (its CPU affinity: 1 under `taskset -c 0`).
+pub fn cores() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
 /// `f` of each item, the items split into one run of consecutive ones per available
 /// core, each run on a thread of its own; in order.
 pub fn chunked<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let cores = cores();
     let run = items.len().div_ceil(cores).max(1);
     std::thread::scope(|scope| {
         let f = &f;

@@ -669,7 +669,8 @@ impl Run<'_> {
     /// step that stops at a horizon once its last cluster is settled, resuming `sound`),
     /// so [`sound`](Self::sound) has only the rest left: the settled state and
     /// the sound's state to resume (bit for bit what it would be made in one go: the sound
-    /// resumes where its record first differs).
+    /// resumes where its record first differs). With one core (`base::parallel::cores`)
+    /// none is made beside the simulation.
     fn settle_sounding(
         &self,
         performance: &mut Performance,
@@ -711,10 +712,13 @@ impl Run<'_> {
             // The last cluster a step settles before its horizon (the editor's first step
             // after an edit: the edited stroke) is sounded at once, while the step goes
             // on to its horizon, so only that stretch is left to sound after it.
+            // On one core the sound made beside the simulation would only take turns with
+            // it: it is all made after it instead, the same bit for bit.
+            let beside = crate::base::parallel::cores() > 1;
             let mut settled = |p: &Performance, last: bool| {
                 let end_s = simulated_to_s(comp, p);
                 let due = if last { sent_s } else { sent_s + SOUND_AHEAD_S };
-                if model != SoundModel::Modal || end_s <= due {
+                if !beside || model != SoundModel::Modal || end_s <= due {
                     return;
                 }
                 sent_s = end_s;
