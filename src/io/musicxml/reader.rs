@@ -798,7 +798,7 @@ impl<'a, 'd> PartReader<'a, 'd> {
             .unwrap_or(PlayingMode::Legato);
         // A trill is a free roll: the unmeasured tremolo's.
         if trill {
-            strokes = strokes.or(Some(free_roll_strokes()));
+            strokes = strokes.or(Some(UNMEASURED_STROKES_PER_QUARTER));
         }
         NoteMarks {
             mode,
@@ -826,7 +826,8 @@ impl<'a, 'd> PartReader<'a, 'd> {
                     line.last = note;
                     let n = &mut self.notes[note];
                     if n.strokes.is_none() {
-                        (n.strokes, n.trill) = (Some(free_roll_strokes()), Some(Trill::Tied));
+                        (n.strokes, n.trill) =
+                            (Some(UNMEASURED_STROKES_PER_QUARTER), Some(Trill::Tied));
                         line.under.push(note);
                     }
                 }
@@ -911,11 +912,11 @@ impl<'a, 'd> PartReader<'a, 'd> {
                         format!("tremolo with {marks} marks: read as an unmeasured roll"),
                         place,
                     );
-                    return Some(free_roll_strokes());
+                    return Some(UNMEASURED_STROKES_PER_QUARTER);
                 }
                 Some(1 << marks)
             }
-            "unmeasured" => Some(free_roll_strokes()),
+            "unmeasured" => Some(UNMEASURED_STROKES_PER_QUARTER),
             _ => None,
         }
     }
@@ -1085,11 +1086,6 @@ fn voice_of(el: Node) -> String {
         .and_then(|v| v.text())
         .map_or("1", str::trim)
         .to_string()
-}
-
-/// Strokes per quarter of a free roll: an unmeasured tremolo, or a trill.
-pub(super) fn free_roll_strokes() -> u32 {
-    UNMEASURED_STROKES_PER_QUARTER
 }
 
 /// Whether `note` has the notation `<notations><group><name>` (e.g. technical, stopped).
