@@ -23,13 +23,9 @@ pub const TURN_S: f64 = 0.4;
 /// Strokes closer than this are looked at together, s.
 const TOGETHER_S: f64 = 0.01;
 
-/// The point looked at per composition sample (m, performer frame).
-pub fn gaze_points(comp: &Composition) -> Vec<DVec3> {
-    gaze_points_at(&looks(comp), comp)
-}
-
-/// [`gaze_points`] of the [`looks`] of `comp`.
-pub fn gaze_points_at(looks: &[(f64, DVec3)], comp: &Composition) -> Vec<DVec3> {
+/// The point looked at per composition sample (m, performer frame), from the [`looks`] of
+/// `comp`.
+pub fn gaze_points(looks: &[(f64, DVec3)], comp: &Composition) -> Vec<DVec3> {
     if looks.is_empty() {
         return vec![DVec3::new(0.0, 0.7, 0.8); comp.len()];
     }

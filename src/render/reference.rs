@@ -207,7 +207,7 @@ impl Targets {
             Some(e) if e.gaze_of == gaze_of && e.rate_hz == rate && e.gaze.len() == n => {
                 e.gaze.clone()
             }
-            _ => super::gaze::gaze_points_at(&gaze_of.0, comp),
+            _ => super::gaze::gaze_points(&gaze_of.0, comp),
         };
         let mut targets = Targets {
             rate_hz: rate,
