@@ -299,3 +299,33 @@ fn no_tracks_says_so() {
         "{err}"
     );
 }
+
+/// A meta event of the right length whose content is odd (a key signature of one byte
+/// where two belong) is skipped by its length: the tempo change after it in the
+/// conductor track is kept, with no damage reported.
+#[test]
+fn an_odd_meta_event_keeps_the_rest_of_its_track() {
+    // 100 bpm (600 000 µs), a one-byte key signature, then 60 bpm at tick 960.
+    let conductor: &[u8] =
+        b"\x00\xff\x51\x03\x09\x27\xc0\x00\xff\x59\x01\x00\x87\x40\xff\x51\x03\x0f\x42\x40\x00\xff\x2f\x00";
+    let dir = tempfile::tempdir().unwrap();
+    let mid = dir.path().join("keysig.mid");
+    std::fs::write(&mid, smf(&[conductor, TIMPANI], &[])).unwrap();
+    let out_path = dir.path().join("out.ron");
+    let out = timpanist(&[
+        "import-midi",
+        mid.to_str().unwrap(),
+        "-o",
+        out_path.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(!err.contains("damaged"), "{err}");
+    let score = LoadedScore::load(&out_path).unwrap().score;
+    let bpm: Vec<f64> = score.tempo.iter().map(|t| t.bpm).collect();
+    assert_eq!(bpm.len(), 2, "{:?}", score.tempo);
+    assert!(
+        (bpm[0] - 100.0).abs() < 0.01 && (bpm[1] - 60.0).abs() < 0.01,
+        "{bpm:?}"
+    );
+}

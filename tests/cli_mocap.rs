@@ -475,3 +475,68 @@ fn importing_the_same_take_again_replaces_it() {
         Some(format!("{sha}+{sha}"))
     );
 }
+
+/// The right tip of [`right_hand_legato`] as a plain CSV (`time_s,StickR_x,…`), each
+/// position multiplied by `scale` (1000: millimetres written where metres belong), with
+/// `spike` (frame, value) written in place of one x.
+fn plain_tip_csv(scale: f64, spike: Option<(usize, f64)>) -> String {
+    let db = right_hand_legato();
+    let take = &db.takes[0];
+    let mut csv = String::from("time_s,StickR_x,StickR_y,StickR_z\n");
+    for (f, p) in take.tips[1].iter().enumerate() {
+        let p = p.expect("the synthetic take has no gaps") * scale;
+        let x = spike.filter(|s| s.0 == f).map_or(p.x, |s| s.1);
+        writeln!(csv, "{:.6},{x},{},{}", f as f64 / take.rate_hz, p.y, p.z).unwrap();
+    }
+    csv
+}
+
+/// Millimetres in a file read as metres are refused, naming `--unit mm`, with nothing
+/// written; one absurd coordinate (a corrupt sample, 10^15 m) is read as a gap with a
+/// note, and the database written stays readable.
+#[test]
+fn a_wrong_unit_is_refused_and_an_absurd_sample_is_a_gap() {
+    let dir = tempfile::tempdir().unwrap();
+    let mm = dir.path().join("legato_mm.csv");
+    std::fs::write(&mm, plain_tip_csv(1000.0, None)).unwrap();
+    let db_dir = dir.path().join("db");
+    let import = |file: &Path, extra: &[&str]| {
+        let mut args = vec!["mocap", "import", file.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["-o", db_dir.to_str().unwrap()]);
+        timpanist(&args)
+    };
+    let out = import(&mm, &[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("legato_mm.csv") && err.contains("m/s") && err.contains("give --unit mm"),
+        "{err}"
+    );
+    assert!(!db_dir.exists());
+    let out = import(&mm, &["--unit", "mm"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+
+    let spiked = dir.path().join("legato_spike.csv");
+    std::fs::write(&spiked, plain_tip_csv(1.0, Some((400, 1e15)))).unwrap();
+    let out = import(&spiked, &[]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("1 sample more than 1000 km from the capture's origin read as gaps")
+            && err.contains("frame 401"),
+        "{err}"
+    );
+    let db = MotionDb::load(&db_dir).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(db.takes.len(), 2);
+    let out = timpanist(&["mocap", "stats", db_dir.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

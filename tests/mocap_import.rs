@@ -1305,3 +1305,70 @@ fn european_csv_reads_as_the_same_export() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Corrupt parameter records are refused, naming the place, not read past: a parameter
+/// whose dimensions make more data than its record holds (it would take the next
+/// records' bytes as its own), and an offset to the next record that points past the
+/// parameter section (a negative offset read unsigned, which would drop every parameter
+/// after it).
+#[test]
+fn c3d_corrupt_parameter_records_are_refused() {
+    let good = write_c3d(&counting_take(50));
+    let read = |bytes: &[u8]| {
+        import::read_bytes(Path::new("corrupt.c3d"), bytes, Format::C3d)
+            .map(|_| ())
+            .unwrap_err()
+            .to_string()
+    };
+    // POINT:SCALE: name, offset to the next record (2 bytes), type, dimension count.
+    let scale = param_at(&good, "SCALE") + 2 + "SCALE".len();
+    let mut bytes = good.clone();
+    bytes[scale + 3] = 1;
+    bytes[scale + 4] = 60;
+    let err = read(&bytes);
+    assert!(
+        err.contains("corrupt.c3d")
+            && err.contains("(parameter SCALE)")
+            && err.contains("run past"),
+        "{err}"
+    );
+    let mut bytes = good.clone();
+    bytes[scale..scale + 2].copy_from_slice(&(-6i16).to_le_bytes());
+    let err = read(&bytes);
+    assert!(
+        err.contains(&format!("byte {scale}")) && err.contains("points past the parameter section"),
+        "{err}"
+    );
+}
+
+/// Whatever the file says, a take's frame rate is one a capture can have, and a sample
+/// absurdly far from the origin (a corrupt value) is a gap with a note.
+#[test]
+fn an_absurd_rate_is_refused_and_an_absurd_sample_is_a_gap() {
+    let rows = |step: f64, x: &dyn Fn(usize) -> f64| {
+        let mut text = String::from("time_s,Tip_x,Tip_y,Tip_z\n");
+        for f in 0..20 {
+            text += &format!("{},{},0.1,0.8\n", f as f64 * step, x(f));
+        }
+        text
+    };
+    let fast = rows(1e-25, &|_| 0.2);
+    let err = import::read_bytes(Path::new("fast.csv"), fast.as_bytes(), Format::Csv)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("fast.csv: frame rate:") && err.contains("at most 100 kHz"),
+        "{err}"
+    );
+    let far = rows(0.004, &|f| if f == 7 { 3e7 } else { 0.2 });
+    let take = import::read_bytes(Path::new("far.csv"), far.as_bytes(), Format::Csv).unwrap();
+    assert_eq!(take.tracks[0].positions[7], None);
+    assert_eq!(take.tracks[0].positions[8], Some(DVec3::new(0.2, 0.1, 0.8)));
+    assert!(
+        take.notes
+            .iter()
+            .any(|n| n.contains("1 sample more than 1000 km") && n.contains("frame 8")),
+        "{:?}",
+        take.notes
+    );
+}

@@ -464,9 +464,30 @@ fn divisions_change() {
         note("D3", 3, ""),
         note("D3", 25, "")
     )]);
-    let (score, _) = run(&xml);
+    let (score, report) = run(&xml);
     assert_eq!(score.ticks_per_quarter, 6720);
     assert_eq!(score.beats[1].tick, 3 * 960);
+    assert!(
+        !report.notices.iter().any(|n| n.contains("<divisions>")),
+        "{:?}",
+        report.notices
+    );
+    // No <divisions> at all: read at one per quarter, and said, naming where.
+    let xml = doc(&[&format!(
+        "<attributes><time><beats>4</beats><beat-type>4</beat-type></time></attributes>{}{}",
+        note("D3", 2, ""),
+        note("D3", 2, "")
+    )]);
+    let (score, report) = run(&xml);
+    assert_eq!(score.beats[1].tick, 2 * 960);
+    assert!(
+        report
+            .notices
+            .iter()
+            .any(|n| n.contains("before any <divisions>") && n.contains("measure 1")),
+        "{:?}",
+        report.notices
+    );
 }
 
 /// Two voices through `<backup>` and `<forward>`: both are read; a unison written in

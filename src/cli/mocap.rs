@@ -7,8 +7,8 @@ use crate::kit::{Kit, Side};
 use crate::mocap::align::{self, Transform};
 use crate::mocap::db::MotionDb;
 use crate::mocap::db::side_index;
-use crate::mocap::import::Format;
 use crate::mocap::import::profile::CaptureProfile;
+use crate::mocap::import::{Format, LengthUnit};
 use crate::mocap::ingest::{
     Alignment, IngestOptions, IngestReport, UpAxis, hand_from_label, ingest,
 };
@@ -268,7 +268,7 @@ pub fn import(args: ImportArgs) -> anyhow::Result<()> {
             .notices
             .extend(db.settle_import(&source.path, &source.sha256));
         print_report(source, &report, &align);
-        refuse_if_strokeless(&source.path, &report)?;
+        refuse_if_strokeless(&source.path, &source.take, &report)?;
         if matches!(align, Alignment::None) {
             warn_if_off_the_kit(&source.path, &report);
         }
@@ -568,19 +568,69 @@ fn resolve_tips(
 
 /// A take none of whose sticks gave a stroke is not a stroke capture, or its sticks were
 /// taken from the wrong tracks: refuse it (before anything is written) naming them.
-fn refuse_if_strokeless(path: &Path, report: &IngestReport) -> anyhow::Result<()> {
+fn refuse_if_strokeless(path: &Path, take: &Take, report: &IngestReport) -> anyhow::Result<()> {
     if report.hands.iter().any(|h| h.units > 0) {
         return Ok(());
+    }
+    if take.frames == 0 {
+        anyhow::bail!(
+            "{}: the file holds no frames; nothing written",
+            path.display()
+        );
     }
     let taken: Vec<String> = report
         .hands
         .iter()
         .map(|h| format!("{:?} \"{}\"", h.hand, h.label))
         .collect();
+    let labels: Vec<&str> = report.hands.iter().map(|h| h.label.as_str()).collect();
     anyhow::bail!(
-        "{}: no strokes found on the tracks taken as sticks ({}); if they are not the sticks, name them with --tips LEFT,RIGHT; nothing written",
+        "{}: no strokes found on the tracks taken as sticks ({}); if they are not the sticks, name them with --tips LEFT,RIGHT{}; nothing written",
         path.display(),
-        taken.join(", ")
+        taken.join(", "),
+        unit_hint(take, &labels)
+    )
+}
+
+/// When the tracks labelled `labels` span a range no stroking stick does (under 2 cm or
+/// over 20 m along every axis, as read), the `--unit` that would give them a stick's
+/// 0.3 m (", or if …"); else nothing.
+fn unit_hint(take: &Take, labels: &[&str]) -> String {
+    let span = take
+        .tracks
+        .iter()
+        .filter(|t| labels.iter().any(|l| t.label.eq_ignore_ascii_case(l)))
+        .filter_map(|t| {
+            let seen: Vec<glam::DVec3> = t.positions.iter().flatten().copied().collect();
+            let lo = seen.iter().copied().reduce(glam::DVec3::min)?;
+            let hi = seen.iter().copied().reduce(glam::DVec3::max)?;
+            Some((hi - lo).max_element())
+        })
+        .fold(0.0f64, f64::max);
+    if span <= 0.0 || (0.02..=20.0).contains(&span) {
+        return String::new();
+    }
+    let Some(now) = LengthUnit::parse(&take.file_unit) else {
+        return String::new();
+    };
+    let better = [
+        LengthUnit::Millimetre,
+        LengthUnit::Centimetre,
+        LengthUnit::Metre,
+    ]
+    .into_iter()
+    .min_by(|a, b| {
+        let off = |u: &LengthUnit| (span * u.metres() / now.metres() / 0.3).ln().abs();
+        off(a).total_cmp(&off(b))
+    })
+    .unwrap_or(now);
+    if better == now {
+        return String::new();
+    }
+    format!(
+        ", or if its lengths are not in {} (the sticks move {span:.3} m in all as read), give --unit {}",
+        now.symbol(),
+        better.symbol()
     )
 }
 

@@ -320,14 +320,34 @@ impl MotionDb {
         })
     }
 
-    /// Write every sample file and then the index, each atomically.
+    /// Write every sample file and then the index, each atomically. Every sample file is
+    /// encoded and read back first: one that would not read back as its take is an error
+    /// before anything is written.
     pub fn save(&self, dir: &Path) -> Result<(), FileError> {
-        for (entry, data) in self.index.takes.iter().zip(&self.takes) {
-            let path = dir.join(&entry.file);
+        let encoded = self
+            .index
+            .takes
+            .iter()
+            .zip(&self.takes)
+            .map(|(entry, data)| {
+                let path = dir.join(&entry.file);
+                let bytes = encode_take(data);
+                let back = decode_take(&path, &bytes)?;
+                if back.frames() != data.frames() {
+                    return Err(FileError::invalid(
+                        &path,
+                        "encoding",
+                        format!("{} frames read back of {}", back.frames(), data.frames()),
+                    ));
+                }
+                Ok((path, bytes))
+            })
+            .collect::<Result<Vec<_>, FileError>>()?;
+        for (path, bytes) in encoded {
             if let Some(parent) = path.parent() {
                 std::fs::create_dir_all(parent).map_err(|e| FileError::io(parent, e))?;
             }
-            ron_file::write_atomic(&path, &encode_take(data))?;
+            ron_file::write_atomic(&path, &bytes)?;
         }
         ron_file::save(&dir.join("index.ron"), &self.index)
     }

@@ -184,6 +184,70 @@ struct Stick {
     loose_markers: bool,
 }
 
+/// The fastest median approach a take's strokes may have, m/s: timpanists' strokes
+/// reach 1.5–3.7 m/s (guide §5) and the fastest stick strokes about 15; a median past
+/// this is a length unit read wrongly (millimetres as metres make 2 m/s into 2 km/s).
+pub const MAX_MEDIAN_APPROACH_MPS: f64 = 40.0;
+
+/// Refuse a stick whose strokes descend impossibly fast (a wrong length unit), naming the
+/// unit that would put them among human strokes: the one that gives the tip's whole
+/// range of motion (`tip`) the half metre or so a stroking stick covers (the strokes
+/// found in a capture read a thousand times too large are few and odd, their speeds no
+/// guide).
+fn check_stroke_speeds(
+    path: &Path,
+    take: &Take,
+    label: &str,
+    tip: &[Option<DVec3>],
+    found: &[Impact],
+) -> Result<(), ImportError> {
+    let mut speeds: Vec<f64> = found
+        .iter()
+        .map(|i| i.approach_mps)
+        .filter(|v| v.is_finite())
+        .collect();
+    if speeds.is_empty() {
+        return Ok(());
+    }
+    speeds.sort_by(f64::total_cmp);
+    let median = speeds[speeds.len() / 2];
+    if median <= MAX_MEDIAN_APPROACH_MPS {
+        return Ok(());
+    }
+    let seen: Vec<DVec3> = tip.iter().flatten().copied().collect();
+    let span = match (
+        seen.iter().copied().reduce(DVec3::min),
+        seen.iter().copied().reduce(DVec3::max),
+    ) {
+        (Some(lo), Some(hi)) => (hi - lo).max_element(),
+        _ => median / 3.0,
+    };
+    // The factor (as read → metres) that brings the span nearest half a metre.
+    let (unit, _) = [("cm", 0.01), ("mm", 0.001)]
+        .into_iter()
+        .min_by(|a, b| {
+            let off = |f: f64| (span * f / 0.5).ln().abs();
+            off(a.1).total_cmp(&off(b.1))
+        })
+        .unwrap_or(("mm", 0.001));
+    let strokes = if speeds.len() == 1 {
+        "stroke descends"
+    } else {
+        "strokes descend"
+    };
+    Err(ImportError::format(
+        path,
+        format!("track \"{label}\""),
+        format!(
+            "its {} {strokes} at a median {median:.0} m/s (real strokes: 1–15 m/s) and \
+             it moves over {span:.0} m, so its lengths are not in {} as read: if the file is \
+             in {unit}, give --unit {unit}; nothing written",
+            speeds.len(),
+            take.file_unit,
+        ),
+    ))
+}
+
 /// Add `take` (read from `path`) to `db` as a new take file `takes/NAME.tmot`.
 pub fn ingest(
     db: &mut MotionDb,
@@ -258,6 +322,9 @@ pub fn ingest(
         .iter()
         .map(|s| segment(&s.tip, rate, &options.segment))
         .collect();
+    for (s, seg) in sticks.iter().zip(&segmentations) {
+        check_stroke_speeds(path, take, &s.label, &s.tip, &seg.found)?;
+    }
     let (transform, fits) = match &options.align {
         Alignment::None => (Transform::IDENTITY, Vec::new()),
         Alignment::Manual(t) => (*t, Vec::new()),
@@ -788,12 +855,21 @@ fn hand_from_name(name: &str) -> Option<Side> {
     let letters: String = name.chars().filter(char::is_ascii_alphabetic).collect();
     let (first, last) = (letters.chars().next()?, letters.chars().last()?);
     let upper = |c: char| side(c).filter(|_| c.is_ascii_uppercase());
+    // A leading L/R names the hand of a short label ("LSTK", "RFIN") or of one whose
+    // letters go on with a stick's name ("LSTICK", "RMALLET", "LSTK_TIP").
+    let names_stick = || {
+        let rest = letters[1..].to_ascii_lowercase();
+        STICK_WORDS.iter().any(|w| rest.starts_with(w))
+    };
     match (upper(last), upper(first)) {
         (Some(s), _) => Some(s),
-        (None, Some(s)) if letters.len() <= 5 => Some(s),
+        (None, Some(s)) if letters.len() <= 5 || names_stick() => Some(s),
         _ => None,
     }
 }
+
+/// What a stick's track is called after its hand's letter, lower case.
+const STICK_WORDS: [&str; 5] = ["stick", "stk", "mallet", "tip", "bead"];
 
 /// The words of a label: runs of letters split at anything else and at case changes
 /// ("R_STICK_tip2" → R, STICK, tip; "RStickTip" → R, Stick, Tip).
@@ -862,6 +938,12 @@ mod tests {
             ("Player:CLAV", None),
             ("LSTK1+LSTK2", Some(Side::Left)),
             ("LSTK1+RSTK2", None),
+            ("LSTICK", Some(Side::Left)),
+            ("RSTICK", Some(Side::Right)),
+            ("LMALLET", Some(Side::Left)),
+            ("LSTICKTIP", Some(Side::Left)),
+            ("RSTK_TIP", Some(Side::Right)),
+            ("LASIS", Some(Side::Left)),
         ];
         for (label, hand) in cases {
             assert_eq!(hand_from_label(label), hand, "{label}");

@@ -26,6 +26,15 @@ impl Track {
     }
 }
 
+/// The highest frame rate a capture may have, Hz (capture systems run at up to a few
+/// kHz; a rate past this is a corrupt header).
+pub const MAX_CAPTURE_RATE_HZ: f64 = 100_000.0;
+/// The farthest a sample may lie from a capture's origin along any axis, m; farther ones
+/// are read as gaps ([`Take::checked`]). Far past any lab, and past millimetres read as
+/// metres (which the strokes' speeds tell, `ingest`), but within what a take file stores
+/// to 10 µm.
+pub const MAX_COORDINATE_M: f64 = 1.0e6;
+
 /// A whole capture.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Take {
@@ -80,6 +89,48 @@ impl Take {
         };
         self.notes.extend(gaps.note());
         n
+    }
+
+    /// Check what every reader must hand on, whatever the file said: a frame rate
+    /// within (0, [`MAX_CAPTURE_RATE_HZ`]] (an error naming the rate otherwise); samples
+    /// farther than [`MAX_COORDINATE_M`] from the file's origin along any axis are read
+    /// as gaps, with a note (a corrupt value: no lab is that large, and such a value
+    /// cannot be stored).
+    pub fn checked(mut self) -> Result<Take, ImportError> {
+        if !(self.rate_hz > 0.0 && self.rate_hz <= MAX_CAPTURE_RATE_HZ) {
+            return Err(ImportError::format(
+                &self.source,
+                "frame rate",
+                format!(
+                    "{} Hz is not a capture's frame rate (expected above 0 and at most {} kHz)",
+                    self.rate_hz,
+                    MAX_CAPTURE_RATE_HZ / 1000.0
+                ),
+            ));
+        }
+        let mut far = 0;
+        let mut first: Option<(String, usize)> = None;
+        for t in &mut self.tracks {
+            for (f, p) in t.positions.iter_mut().enumerate() {
+                if p.is_some_and(|p| p.abs().max_element() > MAX_COORDINATE_M) {
+                    *p = None;
+                    if let Some(q) = t.rotations.get_mut(f) {
+                        *q = None;
+                    }
+                    far += 1;
+                    first.get_or_insert_with(|| (t.label.clone(), f + 1));
+                }
+            }
+        }
+        if let Some((label, frame)) = first {
+            let samples = if far == 1 { "sample" } else { "samples" };
+            self.notes.push(format!(
+                "{far} {samples} more than {} km from the capture's origin read as gaps (the \
+                 first: track \"{label}\", frame {frame}): a corrupt value",
+                MAX_COORDINATE_M / 1000.0
+            ));
+        }
+        Ok(self)
     }
 
     /// The 1-based places in file order of the tracks labelled like `track`

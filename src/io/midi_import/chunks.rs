@@ -10,7 +10,10 @@
 //! after it are read on from there; a channel message without a status byte right after
 //! a meta or system-exclusive event continues the running status from before it (the SMF
 //! specification says those events cancel running status, but writers rely on it and
-//! mido, among others, reads it so: the bytes can mean nothing else).
+//! mido, among others, reads it so: the bytes can mean nothing else); a meta event whose
+//! length is right but whose content midly will not read (a key signature of one byte)
+//! is kept as an unknown meta event, skipped by its length, so the rest of its track
+//! (often the whole tempo map) is not lost for it.
 
 use midly::{EventIter, MetaMessage, TrackEvent, TrackEventKind};
 
@@ -161,9 +164,21 @@ fn read_events(data: &[u8]) -> TrackRead<'_> {
                 iter = again;
             }
         }
-        let Some(Ok(event)) = event else {
-            read.bad = Some((pos, unreadable(&data[pos..], running)));
-            return read;
+        let event = match event {
+            Some(Ok(event)) => event,
+            _ => match odd_meta(&data[pos..]) {
+                // A meta event midly will not read (a key signature of one byte, say),
+                // whose length is right: kept as an unknown one, and reading goes on.
+                Some((event, len)) => {
+                    read.events.push(event);
+                    iter = EventIter::new(&data[pos + len..]);
+                    continue;
+                }
+                None => {
+                    read.bad = Some((pos, unreadable(&data[pos..], running)));
+                    return read;
+                }
+            },
         };
         if matches!(event.kind, TrackEventKind::Midi { .. }) {
             channel_status = iter.running_status();
@@ -202,6 +217,27 @@ fn bad_lengths(rest: &[u8]) -> Option<&'static str> {
         None if kind == "a meta event" => Some("a meta event cut short"),
         None => Some("a system-exclusive event cut short"),
     }
+}
+
+/// The meta event at the start of `rest` (delta time, 0xFF, type, length, data; its
+/// lengths already checked) as an unknown meta event, and the bytes it takes; `None` if
+/// `rest` does not start with a meta event or it is End of Track.
+fn odd_meta(rest: &[u8]) -> Option<(TrackEvent<'_>, usize)> {
+    let (delta, n) = varlen(rest)?;
+    let (&0xFF, &kind) = (rest.get(n)?, rest.get(n + 1)?) else {
+        return None;
+    };
+    if kind == 0x2F {
+        return None;
+    }
+    let (len, m) = varlen(rest.get(n + 2..)?)?;
+    let start = n + 2 + m;
+    let body = rest.get(start..start.checked_add(len)?)?;
+    let event = TrackEvent {
+        delta: u32::try_from(delta).ok()?.into(),
+        kind: TrackEventKind::Meta(MetaMessage::Unknown(kind, body)),
+    };
+    Some((event, start + len))
 }
 
 /// Why midly could not read the event at the start of `rest`, whose lengths are right

@@ -121,6 +121,9 @@ pub(super) struct PartReader<'a, 'd> {
     /// Only notes of this instrument (a part with several).
     pub(super) instrument: Option<String>,
     pub(super) divisions: f64,
+    /// Whether the part has said its `<divisions>` yet (before it does, 1 is assumed,
+    /// and the first duration read so says).
+    divisions_given: bool,
     /// Sounding pitch minus written pitch, semitones.
     pub(super) transpose: i32,
     pub(super) notes: Vec<XNote>,
@@ -197,6 +200,7 @@ impl<'a, 'd> PartReader<'a, 'd> {
             tpq,
             instrument,
             divisions: 1.0,
+            divisions_given: false,
             transpose: 0,
             notes: Vec::new(),
             measures: Vec::new(),
@@ -241,6 +245,15 @@ impl<'a, 'd> PartReader<'a, 'd> {
                     ),
                 )
             })?;
+        if !self.divisions_given && value > 0.0 {
+            // Said once: every later duration is read at the same assumed resolution.
+            self.divisions_given = true;
+            self.notices.add(
+                "a duration before any <divisions>: read at 1 division per quarter (if the \
+                 durations come out too long, the file lacks its <divisions>)",
+                &format!("measure {measure}"),
+            );
+        }
         let exact = value * self.tpq as f64 / self.divisions;
         if exact > 1e12 {
             return Err(self.invalid(
@@ -452,6 +465,7 @@ impl<'a, 'd> PartReader<'a, 'd> {
         for a in el.children().filter(Node::is_element) {
             match a.tag_name().name() {
                 "divisions" => {
+                    self.divisions_given = true;
                     let text = a.text().unwrap_or("").trim();
                     self.divisions = text
                         .parse::<f64>()

@@ -190,6 +190,10 @@ pub fn read_detecting(
     unit: Option<&str>,
 ) -> Result<(Take, Format), ImportError> {
     let (bytes, unit) = read_file(path, unit)?;
+    // A UTF-16 text export (Excel's "Unicode text") is read as the same text in UTF-8.
+    let utf16 = (bytes.starts_with(b"\xff\xfe") || bytes.starts_with(b"\xfe\xff"))
+        .then(|| csv_text::decode_text(&bytes).into_owned().into_bytes());
+    let bytes = utf16.unwrap_or(bytes);
     // A spreadsheet's European "CSV" (semicolons, decimal commas) is read as the same
     // export written with commas.
     let semicolons = (format != Some(Format::C3d)
@@ -240,7 +244,8 @@ pub fn read_bytes_with_unit(
         Format::Vicon => vicon::read(path, bytes, unit),
         Format::Csv => plain_csv::read(path, bytes, unit),
         Format::Trc => trc::read(path, bytes, unit),
-    }
+    }?
+    .checked()
 }
 
 /// Read a column-mapped text capture as `profile` describes it (see [`profile`] and
@@ -252,7 +257,7 @@ pub fn read_with_profile(
     unit: Option<&str>,
 ) -> Result<Take, ImportError> {
     let (bytes, unit) = read_file(path, unit)?;
-    table::read(path, &bytes, profile, unit)
+    table::read(path, &bytes, profile, unit)?.checked()
 }
 
 /// The bytes of a capture file and the unit override parsed (checked first, so a bad

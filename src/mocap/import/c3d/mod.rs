@@ -680,6 +680,9 @@ fn parse_params<'a>(
     // (group id, param) with group names filled in at the end (groups may come later).
     let mut raw: Vec<(u8, Param<'a>)> = Vec::new();
     let what = "a parameter record";
+    // The section's own length: byte 2 of its 4-byte header counts its blocks.
+    let blocks = usize::from(bin.u8(pos - 2, "the parameter section header")?).max(1);
+    let section_end = pos - 4 + blocks * BLOCK;
     let mut end = pos;
     loop {
         if data_offset.is_some_and(|d| pos >= d) {
@@ -722,6 +725,19 @@ fn parse_params<'a>(
                 ));
             };
             let data = bin.slice(q + 4 + nd, len, &format!("parameter {name}'s data"))?;
+            // The record holds its data: a size that runs past the next record is a
+            // corrupt dimension, not data to read.
+            let next_record = q + usize::from(next);
+            if next != 0 && q + 4 + nd + len > next_record {
+                return Err(ImportError::format(
+                    bin.path,
+                    format!("byte {} (parameter {name})", q + 3),
+                    format!(
+                        "its dimensions {dims:?} make {len} bytes of data, which run past the \
+                         next parameter record at byte {next_record}"
+                    ),
+                ));
+            }
             end = end.max(q + 4 + nd + len);
             raw.push((
                 id.unsigned_abs(),
@@ -746,6 +762,19 @@ fn parse_params<'a>(
             break;
         }
         let next_pos = q + usize::from(next);
+        // The last record may point just past the parameter section (some writers do, for
+        // 0); farther is an offset gone wrong (a negative one read unsigned), which would
+        // silently drop every parameter after it.
+        if next_pos > section_end.max(data_offset.unwrap_or(0)) + BLOCK {
+            return Err(ImportError::format(
+                bin.path,
+                format!("byte {q} (offset to the next parameter record)"),
+                format!(
+                    "{next} points past the parameter section \
+                     (which ends at byte {section_end})"
+                ),
+            ));
+        }
         if next_pos <= q + 1 {
             return Err(ImportError::format(
                 bin.path,
