@@ -1284,3 +1284,34 @@ fn quick_pedal_changes_keep_the_new_notes() {
     let f3: timpanist::base::pitch::Pitch = "F3".parse().unwrap();
     assert!((heard / f3.hz() - 1.0).abs() < 0.02, "heard {heard:.1} Hz");
 }
+
+/// A roll of 32nds at 120 bpm written right up to a note on another drum (as notation
+/// programs export a tremolo resolving to the next note) is played: the hand that moves
+/// leaves the roll's last stroke out and reaches the note in time (it had lost control,
+/// asked to cross between drums in one eighth of a second), in both directions.
+#[test]
+fn a_roll_into_a_note_on_another_drum_is_played() {
+    let db = db();
+    for (from, to) in [(1, 2), (2, 1)] {
+        let text = format!(
+            r#"Score(version: 2, title: "roll into a note", kit: "standard", grip: French,
+            ticks_per_quarter: 960, tempo: [(tick: 0, bpm: 120.0, change: Step)],
+            meter: [(bar: 1, numerator: 4, denominator: 4)],
+            beats: [
+                Beat(tick: 0, hand: Auto, mode: Legato, dynamic: Mf, drum: {from}, location: PlayingSpot, roll: Some((length_ticks: 4800, strokes_per_quarter: 8))),
+                Beat(tick: 4800, hand: Auto, mode: Accent, dynamic: Mf, drum: {to}, location: PlayingSpot),
+            ], handles: [], pins: [])"#
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("roll.ron");
+        std::fs::write(&path, text).unwrap();
+        let r = render_file(&path, &db);
+        assert_eq!(r.timing.missed, 0, "{from} → {to}: {:?}", r.timing);
+        let note = r.events.iter().find(|e| e.beat == Some(1)).unwrap();
+        assert!(
+            (note.contact_s - 2.5).abs() < 0.003,
+            "{from} → {to}: the note at {:.4} s",
+            note.contact_s
+        );
+    }
+}

@@ -58,8 +58,10 @@ pub(in crate::io) fn move_into_range(
 /// Give every note a drum as a timpanist would and make it a beat. Walking in time, each
 /// drum keeps its current tuning; a note goes to the drum its data names if that drum
 /// reaches it, else, among the drums that reach it (not already struck at this tick if
-/// possible; for a roll, which takes both hands, one both hands reach if possible), to one
-/// tuned to it, else to the one idle longest (it is retuned), ties to the nearest kit
+/// possible; not one whose roll lasts up to this tick when it would have to be retuned;
+/// for a roll, which takes both hands, one both hands reach if possible), to one tuned
+/// to it, else to the one idle longest since its last note or roll ended (it is
+/// retuned), ties to the nearest kit
 /// tuning. The notes of one tick choose in order of how few drums reach them, so a chord
 /// of F3 and A3 on the standard kit takes the 26- and the 23-inch drum (in score order
 /// the F3 took the 23-inch drum, tuned to it, and left the A3, which only the 23-inch
@@ -111,13 +113,17 @@ pub(in crate::io) fn assign_drums(
                 *moves.entry((pitch, to)).or_insert(0) += 1;
                 pitch = to;
             }
-            let roll = n.data.is_some_and(|d| d.4.is_some());
+            let roll = n.data.and_then(|d| d.4);
+            // A drum still sounding a roll up to this tick cannot be retuned for it.
+            let no_time_to_retune =
+                |d: usize| tuning[d] != pitch && last_used[d].is_some_and(|end| end >= tick);
             let drum = named_drum.unwrap_or_else(|| {
                 kit.drums_for(pitch)
                     .min_by_key(|&d| {
                         (
                             taken.contains(&d),
-                            roll && !both_hands_reach[d],
+                            no_time_to_retune(d),
+                            roll.is_some() && !both_hands_reach[d],
                             tuning[d] != pitch,
                             last_used[d],
                             kit.drums[d].tuning.0.abs_diff(pitch.0),
@@ -126,7 +132,7 @@ pub(in crate::io) fn assign_drums(
                     .expect("notes were moved into a drum's range")
             });
             tuning[drum] = pitch;
-            last_used[drum] = Some(tick);
+            last_used[drum] = Some(tick + roll.map_or(0, |r| r.length_ticks));
             taken.push(drum);
             (drums[i], keys[i]) = (drum, pitch.0);
         }

@@ -17,6 +17,23 @@ fn pitch(name: &str) -> u8 {
     name.parse::<Pitch>().unwrap().0
 }
 
+/// A note at `tick` of pitch `name` rolled for `length_ticks`, its drum left to choose.
+fn rolled(tick: u64, name: &str, length_ticks: u64, strokes_per_quarter: u32) -> Note {
+    Note {
+        data: Some(BeatData(
+            Hand::Auto,
+            PlayingMode::Legato,
+            usize::MAX,
+            ImpactLocation::PlayingSpot,
+            Some(Roll {
+                length_ticks,
+                strokes_per_quarter,
+            }),
+        )),
+        ..note(tick, pitch(name))
+    }
+}
+
 /// Alternating D3 and A2 go to the drum tuned to D3 and to the drum nearest A2 (retuned
 /// once, then kept), with the pitch kept only on a drum retuned somewhere.
 #[test]
@@ -105,23 +122,32 @@ fn a_roll_goes_to_a_drum_both_hands_reach() {
     let kit = Kit::standard();
     let reach = both_hands_reach(&kit);
     assert_eq!(reach, [false, true, true, false]);
-    let rolled = Note {
-        data: Some(BeatData(
-            Hand::Auto,
-            PlayingMode::Legato,
-            usize::MAX,
-            ImpactLocation::PlayingSpot,
-            Some(Roll {
-                length_ticks: 960,
-                strokes_per_quarter: 4,
-            }),
-        )),
-        ..note(0, pitch("F3"))
-    };
-    let beats = assign_drums(&[rolled], &kit, &mut Vec::new());
+    let beats = assign_drums(&[rolled(0, "F3", 960, 4)], &kit, &mut Vec::new());
     assert_eq!(beats[0].drum, 2);
     let beats = assign_drums(&[note(0, pitch("F3"))], &kit, &mut Vec::new());
     assert_eq!(beats[0].drum, 3);
+}
+
+/// A roll that starts as another roll on the drum ends does not take that drum when it
+/// would have to be retuned with no time to do it: after G2, C3 and D3 rolls back to back,
+/// the D3 roll goes to the 23-inch drum (retuned from F3 while idle), although only one
+/// hand reaches it upright, where it had gone to the 26-inch drum the C3 roll had just
+/// released, retuned in no time.
+#[test]
+fn a_roll_does_not_take_a_drum_still_rolling_at_another_pitch() {
+    let kit = Kit::standard();
+    let drums = |d3_at: u64| -> Vec<usize> {
+        let notes = [
+            rolled(0, "G2", 1920, 8),
+            rolled(1920, "C3", 1920, 8),
+            rolled(d3_at, "D3", 1920, 8),
+        ];
+        let beats = assign_drums(&notes, &kit, &mut Vec::new());
+        beats.iter().map(|b| b.drum).collect()
+    };
+    assert_eq!(drums(3840), [1, 2, 3]);
+    // With two beats' rest before it the 26-inch drum has time and takes it.
+    assert_eq!(drums(5760), [1, 2, 2]);
 }
 
 /// Pitches no drum reaches move by the fewest octaves into some drum's range, counted
