@@ -1315,7 +1315,10 @@ fn malformed_input_errors() {
         e.contains("not a MusicXML score") && e.contains("<html>"),
         "{e}"
     );
-    let e = err("not-zip.mxl", b"<score-partwise/>");
+    // Uncompressed XML under an .mxl name is read as XML (here an empty score).
+    let e = err("plain.mxl", b"<score-partwise/>");
+    assert!(e.starts_with("plain.mxl: the score holds no parts"), "{e}");
+    let e = err("not-zip.mxl", b"\x00\x01 neither");
     assert!(
         e.starts_with("not-zip.mxl: not a readable compressed MusicXML"),
         "{e}"
@@ -1700,4 +1703,59 @@ fn midi_titles_in_legacy_encodings() {
     assert_eq!(title(b"\xc5bo"), "Åbo");
     assert_eq!(title(b"\x01\x02\x03"), "song");
     assert_eq!(midi_import::decode_text(b"caf\xe9"), "café");
+}
+
+/// A timpani part of rests only is said to have no notes (it was "no timpani part found
+/// … no part named Timpani", listing the part named Timpani); uncompressed MusicXML saved
+/// under an `.mxl` name is read as what it is, with a notice.
+#[test]
+fn a_rests_only_part_and_plain_xml_named_mxl() {
+    let kit = Kit::standard();
+    let rests = doc(&[&format!("{}{}", attrs(1), rest(4))]);
+    let err = import(
+        Path::new("rests.musicxml"),
+        rests.as_bytes(),
+        &kit,
+        &ImportOptions::default(),
+    )
+    .map(|_| ())
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("rests.musicxml: the timpani part (")
+            && err.contains("has no notes (rests only)"),
+        "{err}"
+    );
+    let xml = doc(&[&format!(
+        "{}{}{}",
+        attrs(1),
+        note("D3", 2, ""),
+        note("A2", 2, "")
+    )]);
+    let (score, report) = import(
+        Path::new("plain.mxl"),
+        xml.as_bytes(),
+        &kit,
+        &ImportOptions::default(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(score.beats.len(), 2);
+    assert!(
+        report
+            .notices
+            .iter()
+            .any(|n| n.contains("holds uncompressed MusicXML")),
+        "{:?}",
+        report.notices
+    );
+    let err = import(
+        Path::new("junk.mxl"),
+        b"not xml, not zip",
+        &kit,
+        &ImportOptions::default(),
+    )
+    .map(|_| ())
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("not a zip archive"), "{err}");
 }

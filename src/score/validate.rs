@@ -53,10 +53,10 @@ pub fn problems(score: &Score, kit: &Kit, places: &BeatPlaces) -> Vec<Problem> {
             out.push(Problem::new(
                 "length",
                 format!(
-                    "{:.0} minutes is longer than the {:.0} minutes a score may last (a render \
-                     holds the whole performance in memory); split it into movements",
-                    length_s / 60.0,
-                    crate::base::limits::MAX_SCORE_S / 60.0
+                    "{} (min:s) is longer than the {} a score may last (a render holds the \
+                     whole performance in memory); split it into movements",
+                    minutes_and_seconds(length_s),
+                    minutes_and_seconds(crate::base::limits::MAX_SCORE_S)
                 ),
             ));
         }
@@ -184,6 +184,13 @@ fn point_problems(radius: f64, angle_deg: f64) -> impl Iterator<Item = String> {
 /// Longest wait before a damping touch, quarter notes (after that the drum has died away).
 pub const MAX_DAMP_QUARTERS: u64 = 16;
 
+/// `s` seconds as minutes and whole seconds, rounded up ("30:07"), so a length just over a
+/// limit never reads as the limit itself.
+fn minutes_and_seconds(s: f64) -> String {
+    let whole = s.max(0.0).ceil() as u64;
+    format!("{}:{:02}", whole / 60, whole % 60)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -284,7 +291,8 @@ mod tests {
         s.beats = vec![beat(0, 0), beat(late, 1)];
         let p = first_problem(&s);
         assert!(
-            p.contains("length: 31 minutes is longer than the 30 minutes"),
+            p.contains("length: 31:0")
+                && p.contains("(min:s) is longer than the 30:00 a score may"),
             "{p}"
         );
         s.beats = vec![beat(0, 0), beat(last, 1)];

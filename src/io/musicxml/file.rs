@@ -20,7 +20,21 @@ pub(super) fn score_text(
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("mxl"));
     if is_mxl {
-        return Err(archive_error(path, "the file is not a zip archive".into()));
+        // Uncompressed MusicXML under a compressed file's name: read as what it is.
+        let text = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes);
+        let looks_xml = text.trim_ascii_start().starts_with(b"<")
+            || bytes.starts_with(b"\xff\xfe")
+            || bytes.starts_with(b"\xfe\xff");
+        if !looks_xml {
+            return Err(archive_error(
+                path,
+                "the file is not a zip archive (nor uncompressed MusicXML)".into(),
+            ));
+        }
+        notices.push_text(
+            "named .mxl (compressed MusicXML) but holds uncompressed MusicXML: read as it is"
+                .into(),
+        );
     }
     decode(path, bytes)
 }

@@ -162,6 +162,12 @@ pub enum MusicXmlError {
         path.display(), crate::base::instrument_name::TIMPANI_NAMES
     )]
     NoTimpani { path: PathBuf, parts: String },
+    /// The timpani part holds rests only.
+    #[error(
+        "{}: the timpani part ({part}) has no notes (rests only), so there is nothing to import",
+        path.display()
+    )]
+    TimpaniWithoutNotes { path: PathBuf, part: String },
     /// A score with no part at all.
     #[error(
         "{}: the score holds no parts (its part list and its <part> elements are empty), so there is nothing to import",

@@ -203,6 +203,16 @@ pub(super) fn choose(
         }
         return Ok((text, i, instrument));
     }
+    // A timpani part with nothing to play is said as such, not as no timpani part.
+    if let Some(p) = parts
+        .iter()
+        .find(|p| by_sound(p).or_else(|| by_name(p)).is_some())
+    {
+        return Err(MusicXmlError::TimpaniWithoutNotes {
+            path: path.to_path_buf(),
+            part: p.label(),
+        });
+    }
     Err(MusicXmlError::NoTimpani {
         path: path.to_path_buf(),
         parts: part_listing(parts),
