@@ -540,3 +540,35 @@ fn a_wrong_unit_is_refused_and_an_absurd_sample_is_a_gap() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// `mocap columns` on a C3D file says it reads text captures (it said "expected a block of
+/// data rows"), and a capture with no tracks is refused saying so.
+#[test]
+fn columns_of_a_c3d_and_a_capture_with_no_tracks() {
+    let c3d = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/c3d/ezc3d_Vicon.c3d");
+    let out = timpanist(&["mocap", "columns", c3d.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("ezc3d_Vicon.c3d: a C3D file: `mocap columns` shows delimited text"),
+        "{err}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let empty = dir.path().join("legato_empty.csv");
+    std::fs::write(&empty, "time_s\n0.000\n0.004\n0.008\n").unwrap();
+    let db_dir = dir.path().join("db");
+    let out = timpanist(&[
+        "mocap",
+        "import",
+        empty.to_str().unwrap(),
+        "-o",
+        db_dir.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("legato_empty.csv") && err.contains("at least one track"),
+        "{err}"
+    );
+    assert!(!db_dir.exists());
+}

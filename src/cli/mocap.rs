@@ -556,6 +556,12 @@ fn resolve_tips(
     if let Some(side) = fixed {
         tips[side_index(side.other())] = None;
     }
+    if take.tracks.is_empty() {
+        anyhow::bail!(
+            "{}: the file holds no tracks (no marker or rigid body); nothing written",
+            path.display()
+        );
+    }
     if tips.iter().all(Option::is_none) {
         anyhow::bail!(
             "{}: cannot tell which track is which stick; name them with --tips LEFT,RIGHT (or one label with --hand); the file has: {}",
@@ -704,7 +710,11 @@ fn print_report(source: &Source, report: &IngestReport, align: &Alignment) {
     };
     println!(
         "{path}: {} frames at {} Hz ({})",
-        source.take.frames, source.take.rate_hz, source.take.file_unit
+        source.take.frames,
+        // To the millihertz: a rate from a text file's times (1 / their median step)
+        // prints as 200, not 200.00000000000426.
+        (source.take.rate_hz * 1000.0).round() / 1000.0,
+        source.take.file_unit
     );
     let t = report.transform;
     if t != Transform::IDENTITY {
@@ -804,6 +814,13 @@ pub fn columns(file: &Path, profile: Option<&str>) -> anyhow::Result<()> {
         None => CaptureProfile::named("auto-detected"),
     };
     let bytes = std::fs::read(file).map_err(|e| anyhow::anyhow!("{}: {e}", file.display()))?;
+    if Format::guess(file, &bytes) == Some(Format::C3d) {
+        anyhow::bail!(
+            "{}: a C3D file: `mocap columns` shows delimited text captures; C3D files name \
+             their tracks themselves (`mocap import` lists them when it cannot tell the sticks)",
+            file.display()
+        );
+    }
     let layout = crate::mocap::import::table::inspect(file, &bytes, &profile)?;
     println!(
         "{}: read with the profile \"{}\"",
