@@ -307,15 +307,18 @@ pub fn plan(
 /// eighth of a second in a roll of 32nds at 120 bpm), which no arm can.
 fn release_rolls(strokes: &mut Vec<PlannedStroke>, score: &Score, kit: &Kit) {
     let mut dropped = vec![false; strokes.len()];
+    // Each beat's first and last stroke (in time order), found in one pass.
+    let mut span: Vec<Option<(usize, usize)>> = vec![None; score.beats.len()];
+    for (i, s) in strokes.iter().enumerate() {
+        let first = span[s.beat].map_or(i, |(f, _)| f);
+        span[s.beat] = Some((first, i));
+    }
     for (b, beat) in score.beats.iter().enumerate() {
-        if beat.roll.is_none() {
-            continue;
-        }
-        let Some(first) = strokes.iter().position(|s| s.beat == b) else {
+        let Some((first, end)) = span[b].filter(|_| beat.roll.is_some()) else {
             continue;
         };
         for hand in [Side::Left, Side::Right] {
-            let mine: Vec<usize> = (first..strokes.len())
+            let mine: Vec<usize> = (first..=end)
                 .filter(|&i| strokes[i].beat == b && strokes[i].hand == hand)
                 .collect();
             let Some(&last) = mine.last() else {
