@@ -10,9 +10,9 @@ use crate::mocap::db::side_index;
 use crate::mocap::import::profile::CaptureProfile;
 use crate::mocap::import::{Format, LengthUnit};
 use crate::mocap::ingest::{
-    Alignment, IngestOptions, IngestReport, UpAxis, hand_from_label, ingest,
+    Alignment, IngestOptions, IngestReport, STICK_WORDS, UpAxis, hand_from_label, ingest,
 };
-use crate::mocap::take::Take;
+use crate::mocap::take::{Take, extent_m};
 use crate::mocap::{stats, synth, vertical};
 use crate::score::{Dynamic, Grip};
 use std::path::{Path, PathBuf};
@@ -606,12 +606,7 @@ fn unit_hint(take: &Take, labels: &[&str]) -> String {
         .tracks
         .iter()
         .filter(|t| labels.iter().any(|l| t.label.eq_ignore_ascii_case(l)))
-        .filter_map(|t| {
-            let seen: Vec<glam::DVec3> = t.positions.iter().flatten().copied().collect();
-            let lo = seen.iter().copied().reduce(glam::DVec3::min)?;
-            let hi = seen.iter().copied().reduce(glam::DVec3::max)?;
-            Some((hi - lo).max_element())
-        })
+        .filter_map(|t| extent_m(&t.positions))
         .fold(0.0f64, f64::max);
     if span <= 0.0 || (0.02..=20.0).contains(&span) {
         return String::new();
@@ -619,17 +614,15 @@ fn unit_hint(take: &Take, labels: &[&str]) -> String {
     let Some(now) = LengthUnit::parse(&take.file_unit) else {
         return String::new();
     };
-    let better = [
-        LengthUnit::Millimetre,
-        LengthUnit::Centimetre,
-        LengthUnit::Metre,
-    ]
-    .into_iter()
-    .min_by(|a, b| {
-        let off = |u: &LengthUnit| (span * u.metres() / now.metres() / 0.3).ln().abs();
-        off(a).total_cmp(&off(b))
-    })
-    .unwrap_or(now);
+    let better = now.nearest_for(
+        span,
+        0.3,
+        &[
+            LengthUnit::Millimetre,
+            LengthUnit::Centimetre,
+            LengthUnit::Metre,
+        ],
+    );
     if better == now {
         return String::new();
     }
@@ -696,9 +689,7 @@ fn one_stick(take: &Take, sticks: &[&str]) -> Option<String> {
 /// Whether a track label names a stick or its tip (not an arm marker).
 fn names_a_stick(label: &str) -> bool {
     let lower = label.to_ascii_lowercase();
-    ["tip", "stick", "stk", "mallet", "bead"]
-        .iter()
-        .any(|w| lower.contains(w))
+    STICK_WORDS.iter().any(|w| lower.contains(w))
 }
 
 /// Print what one take gave.

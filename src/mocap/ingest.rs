@@ -10,9 +10,10 @@
 
 use super::align::{self, HabitBook, HandFit, HandStrokes, Target, Transform};
 use super::db::{MotionDb, TakeData, TakeEntry, UnitEntry};
+use super::import::LengthUnit;
 use super::marker_body;
 use super::segment::{Impact, RejectionCounts, SegmentParams, UnitSpan, fill_gaps, segment};
-use super::take::{ImportError, Take, Track};
+use super::take::{ImportError, Take, Track, extent_m};
 use super::tip_estimate::{self, TipEstimate, TipEstimateError, TipPrior};
 use crate::base::stats::median;
 use crate::kit::{Kit, Side};
@@ -201,36 +202,18 @@ fn check_stroke_speeds(
     tip: &[Option<DVec3>],
     found: &[Impact],
 ) -> Result<(), ImportError> {
-    let mut speeds: Vec<f64> = found
-        .iter()
-        .map(|i| i.approach_mps)
-        .filter(|v| v.is_finite())
-        .collect();
-    if speeds.is_empty() {
+    let speeds = found.iter().map(|i| i.approach_mps);
+    let Some(median) = median(speeds.clone()).filter(|&m| m > MAX_MEDIAN_APPROACH_MPS) else {
         return Ok(());
-    }
-    speeds.sort_by(f64::total_cmp);
-    let median = speeds[speeds.len() / 2];
-    if median <= MAX_MEDIAN_APPROACH_MPS {
-        return Ok(());
-    }
-    let seen: Vec<DVec3> = tip.iter().flatten().copied().collect();
-    let span = match (
-        seen.iter().copied().reduce(DVec3::min),
-        seen.iter().copied().reduce(DVec3::max),
-    ) {
-        (Some(lo), Some(hi)) => (hi - lo).max_element(),
-        _ => median / 3.0,
     };
-    // The factor (as read → metres) that brings the span nearest half a metre.
-    let (unit, _) = [("cm", 0.01), ("mm", 0.001)]
-        .into_iter()
-        .min_by(|a, b| {
-            let off = |f: f64| (span * f / 0.5).ln().abs();
-            off(a.1).total_cmp(&off(b.1))
-        })
-        .unwrap_or(("mm", 0.001));
-    let strokes = if speeds.len() == 1 {
+    let counted = speeds.filter(|v| v.is_finite()).count();
+    let span = extent_m(tip).unwrap_or(median / 3.0);
+    // The smaller unit that brings the span nearest half a metre, the lengths read as
+    // metres now.
+    let unit = LengthUnit::Metre
+        .nearest_for(span, 0.5, &[LengthUnit::Centimetre, LengthUnit::Millimetre])
+        .symbol();
+    let strokes = if counted == 1 {
         "stroke descends"
     } else {
         "strokes descend"
@@ -242,8 +225,7 @@ fn check_stroke_speeds(
             "its {} {strokes} at a median {median:.0} m/s (real strokes: 1–15 m/s) and \
              it moves over {span:.0} m, so its lengths are not in {} as read: if the file is \
              in {unit}, give --unit {unit}; nothing written",
-            speeds.len(),
-            take.file_unit,
+            counted, take.file_unit,
         ),
     ))
 }
@@ -868,8 +850,8 @@ fn hand_from_name(name: &str) -> Option<Side> {
     }
 }
 
-/// What a stick's track is called after its hand's letter, lower case.
-const STICK_WORDS: [&str; 5] = ["stick", "stk", "mallet", "tip", "bead"];
+/// What a stick's track is called (after its hand's letter), lower case.
+pub const STICK_WORDS: [&str; 5] = ["stick", "stk", "mallet", "tip", "bead"];
 
 /// The words of a label: runs of letters split at anything else and at case changes
 /// ("R_STICK_tip2" → R, STICK, tip; "RStickTip" → R, Stick, Tip).

@@ -35,6 +35,15 @@ pub const MAX_CAPTURE_RATE_HZ: f64 = 100_000.0;
 /// to 10 µm.
 pub const MAX_COORDINATE_M: f64 = 1.0e6;
 
+/// The largest extent along any axis of the seen `positions`, m (as read); `None` when
+/// none is seen.
+pub fn extent_m(positions: &[Option<DVec3>]) -> Option<f64> {
+    let seen = positions.iter().flatten().copied();
+    let lo = seen.clone().reduce(DVec3::min)?;
+    let hi = seen.reduce(DVec3::max)?;
+    Some((hi - lo).max_element())
+}
+
 /// A whole capture.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Take {

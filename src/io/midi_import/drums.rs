@@ -74,7 +74,8 @@ pub(in crate::io) fn assign_drums(
     warnings: &mut Vec<String>,
 ) -> Vec<Beat> {
     let mut tuning: Vec<Pitch> = kit.drums.iter().map(|d| d.tuning).collect();
-    let mut last_used: Vec<Option<u64>> = vec![None; kit.drums.len()];
+    // Per drum, the tick its last note or roll ends.
+    let mut busy_until: Vec<Option<u64>> = vec![None; kit.drums.len()];
     let mut drums: Vec<usize> = vec![0; notes.len()];
     let mut keys: Vec<u8> = notes.iter().map(|n| n.key).collect();
     let both_hands_reach = both_hands_reach(kit);
@@ -116,7 +117,7 @@ pub(in crate::io) fn assign_drums(
             let roll = n.data.and_then(|d| d.4);
             // A drum still sounding a roll up to this tick cannot be retuned for it.
             let no_time_to_retune =
-                |d: usize| tuning[d] != pitch && last_used[d].is_some_and(|end| end >= tick);
+                |d: usize| tuning[d] != pitch && busy_until[d].is_some_and(|end| end >= tick);
             let drum = named_drum.unwrap_or_else(|| {
                 kit.drums_for(pitch)
                     .min_by_key(|&d| {
@@ -125,14 +126,14 @@ pub(in crate::io) fn assign_drums(
                             no_time_to_retune(d),
                             roll.is_some() && !both_hands_reach[d],
                             tuning[d] != pitch,
-                            last_used[d],
+                            busy_until[d],
                             kit.drums[d].tuning.0.abs_diff(pitch.0),
                         )
                     })
                     .expect("notes were moved into a drum's range")
             });
             tuning[drum] = pitch;
-            last_used[drum] = Some(tick + roll.map_or(0, |r| r.length_ticks));
+            busy_until[drum] = Some(tick + roll.map_or(0, |r| r.length_ticks));
             taken.push(drum);
             (drums[i], keys[i]) = (drum, pitch.0);
         }

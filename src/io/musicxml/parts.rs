@@ -206,7 +206,7 @@ pub(super) fn choose(
     // A timpani part with nothing to play is said as such, not as no timpani part.
     if let Some(p) = parts
         .iter()
-        .find(|p| by_sound(p).or_else(|| by_name(p)).is_some())
+        .find(|p| rules.iter().any(|rule| rule(p).is_some()))
     {
         return Err(MusicXmlError::TimpaniWithoutNotes {
             path: path.to_path_buf(),

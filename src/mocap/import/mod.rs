@@ -163,6 +163,18 @@ impl LengthUnit {
             LengthUnit::Metre => "m",
         }
     }
+
+    /// Among `candidates`, the unit that, had the file been read in it instead of in
+    /// `self`, would give a span read as `span_m` metres the length nearest `target_m`
+    /// (by ratio): what a capture whose sticks move absurdly little or far was written in.
+    pub fn nearest_for(self, span_m: f64, target_m: f64, candidates: &[LengthUnit]) -> LengthUnit {
+        let off = |u: &LengthUnit| (span_m * u.metres() / self.metres() / target_m).ln().abs();
+        candidates
+            .iter()
+            .copied()
+            .min_by(|a, b| off(a).total_cmp(&off(b)))
+            .unwrap_or(self)
+    }
 }
 
 /// Read a capture file. With `format` `None` the format is guessed from the content and
