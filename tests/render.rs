@@ -484,7 +484,8 @@ fn resumed_render_after_an_edit_equals_a_whole_render() {
             // normalisation gain, as it was, and nothing before the resume is rewritten.
             assert_eq!(resumed.audio.gain, before.audio.gain);
             let shared = resumed.audio.samples.shared_chunks(&before.audio.samples);
-            let before_from = (from - whole.start_s - 1.0).floor().max(0.0) as usize;
+            // Audio frame 0 is score time 0 (the lead-in before it is silent).
+            let before_from = (from - 1.0).floor().max(0.0) as usize;
             let chunks = resumed.audio.samples.chunks().count();
             println!("{shared} of {chunks} one-second chunks shared, resumed at {from:.2} s");
             assert!(

@@ -329,8 +329,12 @@ impl Performance {
         (0..self.commits.len()).rev().find(|&c| {
             let commit = &self.commits[c];
             let k = commit.strokes;
-            // The warp reads at most the largest shift (plus a sample) ahead.
-            let reads = commit.samples + 2 + (MAX_SHIFT_S * rate).ceil() as usize;
+            // The targets the reference read up to the commit (and a sample past it),
+            // through the warp as it was there.
+            let reads = self
+                .warp
+                .reads_through(commit.warp, commit.samples + 1, rate, MAX_SHIFT_S)
+                + 1;
             reads < same_until
                 && k <= new.len()
                 && k <= old.len()

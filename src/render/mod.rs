@@ -318,7 +318,7 @@ pub const SOUND_AHEAD_S: f64 = 5.0;
 
 /// After an edit the editor first renders this far past the edited stroke, s, ready to
 /// play at once...
-pub const FIRST_STEP_S: f64 = 0.4;
+pub const FIRST_STEP_S: f64 = 0.25;
 /// ...then the rest in steps, the first this long, s, and each next one
 /// [`RESUME_STEP_GROWTH`] times the last.
 pub const RESUME_STEP_S: f64 = 4.0;

@@ -332,15 +332,7 @@ impl Targets {
                 while next < knots.len() && knots[next].0 <= t {
                     next += 1;
                 }
-                let shift = match next {
-                    0 => knots.first().map_or(0.0, |p| p.1),
-                    i if i == knots.len() => knots[i - 1].1,
-                    i => {
-                        let ((t0, s0), (t1, s1)) = (knots[i - 1], knots[i]);
-                        s0 + (s1 - s0) * (t - t0) / (t1 - t0)
-                    }
-                };
-                let x = (t + shift) * rate;
+                let x = (t + shift_between(knots, next, t)) * rate;
                 reference.tips[h][k] = sample(&self.shaped[h], x, DVec3::lerp);
                 if let Some(grip) = &mut reference.grip {
                     grip[h][k] = sample(&self.held[h], x, |a, b, u| a + (b - a) * u);
@@ -391,6 +383,32 @@ impl Warp {
         self.knots[hand].last().map_or(0.0, |k| k.1)
     }
 
+    /// The furthest target sample that reference samples `0..=k` (at `rate_hz`) read
+    /// through this warp cut to its first `lens` knots per hand (what a saved state's
+    /// warp was), counting the next sample the interpolation reads; shifts are within
+    /// ±`max_shift_s`, so only the samples from 2·`max_shift_s` before `k` can read
+    /// furthest.
+    pub fn reads_through(
+        &self,
+        lens: [usize; 2],
+        k: usize,
+        rate_hz: f64,
+        max_shift_s: f64,
+    ) -> usize {
+        let from = k.saturating_sub((2.0 * max_shift_s * rate_hz).ceil() as usize);
+        let mut furthest = k;
+        for (knots, len) in self.knots.iter().zip(lens) {
+            let knots = &knots[..len.min(knots.len())];
+            for j in from..=k {
+                let t = j as f64 / rate_hz;
+                let next = knots.partition_point(|&(u, _)| u <= t);
+                let x = (t + shift_between(knots, next, t)) * rate_hz;
+                furthest = furthest.max(x.floor().max(0.0) as usize + 1);
+            }
+        }
+        furthest
+    }
+
     /// Add a knot to `hand` (at or after its last one).
     pub fn push(&mut self, hand: usize, knot: (f64, f64)) {
         debug_assert!(self.knots[hand].last().is_none_or(|k| k.0 <= knot.0));
@@ -421,6 +439,19 @@ fn grip_held(dips: &[Dip], release: &Release, rate: f64, n: usize) -> [Vec<f64>;
         }
     }
     held
+}
+
+/// The shift at time `t_s` between `knots[next - 1]` and `knots[next]` (`next`: the
+/// first knot after `t_s`), held before the first knot and after the last, s.
+fn shift_between(knots: &[(f64, f64)], next: usize, t_s: f64) -> f64 {
+    match next {
+        0 => knots.first().map_or(0.0, |p| p.1),
+        i if i == knots.len() => knots[i - 1].1,
+        i => {
+            let ((t0, s0), (t1, s1)) = (knots[i - 1], knots[i]);
+            s0 + (s1 - s0) * (t_s - t0) / (t1 - t0)
+        }
+    }
 }
 
 /// Interpolation (by `lerp`) of `points` at fractional index `x`, held at the ends.
@@ -494,6 +525,29 @@ mod tests {
         assert_eq!(x[9], 9.0);
         // The other hand is anchored at 0 and 6 with no shift.
         assert!(r.tips[1].iter().enumerate().all(|(k, p)| p.x == k as f64));
+    }
+
+    /// What samples up to k read through a warp: k and the next one without a shift, the
+    /// shifted sample and the next one with it, the most of both hands and of the samples
+    /// before k that a falling shift makes read further; knots past `lens` are not read.
+    #[test]
+    fn reads_through_follows_the_shift_the_warp_had() {
+        let rate = 1.0;
+        let mut warp = Warp::default();
+        assert_eq!(warp.reads_through(warp.lens(), 5, rate, 3.0), 6);
+        // Hand 1: shift 2 held from time 4 (rising from 0 at time 0).
+        warp.push(1, (4.0, 2.0));
+        assert_eq!(warp.reads_through(warp.lens(), 6, rate, 3.0), 9);
+        // Cut to the knots before that one: no shift.
+        assert_eq!(warp.reads_through([1, 1], 6, rate, 3.0), 7);
+        // Hand 0: shift 3 at time 5 falling to 0 at time 6: sample 5 reads 8, further
+        // than sample 6 reads (6 on hand 0, 8 on hand 1).
+        warp.push(0, (5.0, 3.0));
+        warp.push(0, (6.0, 0.0));
+        assert_eq!(warp.reads_through(warp.lens(), 6, rate, 3.0), 9);
+        warp.push(1, (6.0, 0.0));
+        assert_eq!(warp.reads_through(warp.lens(), 6, rate, 3.0), 9);
+        assert_eq!(warp.reads_through(warp.lens(), 8, rate, 3.0), 9);
     }
 
     /// Writing a range equals the same samples of a whole write.
