@@ -255,59 +255,14 @@ pub fn compose(strokes: &[PlannedStroke], db: &MotionDb, params: &ComposeParams)
         .fold(0.0f64, f64::max);
     let start_s = ((first - params.margin_s - 1.0).min(0.0) * rate).floor() / rate;
     let n = ((last + params.margin_s + 1.0 - start_s) * rate).ceil() as usize + 1;
-    let mut tips = [Vec::with_capacity(n), Vec::with_capacity(n)];
-    let mut tags = [Vec::with_capacity(n), Vec::with_capacity(n)];
-    for hand in [Side::Left, Side::Right] {
-        let mine: Vec<usize> = (0..strokes.len())
-            .filter(|&i| strokes[i].hand == hand)
-            .collect();
-        let shaped = shape(strokes, &mine, db, params);
-        let (pieces, joins) = timeline(&shaped, hand, params);
-        let h = side_index(hand);
-        let mut p = 0;
-        for k in 0..n {
-            let t = start_s + k as f64 / rate;
-            while p < joins.len() && t >= joins[p].centre + joins[p].half {
-                p += 1;
-            }
-            let eval = |piece: &Piece| match piece {
-                Piece::Stroke(j) => shaped[*j].at(t),
-                Piece::Hold(q) => *q,
-            };
-            let (position, main) = match joins.get(p) {
-                Some(j) if t > j.centre - j.half => {
-                    let w = smootherstep((t - (j.centre - j.half)) / (2.0 * j.half));
-                    let (a, b) = (&pieces[p], &pieces[p + 1]);
-                    (
-                        eval(a) * (1.0 - w) + eval(b) * w,
-                        if w < 0.5 { a } else { b },
-                    )
-                }
-                _ => (eval(&pieces[p]), &pieces[p]),
-            };
-            tips[h].push(position);
-            tags[h].push(match main {
-                Piece::Hold(_) => Tag {
-                    stroke: None,
-                    phase: Phase::Rest,
-                },
-                Piece::Stroke(j) => {
-                    let s = &shaped[*j];
-                    let phase = if (t - s.impact_s).abs() < 0.5 / rate {
-                        Phase::Impact
-                    } else if t < s.impact_s {
-                        Phase::Preparation
-                    } else {
-                        Phase::Rebound
-                    };
-                    Tag {
-                        stroke: Some(mine[*j]),
-                        phase,
-                    }
-                }
-            });
-        }
-    }
+    // The hands share nothing: each is composed on a thread of its own.
+    let [(left, left_tags), (right, right_tags)]: [(Vec<DVec3>, Vec<Tag>); 2] =
+        crate::base::parallel::each([Side::Left, Side::Right], |hand| {
+            hand_path(strokes, db, params, hand, (start_s, n))
+        })
+        .try_into()
+        .unwrap_or_else(|_| unreachable!("one path per hand"));
+    let (tips, tags) = ([left, right], [left_tags, right_tags]);
     let impact_samples = strokes
         .iter()
         .map(|s| ((snap(s.time_s) - start_s) * rate).round() as usize)
@@ -322,6 +277,68 @@ pub fn compose(strokes: &[PlannedStroke], db: &MotionDb, params: &ComposeParams)
         limits: NO_LIMITS,
         muffles: Muffles::default(),
     }
+}
+
+/// One hand's tip path and tags over the `n` samples from `start_s`: its strokes' shaped
+/// segments on the timeline, blended across each join.
+fn hand_path(
+    strokes: &[PlannedStroke],
+    db: &MotionDb,
+    params: &ComposeParams,
+    hand: Side,
+    (start_s, n): (f64, usize),
+) -> (Vec<DVec3>, Vec<Tag>) {
+    let rate = params.rate_hz;
+    let (mut tips, mut tags) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let mine: Vec<usize> = (0..strokes.len())
+        .filter(|&i| strokes[i].hand == hand)
+        .collect();
+    let shaped = shape(strokes, &mine, db, params);
+    let (pieces, joins) = timeline(&shaped, hand, params);
+    let mut p = 0;
+    for k in 0..n {
+        let t = start_s + k as f64 / rate;
+        while p < joins.len() && t >= joins[p].centre + joins[p].half {
+            p += 1;
+        }
+        let eval = |piece: &Piece| match piece {
+            Piece::Stroke(j) => shaped[*j].at(t),
+            Piece::Hold(q) => *q,
+        };
+        let (position, main) = match joins.get(p) {
+            Some(j) if t > j.centre - j.half => {
+                let w = smootherstep((t - (j.centre - j.half)) / (2.0 * j.half));
+                let (a, b) = (&pieces[p], &pieces[p + 1]);
+                (
+                    eval(a) * (1.0 - w) + eval(b) * w,
+                    if w < 0.5 { a } else { b },
+                )
+            }
+            _ => (eval(&pieces[p]), &pieces[p]),
+        };
+        tips.push(position);
+        tags.push(match main {
+            Piece::Hold(_) => Tag {
+                stroke: None,
+                phase: Phase::Rest,
+            },
+            Piece::Stroke(j) => {
+                let s = &shaped[*j];
+                let phase = if (t - s.impact_s).abs() < 0.5 / rate {
+                    Phase::Impact
+                } else if t < s.impact_s {
+                    Phase::Preparation
+                } else {
+                    Phase::Rebound
+                };
+                Tag {
+                    stroke: Some(mine[*j]),
+                    phase,
+                }
+            }
+        });
+    }
+    (tips, tags)
 }
 
 /// Fit each of one hand's strokes (`mine`, indices into `strokes`) to its neighbours.
