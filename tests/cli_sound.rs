@@ -128,6 +128,50 @@ fn noise_is_refused_as_a_note() {
     assert!(!cal.exists());
 }
 
+/// A note recorded at 4 kHz cannot hold the 4 kHz octave band: `sound analyse` shows
+/// that band as "-" with a note, and `sound fit` refuses the file naming the rate it needs
+/// (it had written a calibration with residuals of +234 dB).
+#[test]
+fn a_low_rate_recording_is_measured_only_where_it_can_be() {
+    let dir = tempfile::tempdir().unwrap();
+    let (note, fs) = timpanist::sound::recording::read_mono(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("kits/samples/Timpani_2L.wav"),
+    )
+    .unwrap();
+    // Every eleventh sample of a 44.1 kHz note (its content below 2 kHz kept by a
+    // running mean over the eleven first).
+    let step = (fs / 4_000) as usize;
+    let low: Vec<f32> = note
+        .chunks_exact(step)
+        .map(|c| c.iter().sum::<f32>() / step as f32)
+        .collect();
+    let wav = dir.path().join("low.wav");
+    let audio = timpanist::sound::Audio {
+        samples: low.into(),
+        channels: 1,
+        rate_hz: fs / step as u32,
+        gain: 1.0,
+    };
+    timpanist::sound::wav::write_wav(&wav, &audio).unwrap();
+    let wav_s = wav.to_str().unwrap();
+    let out = timpanist(&["sound", "analyse", wav_s]);
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{said}");
+    assert!(
+        said.contains("4000 Hz -") && said.contains("half"),
+        "{said}"
+    );
+    let cal = dir.path().join("cal.ron");
+    let out = timpanist(&["sound", "fit", wav_s, "-o", cal.to_str().unwrap()]);
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        said.contains("low.wav") && said.contains("at least 11314 Hz"),
+        "{said}"
+    );
+    assert!(!cal.exists());
+}
+
 /// `sound stroke --room hall` hears the stroke in a concert hall: the (1,1) stays at the
 /// tuning, and the 63 Hz octave band, which a dry D3 stroke leaves empty (its attack is
 /// where the first second's Hann window is zero), holds what the room carries of the

@@ -56,7 +56,9 @@ fn lossless_formats_read_sample_for_sample() {
         ("d2-note.aiff", read_mono(&fixture("d2-note.aiff")).unwrap()),
         (
             "64-bit float WAV",
-            read_mono_bytes(Path::new("note.wav"), &f64_bytes).unwrap(),
+            read_mono_bytes(Path::new("note.wav"), &f64_bytes)
+                .map(|(samples, rate, _)| (samples, rate))
+                .unwrap(),
         ),
     ];
     for (name, (samples, r)) in cases {
@@ -169,13 +171,33 @@ fn unreadable_files_are_refused_by_name() {
     // error; never a panic.
     let flac = std::fs::read(fixture("d2-note.flac")).unwrap();
     for cut in [4, 42, 100, 2000, flac.len() / 2] {
-        if let Ok((samples, rate)) = read_mono_bytes(Path::new("cut.flac"), &flac[..cut]) {
+        if let Ok((samples, rate, notes)) = read_mono_bytes(Path::new("cut.flac"), &flac[..cut]) {
             assert_eq!(rate, 32_000);
             assert!(
                 samples.len() < 38_400,
                 "cut at {cut}: {} samples",
                 samples.len()
             );
+            assert!(
+                notes.iter().any(|n| n.contains("cut short")),
+                "cut at {cut}: {notes:?}"
+            );
         }
     }
+    // A FLAC with damaged bytes mid-file: the frames failing their checksum are skipped
+    // by the reader, read as silence with a note saying when and how long, so the note
+    // keeps its length and what follows its time.
+    let (whole, _, notes) = read_mono_bytes(Path::new("d2-note.flac"), &flac).unwrap();
+    assert!(notes.is_empty(), "{notes:?}");
+    let mut damaged = flac.clone();
+    let at = flac.len() / 2;
+    for b in &mut damaged[at..at + 300] {
+        *b ^= 0xA5;
+    }
+    let (read, _, notes) = read_mono_bytes(Path::new("damaged.flac"), &damaged).unwrap();
+    assert_eq!(read.len(), whole.len());
+    assert!(
+        notes.len() == 1 && notes[0].contains("damaged") && notes[0].contains("silence"),
+        "{notes:?}"
+    );
 }

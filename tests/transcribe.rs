@@ -651,6 +651,54 @@ fn noise_and_held_tones_are_not_strokes() {
     assert_eq!(score.beats.len(), 1);
 }
 
+/// A recorded note cut to 0.3–0.75 s (the note fills the file, so it is most of its own
+/// median level) is still a stroke, while as short a stretch of white noise or a held tone
+/// is still refused; faint clicks (single samples 54 dB down, every 0.5 s) ringing on
+/// after the note are left out, with a notice, instead of becoming pp strokes.
+#[test]
+fn short_notes_are_heard_and_faint_clicks_are_not() {
+    let kit = Kit::standard();
+    let (note, fs) =
+        timpanist::sound::recording::read_mono(&root().join("kits/samples/Timpani_2L.wav"))
+            .unwrap();
+    let mut rng = timpanist::base::rng::Rng::new(11);
+    for seconds in [0.3, 0.5, 0.75] {
+        let n = (seconds * f64::from(fs)) as usize;
+        let (score, _) = transcribe(&note[..n], fs, &kit, "cut.wav", &Options::default()).unwrap();
+        assert_eq!(score.beats.len(), 1, "{seconds} s");
+        let white: Vec<f32> = (0..n)
+            .map(|_| 0.3 * rng.uniform(-1.0, 1.0) as f32)
+            .collect();
+        let tone: Vec<f32> = (0..n)
+            .map(|k| (0.3 * (0.02 * k as f64).sin()) as f32)
+            .collect();
+        for (name, samples) in [("white.wav", white), ("tone.wav", tone)] {
+            let e = transcribe(&samples, fs, &kit, name, &Options::default()).unwrap_err();
+            assert!(
+                matches!(e, TranscribeError::NoStrike { .. }),
+                "{seconds} s {name}: {e}"
+            );
+        }
+    }
+    let mut clicked = note.clone();
+    clicked.resize(8 * fs as usize, 0.0);
+    let peak = note.iter().fold(0.0f32, |m, x| m.max(x.abs()));
+    for k in 1..15 {
+        clicked[k * fs as usize / 2 + 100] += peak * 10f32.powf(-54.0 / 20.0);
+    }
+    let (score, report) =
+        transcribe(&clicked, fs, &kit, "clicks.wav", &Options::default()).unwrap();
+    assert_eq!(score.beats.len(), 1, "{:?}", report.notices);
+    assert!(
+        report
+            .notices
+            .iter()
+            .any(|n| n.contains("clicks were left out")),
+        "{:?}",
+        report.notices
+    );
+}
+
 /// `timpanist transcribe`: a recording becomes a score file that loads; a bad file exits
 /// non-zero naming it and writes nothing.
 #[test]

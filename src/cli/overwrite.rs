@@ -130,6 +130,13 @@ pub fn check_outputs(command: &Command) -> anyhow::Result<()> {
             anyhow::bail!("{}: is a folder; give a file name", out.display());
         }
         let folder = folder_of(out);
+        if folder.is_file() {
+            anyhow::bail!(
+                "{}: {} is a file, not a folder",
+                out.display(),
+                folder.display()
+            );
+        }
         if !folder.is_dir() {
             anyhow::bail!(
                 "{}: the folder {} does not exist",
@@ -173,8 +180,8 @@ mod tests {
     }
 
     /// An output that is an input, named another way, is refused, as are two outputs to
-    /// one file, an output in a folder that does not exist and a stems folder that is a
-    /// file; another output is not.
+    /// one file, an output in a folder that does not exist or under a file, and a stems
+    /// folder that is a file; another output is not.
     #[test]
     fn an_input_is_never_an_output() {
         let dir = tempfile::tempdir().unwrap();
@@ -197,17 +204,20 @@ mod tests {
         assert!(check_outputs(&other).is_ok());
         std::fs::write(&score, b"()").unwrap();
         assert!(check_outputs(&other).is_ok());
-        let nowhere = dir.path().join("nowhere/take.ron");
-        let err = check_outputs(&command(&[
-            "timpanist",
-            "transcribe",
-            take_s,
-            "-o",
-            nowhere.to_str().unwrap(),
-        ]))
-        .unwrap_err()
-        .to_string();
+        let refusal = |out: &Path| {
+            let args = [
+                "timpanist",
+                "transcribe",
+                take_s,
+                "-o",
+                out.to_str().unwrap(),
+            ];
+            check_outputs(&command(&args)).unwrap_err().to_string()
+        };
+        let err = refusal(&dir.path().join("nowhere/take.ron"));
         assert!(err.contains("does not exist"), "{err}");
+        let err = refusal(&take.join("take.ron"));
+        assert!(err.contains("is a file, not a folder"), "{err}");
         for args in [
             vec![
                 "timpanist",

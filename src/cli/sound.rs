@@ -89,6 +89,17 @@ pub fn fit(files: &[PathBuf], output: &Path) -> anyhow::Result<()> {
                 if let Some(why) = analysis::not_a_note(&samples, rate_hz) {
                     anyhow::bail!("{}: {why}", path.display());
                 }
+                let needed_hz = analysis::band_top_hz(OCTAVE_CENTRES_HZ.len() - 1) * 2.0;
+                if f64::from(rate_hz) < needed_hz {
+                    anyhow::bail!(
+                        "{}: recorded at {rate_hz} Hz, which cannot hold the fit's top octave \
+                         band ({:.0} Hz, up to {:.0} Hz): the fit needs at least {:.0} Hz",
+                        path.display(),
+                        OCTAVE_CENTRES_HZ[OCTAVE_CENTRES_HZ.len() - 1],
+                        needed_hz / 2.0,
+                        needed_hz.ceil()
+                    );
+                }
                 Ok(Note {
                     name: path.display().to_string(),
                     samples,
@@ -231,12 +242,27 @@ fn analyse_note(name: &str, samples: &[f32], rate: u32) -> anyhow::Result<()> {
         p.onset_s,
         20.0 * peak.max(1e-12).log10()
     );
+    // A band wholly above the file's Nyquist frequency holds nothing to measure.
+    let nyquist_hz = f64::from(rate) / 2.0;
     let bands: Vec<String> = OCTAVE_CENTRES_HZ
         .iter()
         .zip(&p.bands_db)
-        .map(|(c, b)| format!("{c:.0} Hz {b:.1}"))
+        .enumerate()
+        .map(|(i, (c, b))| {
+            if analysis::band_top_hz(i) / 2f64 >= nyquist_hz {
+                format!("{c:.0} Hz -")
+            } else {
+                format!("{c:.0} Hz {b:.1}")
+            }
+        })
         .collect();
     println!("  octave bands (dB of the total): {}", bands.join(", "));
+    if analysis::band_top_hz(OCTAVE_CENTRES_HZ.len() - 1) > nyquist_hz {
+        println!(
+            "  note: recorded at {rate} Hz: the bands reaching above {nyquist_hz:.0} Hz (half \
+             the rate) are measured only up to it; -: a band wholly above it"
+        );
+    }
     println!("  spectral centroid {:.0} Hz", p.centroid_hz);
     let decays: Vec<String> = OCTAVE_CENTRES_HZ
         .iter()

@@ -22,6 +22,11 @@ pub const MIN_DECAY_DB: f64 = 3.0;
 /// A struck note's loudest 10 ms stand at least this far above the median 10 ms of its
 /// file (or `--at` span), dB: pink noise stands 2–3 dB above, a timpani note 20–60.
 pub const MIN_STRIKE_CONTRAST_DB: f64 = 10.0;
+/// In a file under 2 s a note cut short may have decayed only a little by its end, so
+/// there its loudest 10 ms need stand only this far above its resting level
+/// ([`reference_level`]), dB: over such a span noise stands 1–3 dB above its last quarter,
+/// a held tone less, a D2 note cut to 0.3 s 7.4 dB.
+pub const MIN_SHORT_STRIKE_CONTRAST_DB: f64 = 6.0;
 /// Shorter than this after the onset, a note is not measured at all, s.
 pub const MIN_NOTE_S: f64 = 0.2;
 /// Shorter than this after the onset, a note is measured over what there is, with a
@@ -72,12 +77,25 @@ pub fn not_a_note(samples: &[f32], rate_hz: u32) -> Option<String> {
     }
     // Never missing: 0.2 s after the onset is twenty 10 ms windows at any audio rate.
     let contrast_db = strike_contrast_db(samples, rate_hz)?;
-    (contrast_db < MIN_STRIKE_CONTRAST_DB).then(|| {
+    let needed_db = min_strike_contrast_db(samples.len(), rate_hz);
+    (contrast_db < needed_db).then(|| {
         format!(
-            "no struck note: its loudest 10 ms stand only {contrast_db:.1} dB above its median \
-             level (at least {MIN_STRIKE_CONTRAST_DB} dB: is it noise or a sustained sound?)"
+            "no struck note: its loudest 10 ms stand only {contrast_db:.1} dB above its resting \
+             level (at least {needed_db} dB: is it noise or a sustained sound?)"
         )
     })
+}
+
+/// How far a strike must stand above the resting level ([`reference_level`]) of a file of
+/// `frames` at `rate_hz`, dB: [`MIN_STRIKE_CONTRAST_DB`], or in a file under 2 s
+/// [`MIN_SHORT_STRIKE_CONTRAST_DB`].
+pub fn min_strike_contrast_db(frames: usize, rate_hz: u32) -> f64 {
+    let windows = frames / ((0.01 * f64::from(rate_hz)) as usize).max(1);
+    if windows < SHORT_FILE_WINDOWS {
+        MIN_SHORT_STRIKE_CONTRAST_DB
+    } else {
+        MIN_STRIKE_CONTRAST_DB
+    }
 }
 
 /// Mean square of each whole 10 ms window of `samples`, in time order.
@@ -98,13 +116,30 @@ fn median_of(levels: &[f64]) -> f64 {
     sorted[sorted.len() / 2]
 }
 
+/// Below this many 10 ms windows (2 s) a file may be one note from end to end, s.
+const SHORT_FILE_WINDOWS: usize = 200;
+
+/// The level a strike is measured against: the median 10 ms window, or in a file under
+/// 2 s, where a note cut short fills most of it and is its own median, the median of its
+/// last quarter if quieter (a struck note has decayed there; noise and held tones have
+/// not). Not empty.
+fn reference_level(levels: &[f64]) -> f64 {
+    let median = median_of(levels);
+    if levels.len() >= SHORT_FILE_WINDOWS {
+        return median;
+    }
+    let tail = &levels[levels.len() - levels.len().div_ceil(4)..];
+    median.min(median_of(tail))
+}
+
 /// How far the loudest 10 ms window of `samples` stands above their median 10 ms
-/// window, dB (`None` with no whole window): a struck note stands 20–60 dB above, room
+/// window (in a file under 2 s, the quieter of it and its last quarter's: see
+/// [`reference_level`]), dB (`None` with no whole window): a struck note stands 20–60 dB above, room
 /// tone, noise and sustained tones 2–5 dB (seconds of pink noise up to ~10 dB).
 pub fn strike_contrast_db(samples: &[f32], rate_hz: u32) -> Option<f64> {
     let (_, levels) = window_levels(samples, rate_hz);
     let loudest = levels.iter().copied().reduce(f64::max)?;
-    Some(10.0 * (loudest / median_of(&levels).max(1e-30)).log10())
+    Some(10.0 * (loudest / reference_level(&levels).max(1e-30)).log10())
 }
 
 /// How far the loudest 10 ms window within `span_s` after each of `times_s` stands above
@@ -121,7 +156,7 @@ pub fn attack_contrast_db(
     if levels.is_empty() {
         return None;
     }
-    let median = median_of(&levels).max(1e-30);
+    let median = reference_level(&levels).max(1e-30);
     let index =
         |t: f64| ((t.max(0.0) * f64::from(rate_hz)) as usize / window).min(levels.len() - 1);
     times_s
@@ -152,6 +187,11 @@ fn power_spectrum(samples: &[f32], rate_hz: u32) -> (f64, Vec<f64>) {
     fft(&mut re, &mut im);
     let power = (0..=n / 2).map(|k| re[k] * re[k] + im[k] * im[k]).collect();
     (f64::from(rate_hz) / n as f64, power)
+}
+
+/// The upper edge of octave band `i` of [`OCTAVE_CENTRES_HZ`] (its centre times √2), Hz.
+pub fn band_top_hz(i: usize) -> f64 {
+    OCTAVE_CENTRES_HZ[i] * 2f64.sqrt()
 }
 
 /// The energy of a power spectrum (bin width `bin_hz`) in the octave band centred on

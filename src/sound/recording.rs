@@ -55,11 +55,16 @@ pub fn read_mono_noted(path: &Path) -> Result<(Vec<f32>, u32, Vec<String>), Read
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
-    let notes: Vec<String> = finish_wav_sizes(&mut bytes)
+    let mut notes: Vec<String> = finish_wav_sizes(&mut bytes)
         .into_iter()
         .map(|n| format!("{}: {n}", path.display()))
         .collect();
-    let (samples, rate) = read_mono_bytes(path, &bytes)?;
+    let (samples, rate, read_notes) = read_mono_bytes(path, &bytes)?;
+    notes.extend(
+        read_notes
+            .into_iter()
+            .map(|n| format!("{}: {n}", path.display())),
+    );
     Ok((samples, rate, notes))
 }
 
@@ -121,9 +126,17 @@ fn finish_wav_sizes(bytes: &mut [u8]) -> Option<String> {
     })
 }
 
+/// The highest sample rate read, Hz (a header claiming more is damaged).
+pub const MAX_RATE_HZ: u32 = 768_000;
+
 /// [`read_mono`] of a recording held in memory (`path` names it in errors; its extension,
-/// if any, is a hint to the format, which is recognised from the bytes).
-pub fn read_mono_bytes(path: &Path, bytes: &[u8]) -> Result<(Vec<f32>, u32), ReadError> {
+/// if any, is a hint to the format, which is recognised from the bytes), with notes on
+/// what was read round: damaged stretches a decoder skipped (read as silence, so what
+/// follows keeps its time) and a stream cut short.
+pub fn read_mono_bytes(
+    path: &Path,
+    bytes: &[u8],
+) -> Result<(Vec<f32>, u32, Vec<String>), ReadError> {
     let bad = |message: String| ReadError {
         path: path.to_path_buf(),
         message,
@@ -170,6 +183,14 @@ pub fn read_mono_bytes(path: &Path, bytes: &[u8]) -> Result<(Vec<f32>, u32), Rea
         .sample_rate
         .filter(|&r| r > 0)
         .ok_or_else(|| bad("the file does not say its sample rate".into()))?;
+    if rate > MAX_RATE_HZ {
+        return Err(bad(format!(
+            "its header gives a sample rate of {rate} Hz, more than any recording's (at most \
+             {} kHz): is the file damaged?",
+            MAX_RATE_HZ / 1000
+        )));
+    }
+    let time_base = track.time_base;
     let mut decoder = symphonia::default::get_codecs()
         .make_audio_decoder(&params, &Default::default())
         .map_err(|e| bad(format!("its audio encoding is not read ({e})")))?;
@@ -178,6 +199,12 @@ pub fn read_mono_bytes(path: &Path, bytes: &[u8]) -> Result<(Vec<f32>, u32), Rea
     let mut packet_samples: Vec<f32> = Vec::new();
     let mut channels = 0usize;
     let seconds = |frames: usize| frames as f64 / f64::from(rate);
+    let mut notes = Vec::new();
+    // Where the next packet should start (time-base units): a later one follows a
+    // stretch the reader skipped (a FLAC frame failing its checksum). FLAC only: the
+    // other formats' readers skip nothing (an Ogg Vorbis stream's first packets overlap).
+    let flac = bytes.starts_with(b"fLaC");
+    let mut next_pts: Option<i64> = None;
     loop {
         let packet = match reader.next_packet() {
             Ok(Some(packet)) => packet,
@@ -186,6 +213,13 @@ pub fn read_mono_bytes(path: &Path, bytes: &[u8]) -> Result<(Vec<f32>, u32), Rea
             Err(DecodeError::IoError(e))
                 if e.kind() == std::io::ErrorKind::UnexpectedEof && !raw.is_empty() =>
             {
+                if !bytes.starts_with(b"RIFF") {
+                    notes.push(format!(
+                        "the stream ends unfinished at {:.3} s (is the file cut short?): \
+                         what it holds is read",
+                        seconds(raw.len() / channels.max(1))
+                    ));
+                }
                 break;
             }
             Err(e) => {
@@ -196,6 +230,22 @@ pub fn read_mono_bytes(path: &Path, bytes: &[u8]) -> Result<(Vec<f32>, u32), Rea
         if packet.track_id != track_id {
             continue;
         }
+        if let (Some(tb), Some(expected)) = (time_base, next_pts)
+            && channels > 0
+        {
+            let missing_s = (packet.pts.get() - expected) as f64 * f64::from(tb.numer.get())
+                / f64::from(tb.denom.get());
+            let frames = (missing_s * f64::from(rate)).round();
+            if frames >= 1.0 && frames <= max_frames as f64 {
+                let at = seconds(raw.len() / channels);
+                notes.push(format!(
+                    "{missing_s:.3} s at {at:.3} s could not be read (damaged) and is read \
+                     as silence"
+                ));
+                raw.resize(raw.len() + frames as usize * channels, 0.0);
+            }
+        }
+        next_pts = flac.then(|| packet.pts.get() + packet.dur.get() as i64);
         let decoded = decoder.decode(&packet).map_err(|e| {
             let at = seconds(raw.len() / channels.max(1));
             bad(format!("unreadable at {at:.3} s: {e}"))
@@ -220,14 +270,17 @@ pub fn read_mono_bytes(path: &Path, bytes: &[u8]) -> Result<(Vec<f32>, u32), Rea
     if raw.is_empty() {
         return Err(bad("the file holds no samples".into()));
     }
-    if raw.iter().any(|s| !s.is_finite()) {
-        return Err(bad(
-            "it holds samples that are not numbers (NaN or infinite)".into(),
-        ));
+    if let Some(i) = raw.iter().position(|s| !s.is_finite()) {
+        let frame = i / channels.max(1);
+        return Err(bad(format!(
+            "it holds samples that are not numbers (NaN or infinite), the first at {:.6} s \
+             (frame {frame})",
+            seconds(frame)
+        )));
     }
     let mut mono = downmix(&raw, channels);
     remove_offset(&mut mono);
-    Ok((mono, rate))
+    Ok((mono, rate, notes))
 }
 
 /// A constant offset standing within [`MAX_OFFSET_SHARE`] of the sound's own RMS level
@@ -281,7 +334,8 @@ mod tests {
     fn unfinished_wav_headers_read_what_the_file_holds() {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("kits/samples/Timpani_2R.wav");
         let whole = std::fs::read(&path).unwrap();
-        let (samples, rate) = read_mono_bytes(&path, &whole).unwrap();
+        let (samples, rate, notes) = read_mono_bytes(&path, &whole).unwrap();
+        assert!(notes.is_empty(), "{notes:?}");
         let data = whole.windows(4).position(|w| w == b"data").unwrap();
         let set =
             |b: &mut Vec<u8>, at: usize, v: u32| b[at..at + 4].copy_from_slice(&v.to_le_bytes());
@@ -307,18 +361,55 @@ mod tests {
             assert_eq!(bytes, whole, "riff {riff:?} data {size:?}");
             assert_eq!(
                 read_mono_bytes(&path, &bytes).unwrap(),
-                (samples.clone(), rate)
+                (samples.clone(), rate, vec![])
             );
         }
         // Cut short: the first half of the sound.
         let mut cut = whole[..data + 8 + (whole.len() - data - 8) / 2].to_vec();
         let note = finish_wav_sizes(&mut cut).expect("a note");
         assert!(note.contains("cut short"), "{note}");
-        let (half, _) = read_mono_bytes(&path, &cut).unwrap();
+        let (half, _, _) = read_mono_bytes(&path, &cut).unwrap();
         assert!(half.len() + 2 >= samples.len() / 2 && half.len() <= samples.len() / 2 + 2);
         // A finished file is left alone.
         let mut same = whole.clone();
         assert_eq!(finish_wav_sizes(&mut same), None);
+    }
+
+    /// A 32-bit float WAV of `samples` (mono) at `rate`.
+    fn float_wav(samples: &[f32], rate: u32) -> Vec<u8> {
+        let mut b = Vec::new();
+        let data = (4 * samples.len()) as u32;
+        b.extend_from_slice(b"RIFF");
+        b.extend_from_slice(&(36 + data).to_le_bytes());
+        b.extend_from_slice(b"WAVEfmt ");
+        b.extend_from_slice(&16u32.to_le_bytes());
+        b.extend_from_slice(&3u16.to_le_bytes());
+        b.extend_from_slice(&1u16.to_le_bytes());
+        b.extend_from_slice(&rate.to_le_bytes());
+        b.extend_from_slice(&(4 * rate).to_le_bytes());
+        b.extend_from_slice(&4u16.to_le_bytes());
+        b.extend_from_slice(&32u16.to_le_bytes());
+        b.extend_from_slice(b"data");
+        b.extend_from_slice(&data.to_le_bytes());
+        for x in samples {
+            b.extend_from_slice(&x.to_le_bytes());
+        }
+        b
+    }
+
+    /// A header claiming a rate no recorder writes is refused at once (it had the onset
+    /// detector's frames grow with it, to gigabytes); a NaN is named by its time and frame.
+    #[test]
+    fn an_absurd_rate_and_a_nan_are_refused_saying_where() {
+        let path = Path::new("note.wav");
+        let tone: Vec<f32> = (0..4800).map(|i| (0.01 * i as f32).sin() * 0.5).collect();
+        let e = read_mono_bytes(path, &float_wav(&tone, 4_000_000_000)).unwrap_err();
+        assert!(e.to_string().contains("4000000000 Hz"), "{e}");
+        assert!(read_mono_bytes(path, &float_wav(&tone, MAX_RATE_HZ)).is_ok());
+        let mut bad = tone.clone();
+        bad[2400] = f32::NAN;
+        let e = read_mono_bytes(path, &float_wav(&bad, 48_000)).unwrap_err();
+        assert!(e.to_string().contains("0.050000 s (frame 2400)"), "{e}");
     }
     use super::*;
     use std::f64::consts::TAU;

@@ -84,11 +84,15 @@ pub enum TranscribeError {
     #[error("{file}: no strokes were heard (silence, or no clear attacks)")]
     Silent { file: String },
     #[error(
-        "{file}: no strokes: what starts in it stands only {contrast_db:.1} dB above its median \
-         level (a stroke's attack stands {MIN_CONTRAST_DB} dB and more above: is it noise or \
+        "{file}: no strokes: what starts in it stands only {contrast_db:.1} dB above its \
+         resting level (a stroke's attack stands {needed_db} dB and more above: is it noise or \
          a sustained sound?)"
     )]
-    NoStrike { file: String, contrast_db: f64 },
+    NoStrike {
+        file: String,
+        contrast_db: f64,
+        needed_db: f64,
+    },
     #[error("{file}: sample {frame} is not a finite number")]
     NonFinite { file: String, frame: usize },
     #[error("{file}: {seconds:.0} s of audio is longer than a score may last ({max:.0} s)")]
@@ -105,7 +109,6 @@ pub enum TranscribeError {
 /// [`ATTACK_S`] after one of them, this far above its median level (dB,
 /// `analysis::attack_contrast_db`), else it is refused as holding no playing.
 const MIN_STROKES_UNLESS_STRUCK: usize = 3;
-const MIN_CONTRAST_DB: f64 = analysis::MIN_STRIKE_CONTRAST_DB;
 const ATTACK_S: f64 = 0.05;
 
 /// Transcribe the WAV file `path` onto `kit`.
@@ -127,6 +130,13 @@ pub fn transcribe_file(
     report.notices.splice(0..0, read_notes);
     Ok((score, report))
 }
+
+/// A sound with no kettledrum pitch this far under the loudest stroke is a click, not a
+/// stroke, dB (a timpani's pp stands 30–40 dB under its ff).
+pub const FAINT_CLICK_DB: f64 = 45.0;
+/// Anything this far under the loudest stroke is below the instrument's range: a click,
+/// whatever pitch its window seems to hold (the ringing drums lend it one), dB.
+pub const FAINT_STROKE_DB: f64 = 55.0;
 
 /// Transcribe mono `samples` at `rate_hz` (named `source` in messages) onto `kit`.
 pub fn transcribe(
@@ -170,11 +180,13 @@ pub fn transcribe(
     // has many strokes.
     if times.len() < MIN_STROKES_UNLESS_STRUCK
         && let Some(contrast_db) = analysis::attack_contrast_db(samples, rate_hz, &times, ATTACK_S)
-        && contrast_db < MIN_CONTRAST_DB
+        && let needed_db = analysis::min_strike_contrast_db(samples.len(), rate_hz)
+        && contrast_db < needed_db
     {
         return Err(TranscribeError::NoStrike {
             file: source,
             contrast_db,
+            needed_db,
         });
     }
     let band = pitch_band(kit);
@@ -196,7 +208,8 @@ pub fn transcribe(
     // roll's first stroke reads C♯2 — or hears a partial as the (1,1)); the rolls among
     // them take their pitch once the beats are known, below.
     let heard_alone: Vec<Option<f64>> = strokes.iter().map(|s| s.principal_hz).collect();
-    for run in fast_runs(&times) {
+    let runs = fast_runs(&times);
+    for run in runs.clone() {
         let span = (times[run.start], times[run.end - 1]);
         if let Some(run_hz) = notes::hear_run(samples, rate_hz, span, band) {
             for stroke in &mut strokes[run] {
@@ -204,6 +217,26 @@ pub fn transcribe(
             }
         }
     }
+    // A click far under the playing (a recording quantised to 8 bits flipping its last
+    // bit, a stray tick) is no stroke; a roll's strokes, each adding little to the ringing
+    // it keeps up, are kept.
+    let loudest = strokes
+        .iter()
+        .map(|s| s.level_db)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let clicks: Vec<bool> = strokes
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let below = loudest - s.level_db;
+            !runs.iter().any(|r| r.contains(&i))
+                && (below > FAINT_STROKE_DB || (s.principal_hz.is_none() && below > FAINT_CLICK_DB))
+        })
+        .collect();
+    let times = kept_where(times, &clicks);
+    let mut strokes = kept_where(strokes, &clicks);
+    let heard_alone = kept_where(heard_alone, &clicks);
+    let clicks = clicks.iter().filter(|&&c| c).count();
     let mut score = Score::new(options.title.as_deref().unwrap_or("Transcription"));
     score.kit = options.kit_ref.clone();
     let tpq = score.ticks_per_quarter;
@@ -264,6 +297,12 @@ pub fn transcribe(
     score.sort_beats();
 
     let mut notices = Vec::new();
+    if clicks > 0 {
+        notices.push(format!(
+            "{clicks} clicks were left out: sounds {FAINT_CLICK_DB} dB or more under the \
+             loudest stroke with no pitch, or {FAINT_STROKE_DB} dB or more under it"
+        ));
+    }
     if found_notes.octave_moves > 0 {
         notices.push(format!(
             "{} strokes were moved by octaves into a drum's range",
@@ -324,6 +363,16 @@ fn lead_in_ticks(first_s: f64, period_s: f64, tpq: u32) -> u64 {
         (first_s / period_s * f64::from(tpq)).round().max(1.0)
     };
     ticks as u64
+}
+
+/// The items of `items` whose entry in `dropped` is false.
+fn kept_where<T>(items: Vec<T>, dropped: &[bool]) -> Vec<T> {
+    items
+        .into_iter()
+        .zip(dropped)
+        .filter(|(_, d)| !**d)
+        .map(|(x, _)| x)
+        .collect()
 }
 
 /// The runs of at least [`notes::RUN_STROKES`] onsets (`times`, s, sorted) each within
