@@ -106,13 +106,14 @@ fn rich_score() -> Score {
     more[1].hand = Hand::Right;
     more[2].pitch = Some("E3".parse().unwrap());
     more[2].dynamic = Dynamic::Ff;
+    more[2].damp = Some(480);
     beats.extend(more);
     score.beats = beats;
     score
 }
 
 /// Every beat survives export and import: tick, drum, sounding pitch, MIDI velocity, hand,
-/// mode, location and roll; and title and time signatures too.
+/// mode, location, roll and damp; and title and time signatures too.
 #[test]
 fn round_trip_keeps_every_beat() {
     let kit = Kit::standard();
@@ -137,8 +138,8 @@ fn round_trip_keeps_every_beat() {
         assert_eq!(pitch, back_pitch, "{a:?} {b:?}");
         assert_eq!(a.dynamic.midi_velocity(), b.dynamic.midi_velocity());
         assert_eq!(
-            (a.hand, a.mode, a.location, a.roll),
-            (b.hand, b.mode, b.location, b.roll)
+            (a.hand, a.mode, a.location, a.roll, a.damp),
+            (b.hand, b.mode, b.location, b.roll, b.damp)
         );
     }
 }

@@ -21,11 +21,16 @@ use serde::{Deserialize, Serialize};
 /// General MIDI program "Timpani" (48 counted from 1).
 pub const GM_TIMPANI: u8 = 47;
 
-/// Prefix of the sequencer-specific payload that carries a beat's timpanist data.
+/// The manufacturer ID a sequencer-specific meta event's data starts with (SMF 1.0):
+/// 0x7D, the one set aside for non-commercial use.
+const NON_COMMERCIAL_ID: u8 = 0x7D;
+
+/// Prefix, after [`NON_COMMERCIAL_ID`], of the sequencer-specific payload that carries a
+/// beat's timpanist data.
 pub(crate) const PAYLOAD_PREFIX: &[u8] = b"timpanist:";
 
-/// What MIDI cannot say about a beat: (hand, mode, drum index, location, roll), written
-/// as RON after [`PAYLOAD_PREFIX`].
+/// What MIDI cannot say about a beat: (hand, mode, drum index, location, roll, damp),
+/// written as RON after [`PAYLOAD_PREFIX`].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub(crate) struct BeatData(
     pub Hand,
@@ -33,19 +38,30 @@ pub(crate) struct BeatData(
     pub usize,
     pub ImpactLocation,
     pub Option<Roll>,
+    pub Option<u64>,
 );
+
+/// [`BeatData`] as files written before 2026-12-07 carry it: without the damp, and
+/// without the manufacturer ID.
+#[derive(Deserialize)]
+struct BeatDataWithoutDamp(Hand, PlayingMode, usize, ImpactLocation, Option<Roll>);
 
 impl BeatData {
     /// The payload bytes for a sequencer-specific meta event.
     fn to_payload(self) -> Vec<u8> {
         let ron = ron::to_string(&self).expect("beat data always serialises to RON");
-        [PAYLOAD_PREFIX, ron.as_bytes()].concat()
+        [&[NON_COMMERCIAL_ID], PAYLOAD_PREFIX, ron.as_bytes()].concat()
     }
 
-    /// Read a payload written by [`BeatData::to_payload`]; `None` for anything else.
+    /// Read a payload written by [`BeatData::to_payload`] (or by an earlier version);
+    /// `None` for anything else.
     pub(crate) fn from_payload(bytes: &[u8]) -> Option<BeatData> {
+        let bytes = bytes.strip_prefix(&[NON_COMMERCIAL_ID]).unwrap_or(bytes);
         let text = std::str::from_utf8(bytes.strip_prefix(PAYLOAD_PREFIX)?).ok()?;
-        ron::from_str(text).ok()
+        ron::from_str(text).ok().or_else(|| {
+            let BeatDataWithoutDamp(hand, mode, drum, location, roll) = ron::from_str(text).ok()?;
+            Some(BeatData(hand, mode, drum, location, roll, None))
+        })
     }
 }
 
@@ -56,7 +72,7 @@ pub fn export(score: &Score, kit: &Kit) -> Vec<u8> {
     let payloads: Vec<Vec<u8>> = score
         .beats
         .iter()
-        .map(|b| BeatData(b.hand, b.mode, b.drum, b.location, b.roll).to_payload())
+        .map(|b| BeatData(b.hand, b.mode, b.drum, b.location, b.roll, b.damp).to_payload())
         .collect();
     let title = super::midi_text::encode(&score.title);
     let smf = Smf {
@@ -256,7 +272,8 @@ mod tests {
             .collect()
     }
 
-    /// Beat data survives the payload round trip, including a roll and an exact point.
+    /// Beat data survives the payload round trip, including a roll, an exact point and a
+    /// damp; a payload of an earlier version (no damp, no manufacturer ID) still reads.
     #[test]
     fn payload_round_trip() {
         let data = BeatData(
@@ -271,11 +288,25 @@ mod tests {
                 length_ticks: 1920,
                 strokes_per_quarter: 8,
             }),
+            Some(240),
         );
         let payload = data.to_payload();
-        assert!(payload.starts_with(b"timpanist:("));
+        assert!(payload.starts_with(b"\x7Dtimpanist:("));
         assert_eq!(BeatData::from_payload(&payload), Some(data));
         assert_eq!(BeatData::from_payload(b"other:(Auto)"), None);
+        // As files written before the damp and the manufacturer ID carry it.
+        let old = b"timpanist:(Left,Tenuto,2,PlayingSpot,None)";
+        assert_eq!(
+            BeatData::from_payload(old),
+            Some(BeatData(
+                Hand::Left,
+                PlayingMode::Tenuto,
+                2,
+                ImpactLocation::PlayingSpot,
+                None,
+                None
+            ))
+        );
     }
 
     /// A ramp's tempo steps reach every step boundary at the ramp's time to 1 µs, and the

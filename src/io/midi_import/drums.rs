@@ -161,6 +161,7 @@ pub(in crate::io) fn assign_drums(
                 drum,
                 ImpactLocation::PlayingSpot,
                 None,
+                None,
             ));
             Beat {
                 tick: n.tick,
@@ -171,8 +172,9 @@ pub(in crate::io) fn assign_drums(
                 pitch: Some(Pitch(key)),
                 location: data.3,
                 roll: data.4,
-                // A MIDI note's length says nothing reliable about damping: let it ring.
-                damp: None,
+                // A MIDI note's length says nothing reliable about damping: it rings
+                // unless timpanist's own data says when the hand stops it.
+                damp: data.5,
             }
         })
         .collect();

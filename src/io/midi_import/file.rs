@@ -170,6 +170,10 @@ pub(super) fn sane(mut data: BeatData, clock: &Clock, file_tick: u64) -> BeatDat
         ((1..=32).contains(&spq) && tpq.is_multiple_of(spq) && roll.length_ticks > 0)
             .then_some(roll)
     });
+    // The damp counts ticks after the beat's end: held as the clock moves them.
+    data.5 = data
+        .5
+        .map(|d| clock.tick(file_tick.saturating_add(d)) - clock.tick(file_tick));
     if let ImpactLocation::Point { radius, angle_deg } = data.3
         && !((0.0..=1.0).contains(&radius) && angle_deg.is_finite())
     {

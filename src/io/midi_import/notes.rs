@@ -110,6 +110,7 @@ pub(super) fn detect_rolls(notes: &mut Vec<Note>, tpq: u32) {
                     ANY_DRUM,
                     ImpactLocation::PlayingSpot,
                     Some(roll),
+                    None,
                 ));
                 for &k in &run_of[start + 1..=end] {
                     remove[k] = true;

@@ -29,6 +29,7 @@ fn rolled(tick: u64, name: &str, length_ticks: u64, strokes_per_quarter: u32) ->
                 length_ticks,
                 strokes_per_quarter,
             }),
+            None,
         )),
         ..note(tick, pitch(name))
     }

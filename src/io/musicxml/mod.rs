@@ -340,7 +340,14 @@ pub fn import(
 
 /// The hand, mode and roll of a note in the MIDI import's terms (the drum left to choose).
 fn midi_data(hand: Hand, mode: PlayingMode, roll: Option<Roll>) -> super::midi_export::BeatData {
-    super::midi_export::BeatData(hand, mode, ANY_DRUM, ImpactLocation::PlayingSpot, roll)
+    super::midi_export::BeatData(
+        hand,
+        mode,
+        ANY_DRUM,
+        ImpactLocation::PlayingSpot,
+        roll,
+        None,
+    )
 }
 
 /// The marking of a MIDI velocity if it is exactly one, else the velocity (0–1).
