@@ -19,7 +19,9 @@
 //! marks with `<sound tempo>` (quarter notes per minute); a linear ramp is marked
 //! "accel." or "rit." and played as the MIDI export's steps every sixteenth note, each an
 //! invisible `<sound tempo>` at its `<offset>`, so the seconds match the score's.
-//! The impact location does not survive.
+//! Each note names its drum in a processing instruction, `<?timpanist drum="N"?>`, which
+//! other programs leave alone and the import reads back. The impact location does not
+//! survive.
 
 use crate::base::pitch::Pitch;
 use crate::kit::Kit;
@@ -326,6 +328,8 @@ impl<'a> Writer<'a> {
             let last = at + ticks == group.end;
             for (n, beat) in group.beats.iter().enumerate() {
                 let mut note = String::from("      <note>");
+                let pi = super::musicxml::DRUM_PI_TARGET;
+                let _ = write!(note, "<?{pi} drum=\"{}\"?>", beat.drum);
                 if n > 0 {
                     note.push_str("<chord/>");
                 }

@@ -285,7 +285,7 @@ pub fn import(
             channel: 0,
             key: n.pitch,
             vel: vel.round().clamp(1.0, 127.0) as u8,
-            data: Some(midi_data(n.hand, mode, n.roll)),
+            data: Some(midi_data(n.hand, mode, n.roll, n.drum)),
         });
     }
     let duplicates_dropped = midi::drop_duplicates(&mut notes);
@@ -338,16 +338,21 @@ pub fn import(
     Ok((score, report))
 }
 
-/// The hand, mode and roll of a note in the MIDI import's terms (the drum left to choose).
-fn midi_data(hand: Hand, mode: PlayingMode, roll: Option<Roll>) -> super::midi_export::BeatData {
-    super::midi_export::BeatData(
-        hand,
-        mode,
-        ANY_DRUM,
-        ImpactLocation::PlayingSpot,
-        roll,
-        None,
-    )
+/// The target of the processing instruction `<?timpanist drum="N"?>` that timpanist's
+/// export puts in each note to name its drum (notation programs leave it alone), so a
+/// pitch two drums can play comes back on its own.
+pub(crate) const DRUM_PI_TARGET: &str = "timpanist";
+
+/// The hand, mode, roll and drum of a note in the MIDI import's terms (the drum left to
+/// choose unless named; one that cannot play the note is chosen again).
+fn midi_data(
+    hand: Hand,
+    mode: PlayingMode,
+    roll: Option<Roll>,
+    drum: Option<usize>,
+) -> super::midi_export::BeatData {
+    let drum = drum.unwrap_or(ANY_DRUM);
+    super::midi_export::BeatData(hand, mode, drum, ImpactLocation::PlayingSpot, roll, None)
 }
 
 /// The marking of a MIDI velocity if it is exactly one, else the velocity (0–1).

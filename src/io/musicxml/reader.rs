@@ -27,6 +27,9 @@ pub(super) struct XNote {
     /// Half of a two-note tremolo.
     pub(super) two_note: Option<TwoNote>,
     pub(super) roll: Option<Roll>,
+    /// The drum a `<?timpanist drum="N"?>` processing instruction in the note names (what
+    /// timpanist's own export writes; other programs leave it alone).
+    pub(super) drum: Option<usize>,
     /// Ticks from the last stroke to the damping touch.
     pub(super) damp: Option<u64>,
 }
@@ -627,6 +630,12 @@ impl<'a, 'd> PartReader<'a, 'd> {
         }
         self.ties.retain(|&(p, _)| p != pitch);
         let marks = self.notations(el, tick, &place);
+        let drum = el
+            .children()
+            .filter_map(|c| c.pi())
+            .find(|pi| pi.target == super::DRUM_PI_TARGET)
+            .and_then(|pi| pi.value)
+            .and_then(drum_of_pi);
         self.notes.push(XNote {
             tick,
             end: tick + duration,
@@ -640,6 +649,7 @@ impl<'a, 'd> PartReader<'a, 'd> {
             two_note: marks.two_note,
             roll: None,
             damp: None,
+            drum,
         });
         let index = self.notes.len() - 1;
         if tie_start {
@@ -1173,9 +1183,20 @@ pub(super) fn alternate(a: &XNote, b: &XNote, spq: u32, tpq: u64) -> Vec<XNote> 
                 two_note: None,
                 roll: None,
                 damp: None,
+                drum: from.drum,
             }
         })
         .collect()
+}
+
+/// The drum index of a drum processing instruction's value, `drum="N"`.
+fn drum_of_pi(value: &str) -> Option<usize> {
+    value
+        .trim()
+        .strip_prefix("drum=\"")?
+        .strip_suffix('"')?
+        .parse()
+        .ok()
 }
 
 /// The movement title, else the work title.
