@@ -8,7 +8,7 @@
 //!   --body-hz 10000`);
 //! * after a one-beat edit near 30 s (its dynamic changed), the rendering that resumes
 //!   the previous performance from its saved state before the edit and stops
-//!   `FIRST_STEP_S` (0.4 s) past the edited stroke (what the editor plays at once: its audio is final up
+//!   `FIRST_STEP_S` (0.25 s) past the edited stroke (what the editor plays at once: its audio is final up
 //!   to there), and the resumed rendering of the whole rest.
 //!
 //! * what handing a compensation attempt to the other core would copy first, at the
