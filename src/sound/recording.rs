@@ -386,7 +386,7 @@ mod tests {
         b.extend_from_slice(&3u16.to_le_bytes());
         b.extend_from_slice(&1u16.to_le_bytes());
         b.extend_from_slice(&rate.to_le_bytes());
-        b.extend_from_slice(&(4 * rate).to_le_bytes());
+        b.extend_from_slice(&rate.wrapping_mul(4).to_le_bytes());
         b.extend_from_slice(&4u16.to_le_bytes());
         b.extend_from_slice(&32u16.to_le_bytes());
         b.extend_from_slice(b"data");
