@@ -89,15 +89,15 @@ pub fn fit(files: &[PathBuf], output: &Path) -> anyhow::Result<()> {
                 if let Some(why) = analysis::not_a_note(&samples, rate_hz) {
                     anyhow::bail!("{}: {why}", path.display());
                 }
-                let needed_hz = analysis::band_top_hz(OCTAVE_CENTRES_HZ.len() - 1) * 2.0;
-                if f64::from(rate_hz) < needed_hz {
+                let top = OCTAVE_CENTRES_HZ.len() - 1;
+                let top_hz = analysis::band_top_hz(top);
+                if f64::from(rate_hz) < 2.0 * top_hz {
                     anyhow::bail!(
                         "{}: recorded at {rate_hz} Hz, which cannot hold the fit's top octave \
-                         band ({:.0} Hz, up to {:.0} Hz): the fit needs at least {:.0} Hz",
+                         band ({:.0} Hz, up to {top_hz:.0} Hz): the fit needs at least {:.0} Hz",
                         path.display(),
-                        OCTAVE_CENTRES_HZ[OCTAVE_CENTRES_HZ.len() - 1],
-                        needed_hz / 2.0,
-                        needed_hz.ceil()
+                        OCTAVE_CENTRES_HZ[top],
+                        (2.0 * top_hz).ceil()
                     );
                 }
                 Ok(Note {

@@ -90,17 +90,21 @@ pub fn not_a_note(samples: &[f32], rate_hz: u32) -> Option<String> {
 /// `frames` at `rate_hz`, dB: [`MIN_STRIKE_CONTRAST_DB`], or in a file under 2 s
 /// [`MIN_SHORT_STRIKE_CONTRAST_DB`].
 pub fn min_strike_contrast_db(frames: usize, rate_hz: u32) -> f64 {
-    let windows = frames / ((0.01 * f64::from(rate_hz)) as usize).max(1);
-    if windows < SHORT_FILE_WINDOWS {
+    if frames / window_frames(rate_hz) < SHORT_FILE_WINDOWS {
         MIN_SHORT_STRIKE_CONTRAST_DB
     } else {
         MIN_STRIKE_CONTRAST_DB
     }
 }
 
+/// Frames in a 10 ms window at `rate_hz` (at least one).
+fn window_frames(rate_hz: u32) -> usize {
+    ((0.01 * f64::from(rate_hz)) as usize).max(1)
+}
+
 /// Mean square of each whole 10 ms window of `samples`, in time order.
 fn window_levels(samples: &[f32], rate_hz: u32) -> (usize, Vec<f64>) {
-    let window = ((0.01 * f64::from(rate_hz)) as usize).max(1);
+    let window = window_frames(rate_hz);
     let levels = samples
         .chunks(window)
         .filter(|w| w.len() == window)
@@ -156,7 +160,7 @@ pub fn attack_contrast_db(
     if levels.is_empty() {
         return None;
     }
-    let median = reference_level(&levels).max(1e-30);
+    let resting = reference_level(&levels).max(1e-30);
     let index =
         |t: f64| ((t.max(0.0) * f64::from(rate_hz)) as usize / window).min(levels.len() - 1);
     times_s
@@ -164,7 +168,7 @@ pub fn attack_contrast_db(
         .map(|&t| {
             let (a, b) = (index(t), index(t + span_s));
             let loudest = levels[a..=b].iter().copied().fold(0.0, f64::max);
-            10.0 * (loudest / median).log10()
+            10.0 * (loudest / resting).log10()
         })
         .reduce(f64::max)
 }

@@ -55,16 +55,13 @@ pub fn read_mono_noted(path: &Path) -> Result<(Vec<f32>, u32, Vec<String>), Read
         path: path.to_path_buf(),
         message: e.to_string(),
     })?;
-    let mut notes: Vec<String> = finish_wav_sizes(&mut bytes)
+    let finished = finish_wav_sizes(&mut bytes);
+    let (samples, rate, read) = read_mono_bytes(path, &bytes)?;
+    let notes = finished
         .into_iter()
+        .chain(read)
         .map(|n| format!("{}: {n}", path.display()))
         .collect();
-    let (samples, rate, read_notes) = read_mono_bytes(path, &bytes)?;
-    notes.extend(
-        read_notes
-            .into_iter()
-            .map(|n| format!("{}: {n}", path.display())),
-    );
     Ok((samples, rate, notes))
 }
 

@@ -106,8 +106,8 @@ pub enum TranscribeError {
 }
 
 /// A recording from which fewer strokes than this are heard must stand, within
-/// [`ATTACK_S`] after one of them, this far above its median level (dB,
-/// `analysis::attack_contrast_db`), else it is refused as holding no playing.
+/// [`ATTACK_S`] after one of them, `analysis::min_strike_contrast_db` above its resting
+/// level (dB, `analysis::attack_contrast_db`), else it is refused as holding no playing.
 const MIN_STROKES_UNLESS_STRUCK: usize = 3;
 const ATTACK_S: f64 = 0.05;
 
