@@ -29,6 +29,10 @@ use std::time::{Duration, Instant};
 
 /// Strokes closer together than this, s, are settled together.
 pub const CLUSTER_GAP_S: f64 = 0.09;
+/// Timing errors within this of a tolerance, s, are within it: contact times are whole
+/// contact steps and beat times any time, so a contact 1.5 ms off its beat measured
+/// 0.0015000000000000568 s off and was retried against a 1.5 ms tolerance.
+const TIME_ROUNDING_S: f64 = 1e-9;
 /// How far past a cluster's last stroke its attempts simulate, s.
 const LOOKAHEAD_S: f64 = 0.035;
 /// The most a stroke's target is played earlier or later, s (with the gap and the
@@ -655,7 +659,7 @@ impl Performance {
             // A stroke that does not sound is worse than a stick falling back on a head,
             // that worse than a contact out of time, that worse than a force far off, that
             // worse than a pressed (long) contact, and that worse than a force a little off.
-            let late = worst > aims.acceptable_s;
+            let late = worst > aims.acceptable_s + TIME_ROUNDING_S;
             let key = (missed, recontacts, late, far, long, off_force, worst);
             if best.as_ref().is_none_or(|b| key <= b.0) {
                 best = Some((
@@ -666,7 +670,7 @@ impl Performance {
                 ));
             }
             let clean = missed + recontacts + long + off_force == 0;
-            let on_time = clean && worst <= aims.tolerance_s;
+            let on_time = clean && worst <= aims.tolerance_s + TIME_ROUNDING_S;
             let acceptable = clean && !late && attempt >= aims.settle_attempts;
             // A cluster that sounds but has a force far off or a pressed contact gets up
             // to half as many attempts again.
@@ -692,7 +696,8 @@ impl Performance {
                 c.as_ref().is_none_or(|c| {
                     let ratio = c.peak_force_n / aims.force_n[i];
                     (ratio - 1.0).abs() > aims.force_tolerance
-                        || (c.start_s - strokes[i].time_s).abs() > aims.tolerance_s
+                        || (c.start_s - strokes[i].time_s).abs()
+                            > aims.tolerance_s + TIME_ROUNDING_S
                         || pressed(c, aims)
                 })
             };
