@@ -166,6 +166,14 @@ const SLOW_LOOP: f64 = 0.1;
 /// Rounds of [`place_hand`] in a task-rate IK solve.
 const HAND_SOLVE_ROUNDS: usize = 40;
 
+/// Fastest the trunk's target turns while a hand goes to a point of its own, rad/s
+/// (90°/s). Placing a hand satisfies the hand's point and the stick's tip together as
+/// soon as its weight is above 0 (the alternating rounds compound), which may need the
+/// trunk turned: a damping hand's first 40 ms turned it 17° (570°/s) on pedal-changes,
+/// and the light neck and head, jolted by the trunk's loop, whipped round at up to
+/// 5700°/s. A player turns into such a reach over a few tenths of a second.
+pub const MAX_PLACING_TRUNK_TURN_RAD_PER_S: f64 = std::f64::consts::FRAC_PI_2;
+
 /// Per sample and hand ([left, right]), where the hand goes (its grip joint, m) and how
 /// much of the way: 0 leaves the hand to the stick's task, 1 puts it on its point. While
 /// it is above 0 the stick turns about the hand to point its tip at the tip target.
@@ -464,35 +472,79 @@ pub fn ik_target(
         }
     };
     let mut pose = reference.poses.as_ref().map_or(start, |p| p[k]);
-    for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
-        pose = ik::solve(
-            &model.skeleton,
-            &pose,
-            side,
-            reference.tips[h][k],
-            Some(&pull),
-            &params.ik,
-            &params.ik_limits(),
-        )
-        .pose;
-        if let Some(hand) = reference.hands.as_ref().and_then(|t| t.at(h, k, 1.0)) {
-            place_hand(
-                &model.skeleton,
-                &mut pose,
-                side,
-                hand,
-                reference.tips[h][k],
-                Some(&pull),
-                (&params.ik, &params.ik_limits()),
-                HAND_SOLVE_ROUNDS,
-            );
-        }
+    let placed = arms_ik(
+        model,
+        reference,
+        k,
+        (&params.ik, &params.ik_limits()),
+        &pull,
+        &mut pose,
+    );
+    let trunk = Joint::Trunk.index();
+    let (turn, most) = (
+        start[trunk].angle_between(pose[trunk]),
+        MAX_PLACING_TRUNK_TURN_RAD_PER_S / reference.rate_hz,
+    );
+    if placed && turn > most && reference.poses.is_none() {
+        // The trunk held to its fastest turn, the arms solved again about it.
+        pose[trunk] = start[trunk].slerp(pose[trunk], most / turn).normalize();
+        let held = IkParams {
+            use_trunk: false,
+            ..params.ik
+        };
+        arms_ik(
+            model,
+            reference,
+            k,
+            (&held, &params.ik_limits()),
+            &pull,
+            &mut pose,
+        );
     }
     if let Some(gaze) = &reference.gaze {
         let frames = model.skeleton.forward(&pose);
         super::gaze::look_at(&frames, &mut pose, gaze[k]);
     }
     pose
+}
+
+/// Both arms' IK of reference sample `k` from `pose`, the redundancy pulled toward `pull`
+/// ([`place_hand`] for a hand with a point of its own); whether a hand has one.
+fn arms_ik(
+    model: &BodyModel,
+    reference: &Reference,
+    k: usize,
+    (ik, limits): (&IkParams, &JointLimits),
+    pull: &Pose,
+    pose: &mut Pose,
+) -> bool {
+    let mut placed = false;
+    for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
+        *pose = ik::solve(
+            &model.skeleton,
+            pose,
+            side,
+            reference.tips[h][k],
+            Some(pull),
+            ik,
+            limits,
+        )
+        .pose;
+        if let Some(hand) = reference.hands.as_ref().and_then(|t| t.at(h, k, 1.0)) {
+            placed = true;
+            place_hand(
+                &model.skeleton,
+                pose,
+                side,
+                hand,
+                reference.tips[h][k],
+                Some(pull),
+                (ik, limits),
+                HAND_SOLVE_ROUNDS,
+            );
+        }
+    }
+    placed
 }
 
 /// [`simulate`] with the body meeting `environment` (e.g. the drums) every simulation step.
@@ -1038,6 +1090,65 @@ pub fn rms_error(a: &[DVec3], b: &[DVec3]) -> f64 {
 mod tests {
     use super::*;
     use crate::body::skeleton::REST;
+
+    /// A hand going to a point of its own that the arm reaches only with the trunk
+    /// turned: the trunk's target turns no faster than
+    /// [`MAX_PLACING_TRUNK_TURN_RAD_PER_S`] (unheld it turned as soon as the hand's
+    /// weight left 0), and the hand still gets to its point.
+    #[test]
+    fn a_placed_hand_turns_the_trunk_no_faster_than_a_player() {
+        let model = BodyModel::default();
+        let params = SimParams::default();
+        let rate = 250.0;
+        let n = (1.5 * rate) as usize;
+        let tips = [
+            vec![DVec3::new(-0.35, 0.45, 0.95); n],
+            vec![DVec3::new(0.35, 0.45, 0.95); n],
+        ];
+        let initial = ik::posture_reaching(
+            &model.skeleton,
+            [tips[0][0], tips[1][0]],
+            &params.ik_limits(),
+        );
+        // The left hand to a point in front of the body (unheld, the trunk's target turned
+        // 18° at up to 560°/s), its weight rising smoothly from 0 at 0.2 s to 1 at 0.5 s.
+        let point = DVec3::new(-0.1, 0.45, 0.85);
+        let weight: Vec<f64> = (0..n)
+            .map(|k| {
+                let u = ((k as f64 / rate - 0.2) / 0.3).clamp(0.0, 1.0);
+                u * u * (3.0 - 2.0 * u)
+            })
+            .collect();
+        let mut reference = Reference::following(rate, tips);
+        reference.hands = Some(HandTargets {
+            weight: [weight, vec![0.0; n]],
+            points: [vec![point; n], vec![DVec3::ZERO; n]],
+        });
+        let targets = ik_targets(&model, &reference, &params, &initial);
+        let trunk = Joint::Trunk.index();
+        let fastest = targets
+            .windows(2)
+            .map(|w| w[0][trunk].angle_between(w[1][trunk]) * rate)
+            .fold(0.0, f64::max);
+        let turned = targets[0][trunk].angle_between(targets[n - 1][trunk]);
+        assert!(
+            turned > 0.1,
+            "the reach needs the trunk: it turned {:.1}°",
+            turned.to_degrees()
+        );
+        assert!(
+            fastest <= MAX_PLACING_TRUNK_TURN_RAD_PER_S * (1.0 + 1e-9),
+            "the trunk turned at {:.0}°/s",
+            fastest.to_degrees()
+        );
+        let grip = Joint::arm(Side::Left)[3].index();
+        let reached = model.skeleton.forward(&targets[n - 1]).position[grip];
+        assert!(
+            reached.distance(point) < 0.01,
+            "the hand ended {:.3} m from its point",
+            reached.distance(point)
+        );
+    }
 
     /// The task-rate IK of a long fast passage keeps the arms' posture: 40 s of strokes
     /// (four a second per hand) going round three drums of each side, a loop that turns a
