@@ -100,6 +100,30 @@ fn a_touched_head_falls_silent() {
     }
 }
 
+/// The head moves as a player's does through the study's two-stick strokes and damping
+/// hands: neither the neck's nor the head's joint turns faster than 1000°/s. (With the
+/// trunk's IK target turning with every strike-through dip and reach, the neck and head,
+/// driven for a trunk that could not follow, whipped round at up to 4700°/s here.)
+#[test]
+fn the_head_never_whips_round() {
+    let r = study();
+    let rate = r.motion.rate_hz;
+    let poses: Vec<_> = r.motion.poses.iter().collect();
+    for joint in [Joint::Neck, Joint::Head] {
+        let j = joint.index();
+        let (fastest, at) = poses
+            .windows(2)
+            .enumerate()
+            .map(|(k, w)| (w[0][j].angle_between(w[1][j]).to_degrees() * rate, k))
+            .fold((0.0, 0), |a, b| if b.0 > a.0 { b } else { a });
+        let at_s = r.start_s + at as f64 / rate;
+        assert!(
+            fastest < 1000.0,
+            "{joint:?} turned at {fastest:.0}°/s at {at_s:.2} s"
+        );
+    }
+}
+
 /// Making a beat secco in the editor (a damp added to the study's beat at tick 9600 on
 /// the 29-inch drum) re-renders from a saved state before the edit and gives bit for bit
 /// what rendering the edited study whole gives: the damping hand's way to the head and

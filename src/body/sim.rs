@@ -166,13 +166,16 @@ const SLOW_LOOP: f64 = 0.1;
 /// Rounds of [`place_hand`] in a task-rate IK solve.
 const HAND_SOLVE_ROUNDS: usize = 40;
 
-/// Fastest the trunk's target turns while a hand goes to a point of its own, rad/s
-/// (90°/s). Placing a hand satisfies the hand's point and the stick's tip together as
-/// soon as its weight is above 0 (the alternating rounds compound), which may need the
-/// trunk turned: a damping hand's first 40 ms turned it 17° (570°/s) on pedal-changes,
-/// and the light neck and head, jolted by the trunk's loop, whipped round at up to
-/// 5700°/s. A player turns into such a reach over a few tenths of a second.
-pub const MAX_PLACING_TRUNK_TURN_RAD_PER_S: f64 = std::f64::consts::FRAC_PI_2;
+/// Fastest the trunk's IK target turns, rad/s (90°/s); the arms are solved again about a
+/// trunk held to it. The tips' IK also reaches with the trunk, which turned it with every
+/// fast excursion of a tip: a stroke's strike-through dip (10–20 ms below the head) at
+/// up to 700°/s, a damping hand's reach (whose rounds meet the hand's point and the tip
+/// together as soon as its weight leaves 0) 17° in 40 ms. The target's acceleration (up
+/// to 2600 rad/s²) asked the feed-forward for the trunk's torque limit and, the face
+/// kept on its drum, for the neck's and head's, and the light neck and head, driven for
+/// a trunk that could not follow, whipped round at up to 5700°/s. A player's trunk
+/// turns into a reach over tenths of a second and stays still through a stroke.
+pub const MAX_TRUNK_TURN_RAD_PER_S: f64 = std::f64::consts::FRAC_PI_2;
 
 /// Per sample and hand ([left, right]), where the hand goes (its grip joint, m) and how
 /// much of the way: 0 leaves the hand to the stick's task, 1 puts it on its point. While
@@ -472,7 +475,7 @@ pub fn ik_target(
         }
     };
     let mut pose = reference.poses.as_ref().map_or(start, |p| p[k]);
-    let placed = arms_ik(
+    arms_ik(
         model,
         reference,
         k,
@@ -483,9 +486,10 @@ pub fn ik_target(
     let trunk = Joint::Trunk.index();
     let (turn, most) = (
         start[trunk].angle_between(pose[trunk]),
-        MAX_PLACING_TRUNK_TURN_RAD_PER_S / reference.rate_hz,
+        MAX_TRUNK_TURN_RAD_PER_S / reference.rate_hz,
     );
-    if placed && turn > most && reference.poses.is_none() {
+    // (A captured posture's trunk is followed as it was.)
+    if turn > most && reference.poses.is_none() {
         // The trunk held to its fastest turn, the arms solved again about it.
         pose[trunk] = start[trunk].slerp(pose[trunk], most / turn).normalize();
         let held = IkParams {
@@ -509,7 +513,7 @@ pub fn ik_target(
 }
 
 /// Both arms' IK of reference sample `k` from `pose`, the redundancy pulled toward `pull`
-/// ([`place_hand`] for a hand with a point of its own); whether a hand has one.
+/// ([`place_hand`] for a hand with a point of its own).
 fn arms_ik(
     model: &BodyModel,
     reference: &Reference,
@@ -517,8 +521,7 @@ fn arms_ik(
     (ik, limits): (&IkParams, &JointLimits),
     pull: &Pose,
     pose: &mut Pose,
-) -> bool {
-    let mut placed = false;
+) {
     for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
         *pose = ik::solve(
             &model.skeleton,
@@ -531,7 +534,6 @@ fn arms_ik(
         )
         .pose;
         if let Some(hand) = reference.hands.as_ref().and_then(|t| t.at(h, k, 1.0)) {
-            placed = true;
             place_hand(
                 &model.skeleton,
                 pose,
@@ -544,7 +546,6 @@ fn arms_ik(
             );
         }
     }
-    placed
 }
 
 /// [`simulate`] with the body meeting `environment` (e.g. the drums) every simulation step.
@@ -1093,8 +1094,8 @@ mod tests {
 
     /// A hand going to a point of its own that the arm reaches only with the trunk
     /// turned: the trunk's target turns no faster than
-    /// [`MAX_PLACING_TRUNK_TURN_RAD_PER_S`] (unheld it turned as soon as the hand's
-    /// weight left 0), and the hand still gets to its point.
+    /// [`MAX_TRUNK_TURN_RAD_PER_S`] (unheld it turned as soon as the hand's weight left
+    /// 0), and the hand still gets to its point.
     #[test]
     fn a_placed_hand_turns_the_trunk_no_faster_than_a_player() {
         let model = BodyModel::default();
@@ -1137,7 +1138,7 @@ mod tests {
             turned.to_degrees()
         );
         assert!(
-            fastest <= MAX_PLACING_TRUNK_TURN_RAD_PER_S * (1.0 + 1e-9),
+            fastest <= MAX_TRUNK_TURN_RAD_PER_S * (1.0 + 1e-9),
             "the trunk turned at {:.0}°/s",
             fastest.to_degrees()
         );

@@ -86,24 +86,31 @@ fn moving_average(values: &[DVec3], half: usize) -> Vec<DVec3> {
 }
 
 /// The points to look at and when they are struck (score s), in time order: each stroke's
-/// point on its head, strokes struck together merged into their mean.
+/// point on its head, strokes struck together merged into the point of their mean
+/// [`bearing`] (the mean of points on two sides of the arc lies next to the body, where
+/// the face, turned from there to the next drum, swung round at 1000°/s: the secco
+/// study's closing chord on the outer drums).
 pub fn looks(comp: &Composition) -> Vec<(f64, DVec3)> {
-    let mut strokes: Vec<(f64, DVec3)> =
-        comp.strokes.iter().map(|s| (s.time_s, s.target)).collect();
+    merged(comp.strokes.iter().map(|s| (s.time_s, s.target)).collect())
+}
+
+/// [`looks`] of strokes given as (time s, point m).
+fn merged(mut strokes: Vec<(f64, DVec3)>) -> Vec<(f64, DVec3)> {
     strokes.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut looks: Vec<(f64, DVec3, usize)> = Vec::new();
+    // (time, the first point, the sum of the bearings, how many)
+    let mut looks: Vec<(f64, DVec3, DVec3, usize)> = Vec::new();
     for (t, p) in strokes {
         match looks.last_mut() {
-            Some((t0, sum, n)) if t - *t0 < TOGETHER_S => {
-                *sum += p;
+            Some((t0, _, sum, n)) if t - *t0 < TOGETHER_S => {
+                *sum += bearing(p);
                 *n += 1;
             }
-            _ => looks.push((t, p, 1)),
+            _ => looks.push((t, p, bearing(p), 1)),
         }
     }
     looks
         .into_iter()
-        .map(|(t, sum, n)| (t, sum / n as f64))
+        .map(|(t, p, sum, n)| (t, if n == 1 { p } else { point(sum / n as f64) }))
         .collect()
 }
 
@@ -147,6 +154,23 @@ mod tests {
 
     /// A turn from one drum to another is smooth: its speed changes by little from one
     /// sample to the next (no jump as a box average makes), and it ends on the new drum.
+    /// Two strokes struck together on drums at either side of the player are looked at
+    /// between them at their distance, in front, not at their mean point by the body.
+    #[test]
+    fn a_chord_on_both_sides_is_looked_at_round_the_front() {
+        let (left, right) = (DVec3::new(-0.80, 0.05, 0.76), DVec3::new(0.70, 0.30, 0.78));
+        let looks = merged(vec![(1.0, left), (1.0, right), (2.0, left)]);
+        assert_eq!(looks.len(), 2);
+        let chord = looks[0].1;
+        let distance = chord.truncate().length();
+        assert!(
+            (0.7..0.85).contains(&distance),
+            "{chord}: {distance} m away"
+        );
+        assert!(chord.y > 0.6, "{chord}: not in front");
+        assert_eq!(looks[1].1, left, "a single stroke's own point");
+    }
+
     #[test]
     fn a_turn_has_no_jumps_in_speed() {
         let rate = 250.0;
