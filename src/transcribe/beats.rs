@@ -414,6 +414,26 @@ mod tests {
     use super::*;
     use crate::score::TempoMap;
 
+    /// Strokes from 80 to 120 bpm over eight beats show their pace, however their
+    /// intervals fall; dotted rhythms, and a stroke with its echo heard as another, do not.
+    #[test]
+    fn a_ramp_shows_its_pace_and_uneven_strokes_do_not() {
+        let mut ramp = vec![0.0];
+        for k in 0..8 {
+            let bpm = 80.0 + 40.0 * f64::from(k) / 7.0;
+            ramp.push(ramp[ramp.len() - 1] + 60.0 / bpm);
+        }
+        let pace = even_pace_s(&ramp, 4).expect("the ramp's pace");
+        assert!((0.55..0.7).contains(&pace), "{pace} s");
+        let dotted: Vec<f64> = (0..9)
+            .map(|k| f64::from(k / 2) + 0.75 * f64::from(k % 2))
+            .collect();
+        assert_eq!(even_pace_s(&dotted, 4), None);
+        let mut echoed: Vec<f64> = (0..8).map(|k| 0.6 * f64::from(k)).collect();
+        echoed.insert(4, 0.6 * 3.0 + 0.08);
+        assert_eq!(even_pace_s(&echoed, 4), None);
+    }
+
     fn pulses(times: &[f64], seconds: f64) -> Strength {
         let hop = 0.005;
         let mut values = vec![0.01; (seconds / hop) as usize];
