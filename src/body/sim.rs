@@ -475,14 +475,8 @@ pub fn ik_target(
         }
     };
     let mut pose = reference.poses.as_ref().map_or(start, |p| p[k]);
-    arms_ik(
-        model,
-        reference,
-        k,
-        (&params.ik, &params.ik_limits()),
-        &pull,
-        &mut pose,
-    );
+    let limits = params.ik_limits();
+    arms_ik(model, reference, k, (&params.ik, &limits), &pull, &mut pose);
     let trunk = Joint::Trunk.index();
     let (turn, most) = (
         start[trunk].angle_between(pose[trunk]),
@@ -496,14 +490,7 @@ pub fn ik_target(
             use_trunk: false,
             ..params.ik
         };
-        arms_ik(
-            model,
-            reference,
-            k,
-            (&held, &params.ik_limits()),
-            &pull,
-            &mut pose,
-        );
+        arms_ik(model, reference, k, (&held, &limits), &pull, &mut pose);
     }
     if let Some(gaze) = &reference.gaze {
         let frames = model.skeleton.forward(&pose);

@@ -659,7 +659,7 @@ impl Performance {
             // A stroke that does not sound is worse than a stick falling back on a head,
             // that worse than a contact out of time, that worse than a force far off, that
             // worse than a pressed (long) contact, and that worse than a force a little off.
-            let late = worst > aims.acceptable_s + TIME_ROUNDING_S;
+            let late = out_of_time(worst, aims.acceptable_s);
             let key = (missed, recontacts, late, far, long, off_force, worst);
             if best.as_ref().is_none_or(|b| key <= b.0) {
                 best = Some((
@@ -670,7 +670,7 @@ impl Performance {
                 ));
             }
             let clean = missed + recontacts + long + off_force == 0;
-            let on_time = clean && worst <= aims.tolerance_s + TIME_ROUNDING_S;
+            let on_time = clean && !out_of_time(worst, aims.tolerance_s);
             let acceptable = clean && !late && attempt >= aims.settle_attempts;
             // A cluster that sounds but has a force far off or a pressed contact gets up
             // to half as many attempts again.
@@ -696,8 +696,7 @@ impl Performance {
                 c.as_ref().is_none_or(|c| {
                     let ratio = c.peak_force_n / aims.force_n[i];
                     (ratio - 1.0).abs() > aims.force_tolerance
-                        || (c.start_s - strokes[i].time_s).abs()
-                            > aims.tolerance_s + TIME_ROUNDING_S
+                        || out_of_time((c.start_s - strokes[i].time_s).abs(), aims.tolerance_s)
                         || pressed(c, aims)
                 })
             };
@@ -817,6 +816,12 @@ fn most_alike(settled: &[PlannedStroke], stroke: &PlannedStroke) -> Vec<usize> {
         })
         .find(|like| !like.is_empty())
         .unwrap_or_default()
+}
+
+/// Whether a timing error of `error_s` is beyond `tolerance_s` (by more than
+/// [`TIME_ROUNDING_S`]).
+fn out_of_time(error_s: f64, tolerance_s: f64) -> bool {
+    error_s > tolerance_s + TIME_ROUNDING_S
 }
 
 /// Whether two placements of a cluster are the same to [`REPEAT_SHIFT_S`] and

@@ -152,8 +152,6 @@ mod tests {
         assert!(fastest < 4.0, "turns at {fastest} rad/s");
     }
 
-    /// A turn from one drum to another is smooth: its speed changes by little from one
-    /// sample to the next (no jump as a box average makes), and it ends on the new drum.
     /// Two strokes struck together on drums at either side of the player are looked at
     /// between them at their distance, in front, not at their mean point by the body.
     #[test]
@@ -171,6 +169,8 @@ mod tests {
         assert_eq!(looks[1].1, left, "a single stroke's own point");
     }
 
+    /// A turn from one drum to another is smooth: its speed changes by little from one
+    /// sample to the next (no jump as a box average makes), and it ends on the new drum.
     #[test]
     fn a_turn_has_no_jumps_in_speed() {
         let rate = 250.0;
