@@ -250,7 +250,8 @@ fn ladder_at_the_bottom_of_the_big_drums() {
     let scored: Vec<_> = r.events.iter().filter(|e| e.beat.is_some()).collect();
     assert!(scored.iter().all(|e| e.recontacts == 0), "re-contacts");
     for e in &scored {
-        assert!((2.0..=8.0).contains(&e.duration_ms), "{e:?}");
+        // Contacts last whole 0.1 ms steps: 8 ms may read 8.000000000000895.
+        assert!((2.0..=8.0 + 1e-9).contains(&e.duration_ms), "{e:?}");
         assert!(
             (e.contact_s - e.scheduled_s.unwrap()).abs() < 0.003,
             "{e:?}"
@@ -933,6 +934,9 @@ fn by_hand(contacts: &[ContactEvent]) -> Vec<&ContactEvent> {
 #[derive(Clone, Copy, Debug, Default)]
 struct Apart {
     rms_m: f64,
+    /// The median distance of the tips (the larger hand's), m: the step's systematic
+    /// error, which one rebound gone another way does not sway.
+    median_m: f64,
     worst_m: f64,
     contact_s: f64,
     force: f64,
@@ -944,11 +948,16 @@ impl Apart {
         for (x, y) in a.0.tips.iter().zip(&b.0.tips) {
             assert_eq!(x.len(), y.len(), "{name}");
             let mut squares = 0.0;
+            let mut distances = Vec::with_capacity(x.len());
             for (p, q) in x.iter().zip(y) {
                 apart.worst_m = apart.worst_m.max(p.distance(*q));
                 squares += p.distance_squared(*q);
+                distances.push(p.distance(*q));
             }
             apart.rms_m = apart.rms_m.max((squares / x.len() as f64).sqrt());
+            distances.sort_by(f64::total_cmp);
+            let median = distances.get(distances.len() / 2).copied().unwrap_or(0.0);
+            apart.median_m = apart.median_m.max(median);
         }
         let (ra, rb) = (by_hand(a.1), by_hand(b.1));
         assert_eq!(ra.len(), rb.len(), "{name}: contacts of 5 N or more");
@@ -967,6 +976,7 @@ impl Apart {
     fn max(self, o: Apart) -> Apart {
         Apart {
             rms_m: self.rms_m.max(o.rms_m),
+            median_m: self.median_m.max(o.median_m),
             worst_m: self.worst_m.max(o.worst_m),
             contact_s: self.contact_s.max(o.contact_s),
             force: self.force.max(o.force),
@@ -978,8 +988,9 @@ impl std::fmt::Display for Apart {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "tip paths {:.2} mm RMS, {:.2} mm at worst; contact times {:.2} ms; peak forces {:.1} %",
+            "tip paths {:.2} mm RMS, {:.3} mm median, {:.2} mm at worst; contact times {:.2} ms; peak forces {:.1} %",
             self.rms_m * 1e3,
+            self.median_m * 1e3,
             self.worst_m * 1e3,
             self.contact_s * 1e3,
             self.force * 100.0
@@ -1058,10 +1069,13 @@ fn the_fast_body_step_stays_near_the_reference() {
                 Apart::between(&name, at_20, (&at_40.motion, at_40.drums.contacts())),
             );
             println!("{name}: 10 against 20 kHz {first}; 20 against 40 kHz {second}");
-            let order = first.rms_m / second.rms_m;
+            // By the median distance: one loose-grip rebound that goes another way at one
+            // rate (2.8 mm at 52.2 s, 20 against 40 kHz) weighs on the RMS as much as the
+            // whole score's step error (0.097 mm RMS, 0.075 without it).
+            let order = first.median_m / second.median_m;
             assert!(
                 (1.5..2.6).contains(&order),
-                "halving the step divides the tip error by {order:.2}"
+                "halving the step divides the tips' median distance by {order:.2}"
             );
         }
     }

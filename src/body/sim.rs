@@ -152,6 +152,68 @@ pub struct Reference {
     /// Per sample, the trunk's turn toward far strokes ([`super::lean::track`]: a world
     /// rotation applied to the upright trunk the IK pulls toward); `None` keeps it upright.
     pub lean: Option<Vec<DQuat>>,
+    /// Tip and grip targets between the samples where they change faster than a task
+    /// step resolves (around the strokes); `None`: the line between samples everywhere.
+    pub fine: Option<FineTargets>,
+}
+
+/// Targets [`FineTargets::per_sample`] times per task step over spans of samples. A
+/// stroke's strike-through dip lasts 16 ms, four task steps, and the composed tip turns
+/// sharply at its impact: drawn through the task samples alone, a stroke played a
+/// fraction of a step earlier or later reached up to 5 mm less deep and struck up to 15 %
+/// softer or harder, in a cycle of one task step (4 ms), so its force depended on where
+/// the beat fell between samples rather than on the stroke.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FineTargets {
+    /// Values per task step.
+    pub per_sample: usize,
+    /// Per hand [left, right], spans in time order, not overlapping.
+    pub spans: [Vec<FineSpan>; 2],
+}
+
+/// One span of [`FineTargets`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct FineSpan {
+    /// The task sample of its first value.
+    pub first: usize,
+    /// Tip targets at task samples `first + j / per_sample`, m.
+    pub tips: Vec<DVec3>,
+    /// The fraction of the grip's control held at the same times (empty: no grip).
+    pub grip: Vec<f64>,
+}
+
+impl FineTargets {
+    /// Hand `h`'s span covering the task step from sample `k − 1` to `k`, and where in it
+    /// (the fractional index of its values) the fraction `u` of that step falls.
+    fn locate(&self, h: usize, k: usize, u: f64) -> Option<(&FineSpan, f64)> {
+        let from = k.checked_sub(1)?;
+        let spans = &self.spans[h];
+        let span = &spans[spans.partition_point(|s| s.first <= from).checked_sub(1)?];
+        let x = ((from - span.first) as f64 + u) * self.per_sample as f64;
+        let last = span.tips.len().checked_sub(1)? as f64;
+        (x <= last).then_some((span, x))
+    }
+
+    /// Hand `h`'s values over the task step from sample `k − 1` to `k` (past its start),
+    /// tips and grip, where a span covers it.
+    pub fn step(&self, h: usize, k: usize) -> Option<(&[DVec3], &[f64])> {
+        let (span, x) = self.locate(h, k, 1.0)?;
+        let end = x as usize + 1;
+        let start = end.saturating_sub(self.per_sample);
+        Some((
+            &span.tips[start..end],
+            span.grip.get(start..end).unwrap_or(&[]),
+        ))
+    }
+}
+
+/// `values` at fractional index `x` (within them), interpolated by `lerp`.
+fn between<T: Copy>(values: &[T], x: f64, lerp: impl Fn(T, T, f64) -> T) -> T {
+    let i = (x.floor() as usize).min(values.len().saturating_sub(2));
+    match values.get(i + 1) {
+        Some(&next) => lerp(values[i], next, x - i as f64),
+        None => values[i],
+    }
 }
 
 /// A body is calm (see [`SimParams::calm_substeps`]) this long, s, before and after every
@@ -381,7 +443,30 @@ impl Reference {
             grip: None,
             hands: None,
             lean: None,
+            fine: None,
         }
+    }
+
+    /// Hand `h`'s tip target a fraction `u` (0–1) of the way from sample `k − 1` to `k`,
+    /// m: from the fine targets where they cover that step, else on the line between the
+    /// two samples.
+    pub fn tip_between(&self, h: usize, k: usize, u: f64) -> DVec3 {
+        match self.fine.as_ref().and_then(|f| f.locate(h, k, u)) {
+            Some((span, x)) => between(&span.tips, x, DVec3::lerp),
+            None => self.tips[h][k - 1].lerp(self.tips[h][k], u),
+        }
+    }
+
+    /// The fraction of hand `h`'s grip control held a fraction `u` of the way from sample
+    /// `k − 1` to `k` (as [`Self::tip_between`]); `None` without grip targets.
+    pub fn grip_between(&self, h: usize, k: usize, u: f64) -> Option<f64> {
+        let grip = self.grip.as_ref()?;
+        Some(match self.fine.as_ref().and_then(|f| f.locate(h, k, u)) {
+            Some((span, x)) if span.grip.len() == span.tips.len() => {
+                between(&span.grip, x, |a, b, u| a + (b - a) * u)
+            }
+            _ => grip[h][k - 1] + (grip[h][k] - grip[h][k - 1]) * u,
+        })
     }
 
     /// The beat being played at `time_s`: the first whose impact is not yet past.
@@ -867,7 +952,7 @@ impl Simulator {
                 for _ in 0..self.params.nested_iterations {
                     let frames = self.model.skeleton.forward(&goal);
                     for (h, side) in [Side::Left, Side::Right].into_iter().enumerate() {
-                        let mut target = reference.tips[h][k - 1].lerp(reference.tips[h][k], u);
+                        let mut target = reference.tip_between(h, k, u);
                         if let Some(z) = floor[h] {
                             target.z = target.z.max(z);
                         }
@@ -896,10 +981,10 @@ impl Simulator {
                 }
                 solved = Some(goal);
             }
-            let held = reference.grip.as_ref().map(|grip| {
-                let at = |h: usize| grip[h][k - 1] + (grip[h][k] - grip[h][k - 1]) * u;
-                [at(0), at(1)]
-            });
+            let held = reference
+                .grip_between(0, k, u)
+                .zip(reference.grip_between(1, k, u))
+                .map(|(left, right)| [left, right]);
             let mut tau = pd_torques(&self.gains, &self.state, &goal, &target_w, &bias);
             if let Some(held) = held {
                 for (side, fraction) in [Side::Left, Side::Right].into_iter().zip(held) {
@@ -1078,6 +1163,54 @@ pub fn rms_error(a: &[DVec3], b: &[DVec3]) -> f64 {
 mod tests {
     use super::*;
     use crate::body::skeleton::REST;
+
+    /// Between task samples a tip or grip target comes from the fine targets where a
+    /// span covers the step, else from the line between the two samples.
+    #[test]
+    fn targets_between_samples_come_from_fine_targets_where_given() {
+        let line = |h: usize| -> Vec<DVec3> {
+            (0..6)
+                .map(|k| DVec3::new(k as f64, h as f64, 0.0))
+                .collect()
+        };
+        let mut r = Reference::following(250.0, [line(0), line(1)]);
+        r.grip = Some([vec![1.0; 6], vec![1.0; 6]]);
+        // Hand 1, samples 2 to 3, four values a step, a notch 5 cm deep between them.
+        let notch = [0.0, -0.02, -0.05, -0.02, 0.0];
+        let tips = notch
+            .iter()
+            .enumerate()
+            .map(|(j, z)| DVec3::new(2.0 + j as f64 / 4.0, 1.0, *z))
+            .collect();
+        let grip = vec![1.0, 0.5, 0.02, 0.5, 1.0];
+        r.fine = Some(FineTargets {
+            per_sample: 4,
+            spans: [
+                Vec::new(),
+                vec![FineSpan {
+                    first: 2,
+                    tips,
+                    grip,
+                }],
+            ],
+        });
+        assert_eq!(r.tip_between(1, 3, 0.5), DVec3::new(2.5, 1.0, -0.05));
+        let quarter_way = r.tip_between(1, 3, 0.125);
+        assert!((quarter_way.z + 0.01).abs() < 1e-12, "{quarter_way}");
+        assert_eq!(r.grip_between(1, 3, 0.5), Some(0.02));
+        // Past the span, and the other hand: the line.
+        assert_eq!(r.tip_between(1, 4, 0.5), DVec3::new(3.5, 1.0, 0.0));
+        assert_eq!(r.tip_between(0, 3, 0.5), DVec3::new(2.5, 0.0, 0.0));
+        assert_eq!(r.grip_between(0, 3, 0.5), Some(1.0));
+        // A step's values: from just past its start to its end.
+        let fine = r.fine.as_ref().unwrap();
+        let (tips, grip) = fine.step(1, 3).expect("covered");
+        assert_eq!(tips.len(), 4);
+        assert_eq!(tips[1].z, -0.05);
+        assert_eq!(grip, &[0.5, 0.02, 0.5, 1.0]);
+        assert!(fine.step(1, 2).is_none() && fine.step(1, 4).is_none());
+        assert!(fine.step(0, 3).is_none());
+    }
 
     /// A hand going to a point of its own that the arm reaches only with the trunk
     /// turned: the trunk's target turns no faster than

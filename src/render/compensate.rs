@@ -79,7 +79,12 @@ struct Followed {
     from: usize,
     tips: [Vec<DVec3>; 2],
     grip: [Vec<f64>; 2],
+    /// The fine targets between those samples, per hand and sample of the span.
+    fine: [Vec<Option<FineStep>>; 2],
 }
+
+/// The fine tip and grip targets over one task step (see [`fine_step`]).
+type FineStep = (Vec<DVec3>, Vec<f64>);
 
 impl Followed {
     /// `reference`'s targets over `span`.
@@ -92,6 +97,11 @@ impl Followed {
                     .grip
                     .as_ref()
                     .map_or_else(Vec::new, |g| g[h][span.clone()].to_vec())
+            }),
+            fine: std::array::from_fn(|h| {
+                span.clone()
+                    .map(|k| fine_step(reference, h, k).map(|(t, g)| (t.to_vec(), g.to_vec())))
+                    .collect()
             }),
         }
     }
@@ -109,11 +119,20 @@ impl Followed {
                         .grip
                         .as_ref()
                         .is_some_and(|g| self.grip[h].get(i) != Some(&g[h][k]))
+                    || self.fine[h].get(i).is_none_or(|followed| {
+                        followed.as_ref().map(|(t, g)| (&t[..], &g[..]))
+                            != fine_step(reference, h, k)
+                    })
             })
         };
         let end = span.end;
         span.into_iter().find(|&k| differs(k)).unwrap_or(end)
     }
+}
+
+/// `reference`'s fine targets of hand `h` over the task step ending at sample `k`.
+fn fine_step(reference: &Reference, h: usize, k: usize) -> Option<(&[DVec3], &[f64])> {
+    reference.fine.as_ref().and_then(|f| f.step(h, k))
 }
 
 /// The depth (m) at force aim `aim` (N) on the least-squares line through `points`

@@ -13,7 +13,7 @@
 //! the targets only after the anchor before it, which lets the compensation settle a
 //! score front to back and resume from any settled point.
 
-use crate::body::sim::{HandTargets, Reference};
+use crate::body::sim::{FineSpan, FineTargets, HandTargets, Reference};
 use crate::motion::compose::Composition;
 use glam::{DQuat, DVec3};
 use std::ops::Range;
@@ -107,6 +107,26 @@ struct Dip {
     depth_m: f64,
 }
 
+impl Dip {
+    /// How far the dip lowers the target at composed time `t_s` (from sample 0), m.
+    fn lowered_at(&self, t_s: f64) -> f64 {
+        let x = (t_s - (self.time_s - self.lead_s)) / self.half_s;
+        if x.abs() < 1.0 {
+            self.depth_m * 0.5 * (1.0 + (std::f64::consts::PI * x).cos())
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Fine targets ([`FineTargets`]) are written this many times per task step: at 250 Hz
+/// every 0.4 ms, the rate the nested IK reads them at (every 4 steps of 10 kHz).
+pub const FINE_PER_SAMPLE: usize = 10;
+
+/// Fine targets cover each dip's samples and this much either side, s: more than the
+/// compensation's largest shift, so a dip played earlier or later stays inside.
+pub const FINE_MARGIN_S: f64 = 0.04;
+
 /// The composed tips shaped for striking, before the time warp: raised by the ball
 /// radius, with each stroke's dip at its current depth.
 #[derive(Clone, Debug, PartialEq)]
@@ -131,6 +151,14 @@ pub struct Targets {
     held: [Vec<f64>; 2],
     /// Where the hands damp heads (the composition's muffles), when any do.
     hands: Option<HandTargets>,
+    /// How the grip lets go around each impact.
+    release: Release,
+    /// Per hand, its strokes' indices in time order.
+    by_hand: [Vec<usize>; 2],
+    /// Per hand, the task samples (first, last) the fine targets cover, in time order.
+    fine_spans: [Vec<(usize, usize)>; 2],
+    /// The furthest any dip lowers the target from its impact, s.
+    dip_reach_s: f64,
 }
 
 impl Targets {
@@ -201,6 +229,7 @@ impl Targets {
             .collect();
         beats.sort_by(|a, b| a.0.total_cmp(&b.0));
         let held = grip_held(&dips, &shape.release, rate, n);
+
         let hands = hand_targets(comp);
         let gaze_of = (super::gaze::looks(comp), comp.start_s);
         let gaze = match earlier {
@@ -220,11 +249,29 @@ impl Targets {
             lean: None,
             held,
             hands,
+            release: shape.release,
+            by_hand: [Vec::new(), Vec::new()],
+            fine_spans: [Vec::new(), Vec::new()],
+            dip_reach_s: 0.0,
         };
+        targets.index_dips();
         for i in 0..targets.dips.len() {
             targets.set_depth(i, depth_m);
         }
         targets
+    }
+
+    /// Each hand's strokes in time order, the spans the fine targets cover and how far
+    /// the dips reach, from the dips.
+    fn index_dips(&mut self) {
+        let dips = &self.dips;
+        self.by_hand = std::array::from_fn(|h| {
+            let mut of_hand: Vec<usize> = (0..dips.len()).filter(|&i| dips[i].hand == h).collect();
+            of_hand.sort_by(|&a, &b| dips[a].time_s.total_cmp(&dips[b].time_s));
+            of_hand
+        });
+        self.fine_spans = fine_spans(dips, &self.by_hand, self.rate_hz, self.len());
+        self.dip_reach_s = dips.iter().map(|d| d.lead_s + d.half_s).fold(0.0, f64::max);
     }
 
     /// Where the performer looks, per sample, m.
@@ -258,13 +305,7 @@ impl Targets {
         dip.depth_m = depth_m;
         let (raised, shaped) = (&self.raised[dip.hand], &mut self.shaped[dip.hand]);
         for k in dip.samples.clone() {
-            let x = (k as f64 / self.rate_hz - (dip.time_s - dip.lead_s)) / dip.half_s;
-            let lowered = if x.abs() < 1.0 {
-                depth_m * 0.5 * (1.0 + (std::f64::consts::PI * x).cos())
-            } else {
-                0.0
-            };
-            shaped[k] = raised[k] - DVec3::Z * lowered;
+            shaped[k] = raised[k] - DVec3::Z * dip.lowered_at(k as f64 / self.rate_hz);
         }
     }
 
@@ -300,7 +341,68 @@ impl Targets {
             grip: Some(self.held.clone()),
             hands: self.hands.clone(),
             lean: self.lean.clone(),
+            fine: Some(self.blank_fine()),
         }
+    }
+
+    /// Fine targets over [`Self::fine_spans`] with no warp (the task samples' values on
+    /// the line between them, to be [`write`](Targets::write)n).
+    fn blank_fine(&self) -> FineTargets {
+        let per = FINE_PER_SAMPLE;
+        let spans = std::array::from_fn(|h| {
+            let line = |first: usize, last: usize| {
+                let at = |j: usize| first as f64 + j as f64 / per as f64;
+                let values = (last - first) * per + 1;
+                (
+                    (0..values)
+                        .map(|j| sample(&self.shaped[h], at(j), DVec3::lerp))
+                        .collect(),
+                    (0..values)
+                        .map(|j| sample(&self.held[h], at(j), |a, b, u| a + (b - a) * u))
+                        .collect(),
+                )
+            };
+            self.fine_spans[h]
+                .iter()
+                .map(|&(first, last)| {
+                    let (tips, grip) = line(first, last);
+                    FineSpan { first, tips, grip }
+                })
+                .collect()
+        });
+        FineTargets {
+            per_sample: per,
+            spans,
+        }
+    }
+
+    /// Hand `h`'s tip target and the fraction of its grip held at fractional composed
+    /// sample `x`: the composed tip (raised) there less any dip, and the least grip any
+    /// of its impacts leaves (as [`grip_held`], but at any time, not only on samples).
+    fn at(&self, h: usize, x: f64) -> (DVec3, f64) {
+        let t = x / self.rate_hz;
+        let (before, after) = self.release.span_s();
+        let of_hand = &self.by_hand[h];
+        // Dips and releases reach at most this far from their impact.
+        let reach = before.max(after).max(self.dip_reach_s);
+        let from = of_hand.partition_point(|&i| self.dips[i].time_s < t - reach);
+        let mut lowered = 0.0;
+        let mut held = 1.0f64;
+        for &i in of_hand[from..]
+            .iter()
+            .take_while(|&&i| self.dips[i].time_s <= t + reach)
+        {
+            let dip = &self.dips[i];
+            lowered += dip.lowered_at(t);
+            let since = t - dip.time_s;
+            if (-before..=after).contains(&since) {
+                held = held.min(self.release.held_at(since));
+            }
+        }
+        (
+            sample(&self.raised[h], x, DVec3::lerp) - DVec3::Z * lowered,
+            held,
+        )
     }
 
     /// Lean the trunk toward the composition's far strokes for a player of `skeleton`
@@ -333,9 +435,49 @@ impl Targets {
                     next += 1;
                 }
                 let x = (t + shift_between(knots, next, t)) * rate;
-                reference.tips[h][k] = sample(&self.shaped[h], x, DVec3::lerp);
+                let (tip, held) = self.at(h, x);
+                reference.tips[h][k] = tip;
                 if let Some(grip) = &mut reference.grip {
-                    grip[h][k] = sample(&self.held[h], x, |a, b, u| a + (b - a) * u);
+                    grip[h][k] = held;
+                }
+            }
+            if let Some(fine) = &mut reference.fine {
+                self.write_fine(h, knots, fine, range.start..end);
+            }
+        }
+    }
+
+    /// Hand `h`'s fine targets through `knots` over task samples `range` (from each one's
+    /// time to the next's, the last one's own value included).
+    fn write_fine(
+        &self,
+        h: usize,
+        knots: &[(f64, f64)],
+        fine: &mut FineTargets,
+        range: Range<usize>,
+    ) {
+        let (rate, per) = (self.rate_hz, fine.per_sample);
+        if range.is_empty() {
+            return;
+        }
+        for span in &mut fine.spans[h] {
+            let last = span.first + (span.tips.len().saturating_sub(1)) / per;
+            if last < range.start || span.first >= range.end {
+                continue;
+            }
+            let from = (range.start.max(span.first) - span.first) * per;
+            let to = ((range.end - 1).min(last) - span.first) * per;
+            let t0 = (span.first as f64 + from as f64 / per as f64) / rate;
+            let mut next = knots.partition_point(|&(u, _)| u <= t0);
+            for j in from..=to {
+                let t = (span.first as f64 + j as f64 / per as f64) / rate;
+                while next < knots.len() && knots[next].0 <= t {
+                    next += 1;
+                }
+                let (tip, held) = self.at(h, (t + shift_between(knots, next, t)) * rate);
+                span.tips[j] = tip;
+                if let Some(g) = span.grip.get_mut(j) {
+                    *g = held;
                 }
             }
         }
@@ -441,6 +583,34 @@ fn grip_held(dips: &[Dip], release: &Release, rate: f64, n: usize) -> [Vec<f64>;
     held
 }
 
+/// Per hand, the task samples (first, last) within [`FINE_MARGIN_S`] of a dip of its
+/// strokes (`by_hand`: each hand's strokes in time order), overlapping ones merged, over
+/// `n` samples at `rate` Hz.
+fn fine_spans(
+    dips: &[Dip],
+    by_hand: &[Vec<usize>; 2],
+    rate: f64,
+    n: usize,
+) -> [Vec<(usize, usize)>; 2] {
+    let margin = (FINE_MARGIN_S * rate).ceil() as usize + 1;
+    std::array::from_fn(|h| {
+        let mut spans: Vec<(usize, usize)> = Vec::new();
+        for &i in &by_hand[h] {
+            if n < 2 {
+                break;
+            }
+            let dip = &dips[i];
+            let first = dip.samples.start.saturating_sub(margin).min(n - 2);
+            let last = (dip.samples.end + margin).min(n - 1).max(first + 1);
+            match spans.last_mut() {
+                Some(span) if first <= span.1 => span.1 = span.1.max(last),
+                _ => spans.push((first, last)),
+            }
+        }
+        spans
+    })
+}
+
 /// The shift at time `t_s` between `knots[next - 1]` and `knots[next]` (`next`: the
 /// first knot after `t_s`), held before the first knot and after the last, s.
 fn shift_between(knots: &[(f64, f64)], next: usize, t_s: f64) -> f64 {
@@ -506,6 +676,10 @@ mod tests {
             lean: None,
             held: [vec![1.0; n], vec![1.0; n]],
             hands: None,
+            release: Release::FIRM,
+            by_hand: [Vec::new(), Vec::new()],
+            fine_spans: [Vec::new(), Vec::new()],
+            dip_reach_s: 0.0,
         }
     }
 
@@ -563,6 +737,46 @@ mod tests {
         assert_eq!(whole.tips[1][13..27], part.tips[1][13..27]);
     }
 
+    /// A dip played a fraction of a task step earlier or later reaches the same depth in
+    /// the fine targets the nested IK reads, where the task samples alone cut it by up to
+    /// a seventh; and a write of part of the score gives the fine targets of a whole one.
+    #[test]
+    fn fine_targets_keep_a_dip_whole_at_any_phase() {
+        let mut t = targets(100);
+        t.rate_hz = 250.0;
+        // Deepest at 0.196 s, on sample 49, 20 mm below the raised tip (z = 1 m).
+        t.dips = vec![dip(1, (0.2, 0.008, 0.004), 47..52)];
+        t.index_dips();
+        t.set_depth(0, 0.02);
+        let lowest = |points: &mut dyn Iterator<Item = &DVec3>| {
+            points.map(|p| p.z).fold(f64::INFINITY, f64::min)
+        };
+        for shift in [0.0, 0.0013, 0.002, -0.0027] {
+            let mut warp = Warp::default();
+            warp.push(1, (0.15, shift));
+            warp.push(1, (0.25, shift));
+            let r = t.reference(&warp);
+            let fine = r.fine.as_ref().expect("fine targets");
+            let fine_lowest = lowest(&mut fine.spans[1].iter().flat_map(|s| s.tips.iter()));
+            assert!((fine_lowest - 0.98).abs() < 1e-4, "{shift}: {fine_lowest}");
+            let sampled = lowest(&mut r.tips[1].iter());
+            if shift == 0.002 {
+                // Half a step off the samples: they straddle the deepest point 2 ms
+                // either side, 0.85 of the depth.
+                assert!(sampled > 0.9825, "{sampled}");
+            }
+            assert!(fine.spans[0].is_empty() && fine.spans[1].len() == 1);
+            // A part written over a blank is the whole's over that part.
+            let mut part = t.blank();
+            t.write(&warp, &mut part, 45..55);
+            let (whole, part) = (&fine.spans[1][0], &part.fine.unwrap().spans[1][0]);
+            let per = FINE_PER_SAMPLE;
+            let covered = (45 - whole.first) * per..=(54 - whole.first) * per;
+            assert_eq!(whole.tips[covered.clone()], part.tips[covered.clone()]);
+            assert_eq!(whole.grip[covered.clone()], part.grip[covered]);
+        }
+    }
+
     /// The release lets go before the impact, holds through the contact and closes
     /// again smoothly; the grip is firm away from impacts.
     #[test]
@@ -600,6 +814,7 @@ mod tests {
         let mut t = targets(100);
         t.rate_hz = 1000.0;
         t.dips = vec![dip(0, (0.050, 0.008, 0.004), 38..55)];
+        t.index_dips();
         t.set_depth(0, 0.01);
         let z: Vec<f64> = t.shaped[0].iter().map(|p| p.z).collect();
         let deepest = (0..100).min_by(|&a, &b| z[a].total_cmp(&z[b])).unwrap();
@@ -623,6 +838,8 @@ mod tests {
         t.rate_hz = 250.0;
         t.dips = vec![dip(1, (0.2, 0.012, 0.0), 47..54)];
         t.held = grip_held(&t.dips, &Release::DEFAULT, 250.0, 100);
+        t.release = Release::DEFAULT;
+        t.index_dips();
         assert!(t.held[0].iter().all(|&h| h == 1.0));
         assert_eq!(t.held[1][50], Release::DEFAULT.held);
         assert_eq!(t.held[1][0], 1.0);
