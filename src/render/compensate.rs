@@ -38,6 +38,8 @@ const LOOKAHEAD_S: f64 = 0.035;
 /// The most a stroke's target is played earlier or later, s (with the gap and the
 /// look-ahead, it keeps the next cluster's dips out of a cluster's targets).
 const MAX_SHIFT_S: f64 = 0.035;
+// A dip shifted by the most stays within its fine targets.
+const _: () = assert!(MAX_SHIFT_S < super::reference::FINE_MARGIN_S);
 /// A contact weaker than this fraction of its stroke's aimed force is a graze, ranked with
 /// a stroke that did not sound when the compensation picks its best attempt.
 const GRAZE_FRACTION: f64 = 0.25;

@@ -229,7 +229,6 @@ impl Targets {
             .collect();
         beats.sort_by(|a, b| a.0.total_cmp(&b.0));
         let held = grip_held(&dips, &shape.release, rate, n);
-
         let hands = hand_targets(comp);
         let gaze_of = (super::gaze::looks(comp), comp.start_s);
         let gaze = match earlier {
