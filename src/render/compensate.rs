@@ -329,8 +329,12 @@ impl Performance {
         self.suggested.resize(strokes, (0.0, 0.0));
         self.targets = targets;
         self.reference = self.targets.blank();
+        // The fine targets only from the step the simulation goes on with (a state of n
+        // samples steps next from sample n − 1 to n); those before it are never read.
+        let resumes = commit.samples.saturating_sub(1)..commit.samples + 1;
         self.targets
-            .write(&self.warp, &mut self.reference, 0..commit.samples + 1);
+            .write_task_samples(&self.warp, &mut self.reference, 0..resumes.start);
+        self.targets.write(&self.warp, &mut self.reference, resumes);
         self.settled = commit.strokes;
         self.lead_from = commit.lead.map(|(from, _)| from);
         self.attempts = 0;

@@ -420,8 +420,26 @@ impl Targets {
     }
 
     /// Write samples `range` of `reference` (made by [`blank`](Targets::blank)) through
-    /// `warp`: sample k at time t takes the shaped tip at t + shift(t).
+    /// `warp`: sample k at time t takes the shaped tip at t + shift(t), and so do the
+    /// fine targets from sample `range.start` to the last one.
     pub fn write(&self, warp: &Warp, reference: &mut Reference, range: Range<usize>) {
+        self.write_samples(warp, reference, range, true);
+    }
+
+    /// [`Self::write`] without the fine targets: what a performance resumed at a saved
+    /// state needs before it (the task samples are shown and exported; the fine targets
+    /// there are never read again, and writing them cost an edit about 1 ms).
+    pub fn write_task_samples(&self, warp: &Warp, reference: &mut Reference, range: Range<usize>) {
+        self.write_samples(warp, reference, range, false);
+    }
+
+    fn write_samples(
+        &self,
+        warp: &Warp,
+        reference: &mut Reference,
+        range: Range<usize>,
+        fine: bool,
+    ) {
         let rate = self.rate_hz;
         let end = range.end.min(self.len());
         for h in 0..2 {
@@ -440,8 +458,8 @@ impl Targets {
                     grip[h][k] = held;
                 }
             }
-            if let Some(fine) = &mut reference.fine {
-                self.write_fine(h, knots, fine, range.start..end);
+            if let Some(targets) = reference.fine.as_mut().filter(|_| fine) {
+                self.write_fine(h, knots, targets, range.start..end);
             }
         }
     }
