@@ -207,13 +207,16 @@ impl FineTargets {
     }
 }
 
-/// `values` at fractional index `x` (within them), interpolated by `lerp`.
-fn between<T: Copy>(values: &[T], x: f64, lerp: impl Fn(T, T, f64) -> T) -> T {
-    let i = (x.floor() as usize).min(values.len().saturating_sub(2));
-    match values.get(i + 1) {
-        Some(&next) => lerp(values[i], next, x - i as f64),
-        None => values[i],
+/// Interpolation (by `lerp`) of `points` at fractional index `x`, held at the ends.
+pub fn sample_at<T: Copy>(points: &[T], x: f64, lerp: impl Fn(T, T, f64) -> T) -> T {
+    let last = points.len() - 1;
+    let x = x.clamp(0.0, last as f64);
+    let i = (x.floor() as usize).min(last.saturating_sub(1));
+    let u = x - i as f64;
+    if last == 0 {
+        return points[0];
     }
+    lerp(points[i], points[i + 1], u)
 }
 
 /// A body is calm (see [`SimParams::calm_substeps`]) this long, s, before and after every
@@ -452,7 +455,7 @@ impl Reference {
     /// two samples.
     pub fn tip_between(&self, h: usize, k: usize, u: f64) -> DVec3 {
         match self.fine.as_ref().and_then(|f| f.locate(h, k, u)) {
-            Some((span, x)) => between(&span.tips, x, DVec3::lerp),
+            Some((span, x)) => sample_at(&span.tips, x, DVec3::lerp),
             None => self.tips[h][k - 1].lerp(self.tips[h][k], u),
         }
     }
@@ -463,7 +466,7 @@ impl Reference {
         let grip = self.grip.as_ref()?;
         Some(match self.fine.as_ref().and_then(|f| f.locate(h, k, u)) {
             Some((span, x)) if span.grip.len() == span.tips.len() => {
-                between(&span.grip, x, |a, b, u| a + (b - a) * u)
+                sample_at(&span.grip, x, |a, b, u| a + (b - a) * u)
             }
             _ => grip[h][k - 1] + (grip[h][k] - grip[h][k - 1]) * u,
         })
@@ -1163,6 +1166,19 @@ pub fn rms_error(a: &[DVec3], b: &[DVec3]) -> f64 {
 mod tests {
     use super::*;
     use crate::body::skeleton::REST;
+
+    /// Sampling at a fractional index is linear and clamped.
+    #[test]
+    fn sampling_is_linear_and_clamped() {
+        let pts = [DVec3::ZERO, DVec3::X];
+        assert_eq!(
+            sample_at(&pts, 0.25, DVec3::lerp),
+            DVec3::new(0.25, 0.0, 0.0)
+        );
+        assert_eq!(sample_at(&pts, -3.0, DVec3::lerp), DVec3::ZERO);
+        assert_eq!(sample_at(&pts, 9.0, DVec3::lerp), DVec3::X);
+        assert_eq!(sample_at(&[2.0], 0.7, |a, b, u| a + (b - a) * u), 2.0);
+    }
 
     /// Between task samples a tip or grip target comes from the fine targets where a
     /// span covers the step, else from the line between the two samples.

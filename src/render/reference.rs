@@ -13,7 +13,7 @@
 //! the targets only after the anchor before it, which lets the compensation settle a
 //! score front to back and resume from any settled point.
 
-use crate::body::sim::{FineSpan, FineTargets, HandTargets, Reference};
+use crate::body::sim::{FineSpan, FineTargets, HandTargets, Reference, sample_at};
 use crate::motion::compose::Composition;
 use glam::{DQuat, DVec3};
 use std::ops::Range;
@@ -354,10 +354,10 @@ impl Targets {
                 let values = (last - first) * per + 1;
                 (
                     (0..values)
-                        .map(|j| sample(&self.shaped[h], at(j), DVec3::lerp))
+                        .map(|j| sample_at(&self.shaped[h], at(j), DVec3::lerp))
                         .collect(),
                     (0..values)
-                        .map(|j| sample(&self.held[h], at(j), |a, b, u| a + (b - a) * u))
+                        .map(|j| sample_at(&self.held[h], at(j), |a, b, u| a + (b - a) * u))
                         .collect(),
                 )
             };
@@ -399,7 +399,7 @@ impl Targets {
             }
         }
         (
-            sample(&self.raised[h], x, DVec3::lerp) - DVec3::Z * lowered,
+            sample_at(&self.raised[h], x, DVec3::lerp) - DVec3::Z * lowered,
             held,
         )
     }
@@ -641,18 +641,6 @@ fn shift_between(knots: &[(f64, f64)], next: usize, t_s: f64) -> f64 {
     }
 }
 
-/// Interpolation (by `lerp`) of `points` at fractional index `x`, held at the ends.
-fn sample<T: Copy>(points: &[T], x: f64, lerp: impl Fn(T, T, f64) -> T) -> T {
-    let last = points.len() - 1;
-    let x = x.clamp(0.0, last as f64);
-    let i = (x.floor() as usize).min(last.saturating_sub(1));
-    let u = x - i as f64;
-    if last == 0 {
-        return points[0];
-    }
-    lerp(points[i], points[i + 1], u)
-}
-
 /// The hands' targets of the composition's muffles: per sample, the weight of the muffle
 /// under way (none overlap for one hand) and its hand point; `None` without muffles.
 fn hand_targets(comp: &Composition) -> Option<HandTargets> {
@@ -868,14 +856,5 @@ mod tests {
         let grip = r.grip.unwrap();
         assert_eq!(grip[1][48], t.held[1][50]);
         assert_eq!(grip[1][40], t.held[1][42]);
-    }
-
-    /// Sampling at a fractional index is linear and clamped.
-    #[test]
-    fn sampling_is_linear_and_clamped() {
-        let pts = [DVec3::ZERO, DVec3::X];
-        assert_eq!(sample(&pts, 0.25, DVec3::lerp), DVec3::new(0.25, 0.0, 0.0));
-        assert_eq!(sample(&pts, -3.0, DVec3::lerp), DVec3::ZERO);
-        assert_eq!(sample(&pts, 9.0, DVec3::lerp), DVec3::X);
     }
 }
